@@ -1,0 +1,90 @@
+"""Depth camera geometry and per-object crops (pure numpy).
+
+The camera looks at the table from the far side; the depth buffer is converted to metric depth
+(metres along the view axis) and each object is cut out as a fixed-size window centred on its
+visible pixels, masked to those pixels. The window's top-left pixel (its origin) is kept so that
+two further channels can give every crop pixel its normalized position in the full image.
+
+    >>> cam = CameraConfig()
+    >>> metric_depth(np.array([0.0, 1.0], np.float32), cam).round(2).tolist()
+    [0.75, 5.5]
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class CameraConfig:
+    """An overhead depth camera; numbers from REFERENCE_NOTES.md (about 24 px per 10 cm)."""
+
+    eye: tuple[float, float, float] = (1.2, 0.0, 1.6)
+    target: tuple[float, float, float] = (0.8, 0.0, 0.4)
+    up: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    fov_deg: float = 45.0  # vertical field of view
+    size: int = 256  # square image, pixels
+    near: float = 0.75
+    far: float = 5.5
+
+
+def metric_depth(buffer: np.ndarray, cam: CameraConfig) -> np.ndarray:
+    """OpenGL depth buffer values in [0, 1] -> metric depth in metres (float32)."""
+    d = np.asarray(buffer, np.float64)
+    return (cam.far * cam.near / (cam.far - (cam.far - cam.near) * d)).astype(np.float32)
+
+
+def crop_origins(seg: np.ndarray, body_ids: np.ndarray, crop: int,
+                 last_origins: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Top-left pixel (row, col) of each object's crop window, and its visible pixel count.
+
+    The window is centred on the mean pixel of the object's segment. A fully occluded object
+    keeps `last_origins` (its last known window) or, without one, the image centre.
+    """
+    h, w = seg.shape
+    k = len(body_ids)
+    origins = np.zeros((k, 2), np.int16)
+    counts = np.zeros(k, np.int32)
+    rows, cols = np.indices(seg.shape)
+    for i, b in enumerate(body_ids):
+        m = seg == b
+        n = int(m.sum())
+        counts[i] = n
+        if n:
+            centre = np.array([rows[m].mean(), cols[m].mean()])
+            origins[i] = np.rint(centre).astype(np.int64) - crop // 2
+        elif last_origins is not None:
+            origins[i] = last_origins[i]
+        else:
+            origins[i] = (h // 2 - crop // 2, w // 2 - crop // 2)
+    return origins, counts
+
+
+def cut_crops(depth: np.ndarray, seg: np.ndarray, body_ids: np.ndarray, origins: np.ndarray,
+              crop: int) -> np.ndarray:
+    """(k, crop, crop) depth windows at `origins`, zero outside the object's own pixels."""
+    h, w = depth.shape
+    pad_d = np.zeros((h + 2 * crop, w + 2 * crop), np.float32)
+    pad_d[crop:crop + h, crop:crop + w] = depth
+    pad_s = np.full((h + 2 * crop, w + 2 * crop), -1, seg.dtype)
+    pad_s[crop:crop + h, crop:crop + w] = seg
+    out = np.zeros((len(body_ids), crop, crop), np.float32)
+    for i, (b, (r, c)) in enumerate(zip(body_ids, origins)):
+        r0 = int(np.clip(r, -crop, h)) + crop
+        c0 = int(np.clip(c, -crop, w)) + crop
+        win_d = pad_d[r0:r0 + crop, c0:c0 + crop]
+        out[i] = np.where(pad_s[r0:r0 + crop, c0:c0 + crop] == b, win_d, 0.0)
+    return out
+
+
+def position_channels(origins: np.ndarray, crop: int, image_size: int) -> np.ndarray:
+    """(..., 2, crop, crop) float32: each crop pixel's column (x) and row (y) in the image, in [0, 1]."""
+    origins = np.asarray(origins, np.float32)
+    offs = np.arange(crop, dtype=np.float32)
+    rows = origins[..., 0, None] + offs  # (..., crop)
+    cols = origins[..., 1, None] + offs
+    scale = 1.0 / (image_size - 1)
+    x = np.broadcast_to(cols[..., None, :], origins.shape[:-1] + (crop, crop)) * scale
+    y = np.broadcast_to(rows[..., :, None], origins.shape[:-1] + (crop, crop)) * scale
+    return np.stack([x, y], axis=-3).astype(np.float32)

@@ -1,0 +1,83 @@
+"""The robot's exploration protocol: random initial scenes and random actions (no pybullet).
+
+Numbers follow REFERENCE_NOTES.md, which reproduce the paper's 28,607 objects in 10,000 samples:
+1, 2, 3 objects with probability 0.1, 0.2, 0.7; episodes of 4, 8, 20 actions; the pick location
+is an occupied one with probability 0.8; the release location is uniform over all six.
+
+    >>> cfg = ExplorationConfig()
+    >>> rng = np.random.default_rng(0)
+    >>> spec = sample_scene_spec(rng, cfg)
+    >>> 1 <= len(spec) <= 3
+    True
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from symlearn.world import N_LOCATIONS, NEAR_ROW, Action, ObjectType
+
+MAX_OBJECTS = 5  # scenes larger than this are not supported (crops, padding, planners)
+
+
+@dataclass(frozen=True)
+class ExplorationConfig:
+    """How scenes are drawn and actions chosen while collecting data."""
+
+    k_values: tuple[int, ...] = (1, 2, 3)  # numbers of objects a scene may hold
+    k_probs: tuple[float, ...] = (0.1, 0.2, 0.7)  # the paper's mix gives about 2.86 objects/sample
+    episode_lengths: tuple[int, ...] = (4, 8, 20)  # actions per scene, by k (last one for larger k)
+    stick_prob: float = 0.35  # chance that an object is a stick, while the scene has none yet
+    pick_occupied_prob: float = 0.8  # else the pick location is uniform over all six
+
+    def __post_init__(self) -> None:
+        if len(self.k_values) != len(self.k_probs) or not self.k_values:
+            raise ValueError("k_values and k_probs must have the same, non-zero length")
+        for k in self.k_values:
+            if not (isinstance(k, (int, np.integer)) and 1 <= k <= MAX_OBJECTS):
+                raise ValueError(f"number of objects k={k!r} is out of range 1..{MAX_OBJECTS}")
+        if abs(sum(self.k_probs) - 1.0) > 1e-6 or min(self.k_probs) < 0:
+            raise ValueError(f"k_probs {self.k_probs} must be non-negative and sum to 1")
+        if not 0.0 <= self.stick_prob <= 1.0 or not 0.0 <= self.pick_occupied_prob <= 1.0:
+            raise ValueError("stick_prob and pick_occupied_prob must lie in [0, 1]")
+
+    def episode_length(self, k: int) -> int:
+        return self.episode_lengths[min(k, len(self.episode_lengths)) - 1]
+
+    @staticmethod
+    def with_k_range(lo: int, hi: int) -> "ExplorationConfig":
+        """Uniform over lo..hi objects (e.g. 4-5 for generalization scenes)."""
+        ks = tuple(range(lo, hi + 1))
+        if not ks:
+            raise ValueError(f"empty object range {lo}-{hi}")
+        return ExplorationConfig(k_values=ks, k_probs=tuple([1.0 / len(ks)] * len(ks)))
+
+
+def sample_scene_spec(rng: np.random.Generator, cfg: ExplorationConfig,
+                      k: int | None = None) -> list[tuple[ObjectType, int]]:
+    """Objects to drop, in order: (type, near-row location). Distinct locations while they last,
+    then stacked on a random near-row location; at most one stick."""
+    if k is None:
+        k = int(rng.choice(cfg.k_values, p=cfg.k_probs))
+    if not 1 <= k <= MAX_OBJECTS:
+        raise ValueError(f"number of objects k={k} is out of range 1..{MAX_OBJECTS}")
+    locs = list(rng.permutation(NEAR_ROW))
+    spec = []
+    has_stick = False
+    for i in range(k):
+        is_stick = (not has_stick) and rng.random() < cfg.stick_prob
+        has_stick |= is_stick
+        loc = int(locs[i]) if i < len(locs) else int(rng.choice(NEAR_ROW))
+        spec.append((ObjectType.STICK if is_stick else ObjectType.CUBE, loc))
+    return spec
+
+
+def sample_action(rng: np.random.Generator, occupied: np.ndarray, cfg: ExplorationConfig) -> Action:
+    """A random action: pick an occupied location with probability p, else any; release anywhere."""
+    occ = np.flatnonzero(occupied)
+    if occ.size and rng.random() < cfg.pick_occupied_prob:
+        pick = int(rng.choice(occ))
+    else:
+        pick = int(rng.integers(N_LOCATIONS))
+    return Action(pick, int(rng.integers(N_LOCATIONS)))

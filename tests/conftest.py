@@ -1,0 +1,11 @@
+import pytest
+
+from symlearn.simulator import TabletopSimulator
+
+
+@pytest.fixture(scope="session")
+def sim():
+    """One simulator for the session: every scenario rebuilds its own scene."""
+    s = TabletopSimulator()
+    yield s
+    s.close()

@@ -1,0 +1,135 @@
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from symlearn.collect import CollectConfig, CollectError, collect, shard_name
+from symlearn.dataset import ARRAY_NAMES, DataError, load_manifest, load_split, model_inputs, summarize
+from symlearn.exploration import ExplorationConfig
+
+CFG = CollectConfig(n=24, seed=3, shard_size=2)
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    out = tmp_path_factory.mktemp("data") / "tiny"
+    collect(out, CFG, workers=1, show_progress=False)
+    return out
+
+
+def test_manifest_and_splits(tiny):
+    m = load_manifest(tiny)
+    assert m["complete"] and m["n_shards"] == 12
+    assert m["counts"] == {"train": 20, "val": 2, "test": 2}
+    assert m["settings"]["seed"] == 3 and "pybullet" in m["versions"]
+    train = load_split(tiny, "train")
+    assert len(train) == 20 and train.pre_depth.shape == (20, 3, 64, 64)
+    assert train.pre_depth.dtype == np.float16 and train.effect.shape == (20, 3, 3)
+    assert set(np.unique(train.action)) <= set(range(36))
+    # padding rows are empty; real rows have types and (mostly) visible crops
+    assert np.all(train.obj_type[~train.mask] == -1) and np.all(train.effect[~train.mask] == 0)
+    assert np.all(train.obj_type[train.mask] >= 0)
+    # each step's post-state is the next step's pre-state within an episode
+    same_ep = (train.episode[1:] == train.episode[:-1]) & (train.step[1:] == train.step[:-1] + 1)
+    assert same_ep.any()
+    np.testing.assert_array_equal(train.post_depth[:-1][same_ep], train.pre_depth[1:][same_ep])
+    np.testing.assert_allclose(train.effect[train.mask],
+                               (train.post_pose[..., :3] - train.pre_pose[..., :3])[train.mask], atol=1e-6)
+
+
+def test_model_inputs_shapes(tiny):
+    d = load_split(tiny, "val")
+    x = model_inputs(d.pre_depth, d.pre_origin)
+    assert x.shape == (2, 3, 3, 64, 64) and x.dtype == np.float32
+    assert 0 <= x[:, :, 1:].min() and x[:, :, 1:].max() <= 1.3  # windows may reach past the border
+    with pytest.raises(DataError, match="shape"):
+        model_inputs(d.pre_depth[:, :, 0], d.pre_origin)
+
+
+def test_same_seed_same_arrays_with_two_workers(tiny, tmp_path):
+    out = tmp_path / "again"
+    collect(out, CFG, workers=2, show_progress=False)
+    for split in ("train", "val", "test"):
+        a, b = load_split(tiny, split), load_split(out, split)
+        for name in ARRAY_NAMES:
+            np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
+def test_resume_redoes_only_missing_shards(tmp_path):
+    out = tmp_path / "resume"
+    cfg = CollectConfig(n=12, seed=1, shard_size=1)
+    collect(out, cfg, show_progress=False)
+    before = {p.name: p.stat().st_mtime_ns for p in out.glob("shard_*.npz")}
+    (out / shard_name(5)).unlink()
+    m = collect(out, cfg, show_progress=False)
+    after = {p.name: p.stat().st_mtime_ns for p in out.glob("shard_*.npz")}
+    assert m["complete"] and set(after) == set(before)
+    changed = [n for n in after if after[n] != before.get(n)]
+    assert changed == [shard_name(5)]
+
+
+def test_different_settings_refused(tiny):
+    with pytest.raises(CollectError, match="different settings.*seed"):
+        collect(tiny, CollectConfig(n=24, seed=4, shard_size=2), show_progress=False)
+
+
+def test_foreign_directory_refused(tmp_path):
+    (tmp_path / "notes.txt").write_text("hello")
+    with pytest.raises(CollectError, match="not a symlearn data set"):
+        collect(tmp_path, CFG, show_progress=False)
+
+
+def test_corrupted_and_truncated_shards_detected(tiny, tmp_path):
+    import shutil
+
+    copy = tmp_path / "copy"
+    shutil.copytree(tiny, copy)
+    shard = copy / shard_name(0)
+    data = bytearray(shard.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    shard.write_bytes(bytes(data))
+    with pytest.raises(DataError, match="shard_00000.npz is corrupted"):
+        load_split(copy, "train")
+    shard.write_bytes(bytes(data[: len(data) // 3]))
+    with pytest.raises(DataError, match="corrupted or truncated"):
+        load_split(copy, "train")
+    (copy / shard_name(11)).unlink()
+    with pytest.raises(DataError, match="missing"):
+        load_split(copy, "test")
+
+
+def test_missing_foreign_and_old_format_refused(tmp_path):
+    with pytest.raises(DataError, match="manifest.json missing"):
+        load_manifest(tmp_path)
+    (tmp_path / "manifest.json").write_text(json.dumps({"kind": "other"}))
+    with pytest.raises(DataError, match="not a symlearn"):
+        load_manifest(tmp_path)
+    (tmp_path / "manifest.json").write_text(json.dumps({"kind": "symlearn-interaction-data", "format_version": 99}))
+    with pytest.raises(DataError, match="format version 99"):
+        load_manifest(tmp_path)
+    with pytest.raises(DataError, match="unknown split"):
+        load_split(tmp_path, "dev")
+
+
+@pytest.mark.parametrize("kw,msg", [({"k_values": (6,), "k_probs": (1.0,)}, "out of range"),
+                                    ({"k_values": (0, 1), "k_probs": (0.5, 0.5)}, "out of range"),
+                                    ({"k_probs": (0.5, 0.5, 0.5)}, "sum to 1")])
+def test_bad_exploration_settings_refused(kw, msg):
+    with pytest.raises(ValueError, match=msg):
+        ExplorationConfig(**kw)
+
+
+def test_cli_collect_and_refusals(tmp_path):
+    out = tmp_path / "cli"
+    run = [sys.executable, "-m", "symlearn.cli", "collect", "--out", str(out), "--n", "12",
+           "--shard-size", "1", "--objects", "4-5", "--quiet"]
+    r = subprocess.run(run, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    summary = json.loads(r.stdout)
+    assert summary["samples"] == 12 and summary["objects_per_sample"] >= 4
+    assert load_split(out, "all").pre_depth.shape[1] == 5  # padded to the largest scene
+    bad = subprocess.run(run[:-2] + ["0-6", "--quiet"], capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2 and "out of range" in bad.stderr and len(bad.stderr.strip().splitlines()) == 1
+    assert summarize(out)["shards"] == 12
