@@ -61,6 +61,43 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
     return 0
 
 
+def _init_distributed() -> None:
+    """Join the process group when launched by torchrun (WORLD_SIZE > 1)."""
+    import os
+
+    if int(os.environ.get("WORLD_SIZE", "1")) > 1:
+        import torch
+        import torch.distributed as dist
+
+        dist.init_process_group("nccl" if torch.cuda.is_available() else "gloo")
+
+
+def cmd_train(args: argparse.Namespace) -> int:
+    from symlearn.training import TrainConfig, train
+
+    over = {k: v for k, v in dict(epochs=args.epochs, batch_size=args.batch_size, lr=args.lr, seed=args.seed,
+                                   max_train_samples=args.max_train_samples).items() if v is not None}
+    if args.no_attention:
+        over["attention"] = False
+    cfg = TrainConfig.preset(args.preset, bf16=not args.no_bf16, compile=args.compile, **over)
+    _init_distributed()
+    print(f"train: preset {cfg.preset}, {cfg.epochs} epochs, seed {cfg.seed}, attention {cfg.model.attention} "
+          f"-> {args.out}", file=sys.stderr)
+    out = train(Path(args.data), Path(args.out), cfg, resume=not args.no_resume, show_progress=not args.quiet)
+    last = out["history"][-1] if out["history"] else {}
+    print(json.dumps({"run": args.out, "best_val_loss": out["best_val_loss"], "last_epoch": last}, indent=2))
+    return 0
+
+
+def cmd_evaluate(args: argparse.Namespace) -> int:
+    from symlearn.evaluation import evaluate, format_table
+
+    res = evaluate(Path(args.run), Path(args.data), Path(args.baseline_run) if args.baseline_run else None)
+    print(format_table(res))
+    print(f"wrote {Path(args.run) / 'eval.json'}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="symlearn", description="Learn planning symbols from robot interaction.")
     sub = p.add_subparsers(dest="command", required=True)
@@ -81,6 +118,28 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true", help="print JSON")
     s.add_argument("--gui", action="store_true", help="watch in pybullet's GUI")
     s.set_defaults(func=cmd_scenarios)
+
+    t = sub.add_parser("train", help="train the attentive effect model (runs under torchrun too)")
+    t.add_argument("--data", required=True)
+    t.add_argument("--out", required=True, help="run directory (resumed if it holds the same run)")
+    t.add_argument("--preset", default="paper", choices=["paper", "quick"])
+    t.add_argument("--epochs", type=int)
+    t.add_argument("--batch-size", type=int)
+    t.add_argument("--lr", type=float)
+    t.add_argument("--seed", type=int)
+    t.add_argument("--max-train-samples", type=int, help="train on the first N samples only")
+    t.add_argument("--no-attention", action="store_true", help="the DeepSym baseline without attention")
+    t.add_argument("--no-bf16", action="store_true", help="plain float32 (bf16 autocast is the default)")
+    t.add_argument("--compile", action="store_true", help="torch.compile the model")
+    t.add_argument("--no-resume", action="store_true", help="start over even if RUN/last.pt exists")
+    t.add_argument("--quiet", action="store_true")
+    t.set_defaults(func=cmd_train)
+
+    e = sub.add_parser("evaluate", help="effect errors on the test split, with ablation rows")
+    e.add_argument("--run", required=True)
+    e.add_argument("--data", required=True)
+    e.add_argument("--baseline-run", help="a run trained with --no-attention, for the ablation row")
+    e.set_defaults(func=cmd_evaluate)
     return p
 
 

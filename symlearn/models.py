@@ -1,0 +1,181 @@
+"""Attentive DeepSym and its baselines as torch modules.
+
+The encoder f turns each object's 3-channel crop (depth, x, y) into a `bits`-bit code through a
+Gumbel-sigmoid with a straight-through estimator (a deterministic threshold at evaluation);
+the one-hot action is concatenated to every code; a stack of transformer encoder layers lets
+the objects of a scene attend to each other (padding masked out); the decoder g predicts each
+object's normalized displacement. Batch-norm layers only ever see real objects: padded slots
+are removed before the encoder and decoder and scattered back after.
+
+    >>> cfg = ModelConfig.preset("quick")
+    >>> model = AttentiveDeepSym(cfg)
+    >>> x = torch.zeros(2, 3, 3, cfg.crop, cfg.crop); mask = torch.tensor([[1, 1, 0], [1, 0, 0]]).bool()
+    >>> out = model(x, mask, torch.tensor([0, 35]))
+    >>> tuple(out.effect.shape), tuple(out.codes.shape)
+    ((2, 3, 3), (2, 3, 8))
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import torch
+import torch.nn as nn
+import torch.nn.functional as F
+
+N_ACTIONS = 36
+
+
+@dataclass(frozen=True)
+class ModelConfig:
+    """Architecture of the effect model; `paper` is the seed paper's, `quick` trains in minutes."""
+
+    bits: int = 8  # code length: at most 256 symbols, as the paper
+    crop: int = 64  # input crop size in pixels
+    conv_channels: tuple[int, ...] = (64, 128, 256, 512)  # DCGAN-like: kernel 4, stride 2, padding 1
+    d_model: int = 128  # transformer width; code+action (44) is projected to it
+    n_heads: int = 8  # 16 dimensions per head
+    n_layers: int = 4  # TransformerEncoderLayer stack
+    ff_dim: int = 2048  # PyTorch's default dim_feedforward
+    dropout: float = 0.1  # PyTorch's default
+    decoder_hidden: tuple[int, ...] = (256, 256, 256)  # three hidden layers with batch-norm
+    attention: bool = True  # False: the DeepSym baseline, each object decoded from its own code
+    tau: float = 1.0  # Gumbel-sigmoid temperature
+    depth_ref: float = 2.0  # input depth d becomes (depth_ref - d) / depth_scale on object pixels
+    depth_scale: float = 0.5
+
+    def __post_init__(self) -> None:
+        if self.d_model % self.n_heads:
+            raise ValueError(f"d_model {self.d_model} is not divisible by n_heads {self.n_heads}")
+        if self.crop % (2 ** len(self.conv_channels)):
+            raise ValueError(f"crop {self.crop} must be divisible by 2^{len(self.conv_channels)}")
+        if not 1 <= self.bits <= 16:
+            raise ValueError(f"bits={self.bits} must lie in 1..16")
+
+    @staticmethod
+    def preset(name: str, **overrides) -> "ModelConfig":
+        if name not in PRESETS:
+            raise ValueError(f"unknown preset {name!r}; known: {', '.join(PRESETS)}")
+        return dataclasses.replace(PRESETS[name], **overrides)
+
+    def to_json(self) -> dict:
+        return dataclasses.asdict(self)
+
+    @staticmethod
+    def from_json(d: dict) -> "ModelConfig":
+        fields = {f.name for f in dataclasses.fields(ModelConfig)}
+        unknown = set(d) - fields
+        if unknown:
+            raise ValueError(f"unknown model config fields {sorted(unknown)}")
+        return ModelConfig(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
+
+
+PRESETS = {
+    "paper": ModelConfig(),
+    "quick": ModelConfig(conv_channels=(16, 32, 64, 64), d_model=64, n_heads=4, n_layers=2, ff_dim=256,
+                         decoder_hidden=(128, 128, 128)),
+}
+
+
+class EffectOutput(NamedTuple):
+    effect: torch.Tensor  # (B, K, 3) normalized displacement
+    codes: torch.Tensor  # (B, K, bits) in {0, 1} (straight-through while training)
+    logits: torch.Tensor  # (B, K, bits)
+
+
+def gumbel_sigmoid(logits: torch.Tensor, tau: float, training: bool,
+                   generator: torch.Generator | None = None) -> torch.Tensor:
+    """Binary codes: noisy hard sample with straight-through gradients in training, threshold at eval."""
+    if not training:
+        return (logits > 0).to(logits.dtype)
+    u = torch.rand(logits.shape, generator=generator, device=logits.device, dtype=torch.float32)
+    u = u.clamp(1e-6, 1 - 1e-6).to(logits.dtype)
+    soft = torch.sigmoid((logits + torch.log(u) - torch.log1p(-u)) / tau)  # logistic = Gumbel difference
+    hard = (soft > 0.5).to(logits.dtype)
+    return hard + soft - soft.detach()
+
+
+class Encoder(nn.Module):
+    """Crop (3, S, S) -> code logits (bits,)."""
+
+    def __init__(self, cfg: ModelConfig) -> None:
+        super().__init__()
+        layers, c_in = [], 3
+        for c in cfg.conv_channels:
+            layers += [nn.Conv2d(c_in, c, 4, 2, 1, bias=False), nn.BatchNorm2d(c), nn.ReLU(inplace=True)]
+            c_in = c
+        self.conv = nn.Sequential(*layers)
+        self.proj = nn.Linear(c_in, cfg.bits)
+        self.cfg = cfg
+
+    def forward(self, crops: torch.Tensor) -> torch.Tensor:
+        d = crops[:, :1]
+        depth = torch.where(d > 0, (self.cfg.depth_ref - d) / self.cfg.depth_scale, torch.zeros_like(d))
+        x = torch.cat([depth, crops[:, 1:]], dim=1).contiguous(memory_format=torch.channels_last)  # (N, 3, S, S)
+        h = self.conv(x).mean(dim=(2, 3))  # (N, C)
+        return self.proj(h)  # (N, bits)
+
+
+def mlp(sizes: list[int], batch_norm: bool = True) -> nn.Sequential:
+    layers: list[nn.Module] = []
+    for a, b in zip(sizes[:-2], sizes[1:-1]):
+        layers += [nn.Linear(a, b), *( [nn.BatchNorm1d(b)] if batch_norm else []), nn.ReLU(inplace=True)]
+    layers.append(nn.Linear(sizes[-2], sizes[-1]))
+    return nn.Sequential(*layers)
+
+
+class AttentiveDeepSym(nn.Module):
+    """Encoder -> (code, action) tokens -> transformer (or none) -> decoder, per object."""
+
+    def __init__(self, cfg: ModelConfig) -> None:
+        super().__init__()
+        self.cfg = cfg
+        self.encoder = Encoder(cfg)
+        self.inp = nn.Linear(cfg.bits + N_ACTIONS, cfg.d_model)
+        if cfg.attention:
+            layer = nn.TransformerEncoderLayer(cfg.d_model, cfg.n_heads, cfg.ff_dim, cfg.dropout, batch_first=True)
+            self.attn = nn.TransformerEncoder(layer, cfg.n_layers, enable_nested_tensor=False)
+        else:
+            self.attn = None
+        self.decoder = mlp([cfg.d_model, *cfg.decoder_hidden, 3])
+
+    def encode(self, crops: torch.Tensor, mask: torch.Tensor,
+               generator: torch.Generator | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+        """(B, K, 3, S, S) crops -> codes (B, K, bits) and logits; padded slots are zero."""
+        b, k = mask.shape
+        logits_real = self.encoder(crops[mask])  # (N, bits)
+        logits = logits_real.new_zeros(b, k, self.cfg.bits)
+        logits[mask] = logits_real
+        codes = gumbel_sigmoid(logits, self.cfg.tau, self.training, generator) * mask[..., None]
+        return codes, logits
+
+    def decode(self, codes: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
+        """Codes (B, K, bits), mask (B, K), action ids (B,) -> normalized effects (B, K, 3)."""
+        b, k = mask.shape
+        a = F.one_hot(actions.long(), N_ACTIONS).to(codes.dtype)  # (B, 36)
+        tok = self.inp(torch.cat([codes, a[:, None].expand(b, k, N_ACTIONS)], dim=-1))  # (B, K, D)
+        if self.attn is not None:
+            tok = self.attn(tok, src_key_padding_mask=~mask)  # (B, K, D)
+        eff_real = self.decoder(tok[mask])  # (N, 3)
+        eff = eff_real.new_zeros(b, k, 3)
+        eff[mask] = eff_real
+        return eff
+
+    def forward(self, crops: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor,
+                generator: torch.Generator | None = None) -> EffectOutput:
+        if crops.dim() != 5 or crops.shape[:2] != mask.shape or crops.shape[2] != 3:
+            raise ValueError(f"crops must be (B, K, 3, S, S) matching mask (B, K); got {tuple(crops.shape)} "
+                             f"and {tuple(mask.shape)}")
+        if actions.shape != mask.shape[:1]:
+            raise ValueError(f"actions must be (B,), got {tuple(actions.shape)}")
+        if actions.numel() and (int(actions.min()) < 0 or int(actions.max()) >= N_ACTIONS):
+            raise ValueError(f"unknown action id: expected 0..{N_ACTIONS - 1}")
+        codes, logits = self.encode(crops, mask, generator)
+        return EffectOutput(self.decode(codes, mask, actions), codes, logits)
+
+
+def masked_mse(pred: torch.Tensor, target: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+    """Mean squared error over real objects only; padded slots contribute nothing."""
+    m = mask[..., None].to(pred.dtype)
+    return ((pred - target) ** 2 * m).sum() / (m.sum() * pred.shape[-1]).clamp_min(1.0)

@@ -1,0 +1,267 @@
+"""Training the effect model: whole split in memory, Adam, validation each epoch, resumable.
+
+The data set's depth crops stay as float16 tensors in memory and each batch's 3-channel input
+(depth, x, y) is built with tensor ops, so the loop does no per-sample Python work. Effects
+are normalized per axis with statistics of the real (unpadded) training objects; they travel
+in the checkpoint. Runs under `torchrun` with DistributedDataParallel (gloo on CPU, nccl on a
+GPU): every rank takes its share of each shuffled epoch and rank 0 writes the files.
+
+    >>> train(Path("data/paper"), Path("runs/paper"), TrainConfig.preset("quick"))  # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import torch
+import torch.distributed as dist
+
+from symlearn.checkpoint import CheckpointError, load_checkpoint, save_checkpoint
+from symlearn.dataset import InteractionData, load_manifest, load_split
+from symlearn.models import AttentiveDeepSym, ModelConfig, masked_mse
+from symlearn.provenance import atomic_write_json, sha256_bytes, versions
+
+
+class TrainingError(RuntimeError):
+    """Training cannot go on (NaN loss, mismatched run directory)."""
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """Optimization settings; `paper` and `quick` pair with the model presets of the same name."""
+
+    model: ModelConfig = field(default_factory=ModelConfig)
+    preset: str = "paper"
+    epochs: int = 60
+    batch_size: int = 128  # scenes per step
+    lr: float = 5e-4
+    weight_decay: float = 0.0
+    seed: int = 0
+    bf16: bool = True  # bfloat16 autocast on CPU (AMX) or GPU; weights stay float32
+    compile: bool = False  # torch.compile the model
+    max_train_samples: int | None = None  # a subset, for quick runs and tests
+
+    @staticmethod
+    def preset(name: str, **overrides) -> "TrainConfig":
+        model_over = {k: overrides.pop(k) for k in list(overrides) if k in ModelConfig.__dataclass_fields__}
+        base = {"paper": dict(epochs=60, batch_size=128, lr=5e-4),
+                "quick": dict(epochs=12, batch_size=64, lr=1e-3)}
+        if name not in base:
+            raise ValueError(f"unknown preset {name!r}; known: paper, quick")
+        return TrainConfig(model=ModelConfig.preset(name, **model_over), preset=name, **{**base[name], **overrides})
+
+    def to_json(self) -> dict:
+        d = dataclasses.asdict(self)
+        d["model"] = self.model.to_json()
+        return json.loads(json.dumps(d))  # tuples as lists, as read back from disk
+
+    @staticmethod
+    def from_json(d: dict) -> "TrainConfig":
+        d = dict(d)
+        d["model"] = ModelConfig.from_json(d["model"])
+        return TrainConfig(**d)
+
+
+@dataclass(frozen=True)
+class SplitTensors:
+    """One split as tensors: float16 depth, crop origins, mask, actions, normalized effects."""
+
+    depth: torch.Tensor  # (N, K, S, S) float16
+    origin: torch.Tensor  # (N, K, 2) float32
+    mask: torch.Tensor  # (N, K) bool
+    action: torch.Tensor  # (N,) int64
+    effect: torch.Tensor  # (N, K, 3) float32, normalized
+    n_objects: torch.Tensor  # (N,) int64
+
+    def __len__(self) -> int:
+        return int(self.action.shape[0])
+
+    def batch(self, idx: torch.Tensor, image_size: int = 256):
+        """Model inputs for rows idx: crops (B, K, 3, S, S) float32, mask, actions, effects."""
+        d = self.depth[idx].float()  # (B, K, S, S)
+        crops = crops_from_depth(d, self.origin[idx], image_size)
+        return crops, self.mask[idx], self.action[idx], self.effect[idx]
+
+
+def crops_from_depth(depth: torch.Tensor, origin: torch.Tensor, image_size: int = 256) -> torch.Tensor:
+    """(B, K, S, S) depth and (B, K, 2) origins -> (B, K, 3, S, S): depth, column x and row y in [0, 1]."""
+    s = depth.shape[-1]
+    offs = torch.arange(s, dtype=torch.float32, device=depth.device)
+    rows = (origin[..., 0:1].float() + offs) / (image_size - 1)  # (B, K, S)
+    cols = (origin[..., 1:2].float() + offs) / (image_size - 1)
+    x = cols[..., None, :].expand(*depth.shape)
+    y = rows[..., :, None].expand(*depth.shape)
+    return torch.stack([depth, x, y], dim=2)
+
+
+def effect_normalization(data: InteractionData) -> tuple[np.ndarray, np.ndarray]:
+    """Per-axis mean and std of the real objects' effects (padding excluded)."""
+    eff = data.effect[data.mask].astype(np.float64)
+    return eff.mean(0).astype(np.float32), np.maximum(eff.std(0), 1e-6).astype(np.float32)
+
+
+def to_tensors(data: InteractionData, mean: np.ndarray, std: np.ndarray, post: bool = False) -> SplitTensors:
+    mask = torch.from_numpy(data.mask)
+    eff = torch.from_numpy((data.effect - mean) / std) * mask[..., None]
+    return SplitTensors(
+        depth=torch.from_numpy(data.post_depth if post else data.pre_depth),
+        origin=torch.from_numpy((data.post_origin if post else data.pre_origin).astype(np.float32)),
+        mask=mask, action=torch.from_numpy(data.action.astype(np.int64)), effect=eff.float(),
+        n_objects=torch.from_numpy(data.n_objects.astype(np.int64)))
+
+
+def data_fingerprint(root: Path) -> str:
+    """Hash of the data set's shard checksums: identifies exactly what a run was trained on."""
+    m = load_manifest(root)
+    return sha256_bytes("".join(sorted(s["sha256"] for s in m["shards"])).encode())[:16]
+
+
+def _dist_info() -> tuple[int, int]:
+    if dist.is_available() and dist.is_initialized():
+        return dist.get_rank(), dist.get_world_size()
+    return 0, 1
+
+
+def _autocast(cfg: TrainConfig, device: torch.device):
+    return torch.autocast(device.type, dtype=torch.bfloat16, enabled=cfg.bf16)
+
+
+@torch.no_grad()
+def predict_effects(model: AttentiveDeepSym, split: SplitTensors, batch_size: int = 256,
+                    bf16: bool = False) -> torch.Tensor:
+    """Normalized effect predictions (N, K, 3) in eval mode (deterministic codes)."""
+    model.eval()
+    device = next(model.parameters()).device
+    outs = []
+    for i in range(0, len(split), batch_size):
+        idx = torch.arange(i, min(i + batch_size, len(split)))
+        crops, mask, act, _ = split.batch(idx)
+        with torch.autocast(device.type, dtype=torch.bfloat16, enabled=bf16):
+            outs.append(model(crops.to(device), mask.to(device), act.to(device)).effect.float().cpu())
+    return torch.cat(outs)
+
+
+def mae_mm(pred: torch.Tensor, split: SplitTensors, std: np.ndarray) -> dict[str, float]:
+    """Mean absolute error per axis in millimetres over real objects."""
+    err = (pred - split.effect)[split.mask].abs() * torch.from_numpy(std) * 1000
+    return dict(zip("xyz", [round(float(v), 2) for v in err.mean(0)]))
+
+
+def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, show_progress: bool = True) -> dict:
+    """Train (or resume training) an effect model; returns the metrics written to RUN/metrics.json."""
+    from tqdm import tqdm
+
+    rank, world = _dist_info()
+    run_dir = Path(run_dir)
+    device = torch.device("cuda", rank % torch.cuda.device_count()) if torch.cuda.is_available() else torch.device("cpu")
+    fingerprint = data_fingerprint(data_dir)
+    train_data = load_split(data_dir, "train")
+    val_data = load_split(data_dir, "val")
+    if cfg.max_train_samples:
+        train_data = InteractionData(**{f.name: getattr(train_data, f.name)[: cfg.max_train_samples]
+                                        for f in dataclasses.fields(InteractionData)})
+    if train_data.pre_depth.shape[-1] != cfg.model.crop:
+        raise TrainingError(f"data crops are {train_data.pre_depth.shape[-1]} px but the model expects {cfg.model.crop}")
+    mean, std = effect_normalization(train_data)
+    tr, va = to_tensors(train_data, mean, std), to_tensors(val_data, mean, std)
+
+    torch.manual_seed(cfg.seed)
+    model = AttentiveDeepSym(cfg.model).to(device)
+    opt = torch.optim.Adam(model.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
+    gen = torch.Generator().manual_seed(cfg.seed)
+    noise_gen = torch.Generator(device=device).manual_seed(cfg.seed + 1 + rank)
+    start_epoch, best, history = 0, math.inf, []
+    meta = {"train_config": cfg.to_json(), "data": str(data_dir), "data_fingerprint": fingerprint}
+    last = run_dir / "last.pt"
+    if resume and last.exists():
+        ck = load_checkpoint(last, expect_config=cfg.model)
+        if (_resumable(ck.meta.get("train_config", {})) != _resumable(cfg.to_json())
+                or ck.meta.get("data_fingerprint") != fingerprint):
+            raise TrainingError(f"{run_dir} holds a run with other settings or data; use a new --out or --no-resume")
+        model.load_state_dict(ck.model_state)
+        opt.load_state_dict(ck.optimizer_state)
+        gen.set_state(ck.rng_states["shuffle"])
+        noise_gen.set_state(ck.rng_states["noise"])
+        torch.set_rng_state(ck.rng_states["torch"])  # dropout
+        start_epoch, best, history = ck.epoch + 1, ck.best_val, ck.history
+    if rank == 0:
+        run_dir.mkdir(parents=True, exist_ok=True)
+        atomic_write_json(run_dir / "config.json", {**meta, "seed": cfg.seed, "versions": versions(),
+                                                    "world_size": world})
+    net = model
+    if world > 1:
+        net = torch.nn.parallel.DistributedDataParallel(model, device_ids=[device.index] if device.type == "cuda" else None)
+    step_fn = torch.compile(net) if cfg.compile else net
+
+    for epoch in range(start_epoch, cfg.epochs):
+        model.train()
+        perm = torch.randperm(len(tr), generator=gen)
+        per_rank = len(perm) // world
+        perm = perm[rank * per_rank:(rank + 1) * per_rank]
+        n_batches = max(1, len(perm) // cfg.batch_size)
+        t0, seen, total = time.perf_counter(), 0, 0.0
+        bar = tqdm(range(n_batches), desc=f"epoch {epoch + 1}/{cfg.epochs}", disable=not show_progress or rank != 0,
+                   leave=False)
+        for b in bar:
+            idx = perm[b * cfg.batch_size:(b + 1) * cfg.batch_size]
+            crops, mask, act, eff = (t.to(device) for t in tr.batch(idx))
+            with _autocast(cfg, device):
+                out = step_fn(crops, mask, act, generator=noise_gen)
+            loss = masked_mse(out.effect.float(), eff, mask)
+            if not torch.isfinite(loss):
+                raise TrainingError(f"loss became {loss.item()} at epoch {epoch + 1}, step {b + 1}; "
+                                    "lower the learning rate or check the data")
+            opt.zero_grad(set_to_none=True)
+            loss.backward()
+            opt.step()
+            seen += int(mask.sum())
+            total += float(loss.detach())
+            bar.set_postfix(loss=f"{total / (b + 1):.4f}", crops_s=f"{seen * world / (time.perf_counter() - t0):.0f}")
+        train_time = time.perf_counter() - t0
+        pred = predict_effects(model, va, bf16=cfg.bf16)
+        val_loss = float(masked_mse(pred, va.effect, va.mask))
+        row = {"epoch": epoch + 1, "train_loss": round(total / n_batches, 5), "val_loss": round(val_loss, 5),
+               "val_mae_mm": mae_mm(pred, va, std), "crops_per_s": round(seen * world / train_time, 1),
+               "epoch_time_s": round(train_time, 1)}
+        history.append(row)
+        if rank == 0:
+            improved = val_loss < best
+            best = min(best, val_loss)
+            state = dict(model=model, optimizer=opt, epoch=epoch, best_val=best, history=history,
+                         rng_states={"shuffle": gen.get_state(), "noise": noise_gen.get_state(),
+                                     "torch": torch.get_rng_state()},
+                         effect_mean=mean, effect_std=std, meta=meta)
+            save_checkpoint(last, **state)
+            if improved:
+                save_checkpoint(run_dir / "best.pt", **state)
+            atomic_write_json(run_dir / "metrics.json", {"history": history, "best_val_loss": best,
+                                                         "data_fingerprint": fingerprint})
+            if show_progress:
+                print(f"epoch {epoch + 1}: train {row['train_loss']:.4f} val {val_loss:.4f} "
+                      f"mae mm {row['val_mae_mm']} {row['crops_per_s']:.0f} crops/s", flush=True)
+    result = {"history": history, "best_val_loss": best}
+    if world > 1:
+        result["ranks_identical"] = _ranks_identical(model)
+        if rank == 0:
+            atomic_write_json(run_dir / "metrics.json", {**result, "data_fingerprint": fingerprint,
+                                                         "world_size": world})
+    return result
+
+
+def _resumable(train_config: dict) -> dict:
+    """The settings a resumed run must share with the original: all but the number of epochs."""
+    return {k: v for k, v in train_config.items() if k != "epochs"}
+
+
+def _ranks_identical(model: torch.nn.Module) -> bool:
+    """Whether every rank ends with bit-identical weights (DDP keeps them in step)."""
+    flat = torch.cat([p.detach().float().flatten() for p in model.parameters()])
+    gathered = [torch.empty_like(flat) for _ in range(dist.get_world_size())]
+    dist.all_gather(gathered, flat)
+    return all(torch.equal(gathered[0], g) for g in gathered[1:])

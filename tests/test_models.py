@@ -1,0 +1,88 @@
+import pytest
+import torch
+
+from symlearn.models import AttentiveDeepSym, ModelConfig, gumbel_sigmoid, masked_mse
+
+CFG = ModelConfig.preset("quick")
+
+
+def _batch(b=4, k=3, s=CFG.crop, seed=0):
+    g = torch.Generator().manual_seed(seed)
+    x = torch.rand(b, k, 3, s, s, generator=g) * 1.5
+    mask = torch.ones(b, k, dtype=torch.bool)
+    mask[0, 1:] = False
+    mask[1, 2] = False
+    return x, mask, torch.randint(0, 36, (b,), generator=g)
+
+
+@pytest.mark.parametrize("attention", [True, False])
+def test_padding_does_not_change_real_objects(attention):
+    model = AttentiveDeepSym(ModelConfig.preset("quick", attention=attention)).eval()
+    x, mask, a = _batch()
+    out1 = model(x, mask, a)
+    x2 = x.clone()
+    x2[~mask] = torch.rand_like(x2[~mask]) * 9  # garbage in padded slots
+    out2 = model(x2, mask, a)
+    torch.testing.assert_close(out1.effect[mask], out2.effect[mask])
+    assert torch.all(out1.effect[~mask] == 0) and torch.all(out1.codes[~mask] == 0)
+
+
+def test_attention_lets_objects_influence_each_other():
+    model = AttentiveDeepSym(CFG).eval()
+    x, mask, a = _batch()
+    out1 = model(x, mask, a)
+    x2 = x.clone()
+    x2[3, 2] = torch.rand_like(x2[3, 2])  # change another object of scene 3
+    out2 = model(x2, mask, a)
+    assert not torch.allclose(out1.effect[3, 0], out2.effect[3, 0])
+    base = AttentiveDeepSym(ModelConfig.preset("quick", attention=False)).eval()
+    torch.testing.assert_close(base(x, mask, a).effect[3, 0], base(x2, mask, a).effect[3, 0])
+
+
+def test_masked_mse_ignores_padding():
+    pred = torch.zeros(2, 3, 3)
+    target = torch.ones(2, 3, 3)
+    mask = torch.tensor([[True, False, False], [True, True, False]])
+    target[~mask] = 1000.0
+    assert masked_mse(pred, target, mask).item() == pytest.approx(1.0)
+
+
+def test_gumbel_sigmoid_straight_through_and_deterministic_eval():
+    logits = torch.tensor([[-3.0, -0.1, 0.2, 4.0]], requires_grad=True)
+    z = gumbel_sigmoid(logits, 1.0, training=True, generator=torch.Generator().manual_seed(0))
+    assert set(z.detach().unique().tolist()) <= {0.0, 1.0}
+    (z * torch.arange(4.0)).sum().backward()
+    assert logits.grad is not None and torch.all(logits.grad[0, 1:] > 0)  # gradient flows through the sample
+    ev = gumbel_sigmoid(logits.detach(), 1.0, training=False)
+    assert ev.tolist() == [[0.0, 0.0, 1.0, 1.0]]
+
+
+def test_encoder_gets_gradients_through_binary_codes():
+    model = AttentiveDeepSym(CFG).train()
+    x, mask, a = _batch(b=8)
+    out = model(x, mask, a, generator=torch.Generator().manual_seed(1))
+    masked_mse(out.effect, torch.randn_like(out.effect), mask).backward()
+    g = model.encoder.proj.weight.grad
+    assert g is not None and g.abs().sum() > 0
+
+
+@pytest.mark.parametrize("bad", ["shape", "action"])
+def test_bad_inputs_refused(bad):
+    model = AttentiveDeepSym(CFG).eval()
+    x, mask, a = _batch()
+    if bad == "shape":
+        with pytest.raises(ValueError, match="crops must be"):
+            model(x[:, :, :2], mask, a)
+    else:
+        with pytest.raises(ValueError, match="unknown action id"):
+            model(x, mask, torch.tensor([0, 1, 2, 36]))
+
+
+def test_config_validation_and_presets():
+    with pytest.raises(ValueError, match="divisible by n_heads"):
+        ModelConfig(d_model=100, n_heads=8)
+    with pytest.raises(ValueError, match="unknown preset"):
+        ModelConfig.preset("huge")
+    p = ModelConfig.preset("paper")
+    assert p.conv_channels == (64, 128, 256, 512) and p.n_layers == 4 and p.decoder_hidden == (256, 256, 256)
+    assert ModelConfig.from_json(p.to_json()) == p
