@@ -80,6 +80,10 @@ def cmd_train(args: argparse.Namespace) -> int:
     if args.no_attention:
         over["attention"] = False
     cfg = TrainConfig.preset(args.preset, bf16=not args.no_bf16, compile=args.compile, **over)
+    if args.threads:
+        import torch
+
+        torch.set_num_threads(args.threads)
     _init_distributed()
     print(f"train: preset {cfg.preset}, {cfg.epochs} epochs, seed {cfg.seed}, attention {cfg.model.attention} "
           f"-> {args.out}", file=sys.stderr)
@@ -95,6 +99,31 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     res = evaluate(Path(args.run), Path(args.data), Path(args.baseline_run) if args.baseline_run else None)
     print(format_table(res))
     print(f"wrote {Path(args.run) / 'eval.json'}")
+    return 0
+
+
+def cmd_table1(args: argparse.Namespace) -> int:
+    from symlearn.table1 import format_table1, table1
+
+    res = table1(Path(args.run))
+    print(format_table1(res))
+    print(f"mean absolute error mm {res['mean_abs_error_mm']}; wrote {Path(args.run) / 'table1.json'}")
+    return 0
+
+
+def cmd_symbols(args: argparse.Namespace) -> int:
+    from symlearn.symbols import analyse_symbols
+
+    res = analyse_symbols(Path(args.run), Path(args.data), symbol=args.symbol, min_count=args.min_count)
+    print(f"{res['n_objects']} training objects, {res['n_distinct']} distinct symbols, "
+          f"{res['n_symbols_for_95pct']} cover 95%; weighted type purity {res['weighted_type_purity']}, "
+          f"moved-when-picked purity {res.get('weighted_moved_purity')}")
+    print(f"{'symbol':>10} {'count':>7} {'x px':>6} {'y px':>6} {'cube':>6} {'picked':>7} {'moved':>6}")
+    for r in res["symbols"][:20]:
+        mv = "-" if r["moved_when_picked"] is None else f"{r['moved_when_picked']:.2f}"
+        print(f"{r['code']:>10} {r['count']:7d} {r['mean_x_px']:6.0f} {r['mean_y_px']:6.0f} "
+              f"{r['cube_fraction']:6.2f} {r['times_picked']:7d} {mv:>6}")
+    print(f"wrote symbols.json, symbols.png and symbol_examples.png (symbol {res['example_symbol']}) in {args.run}")
     return 0
 
 
@@ -132,6 +161,8 @@ def build_parser() -> argparse.ArgumentParser:
     t.add_argument("--no-bf16", action="store_true", help="plain float32 (bf16 autocast is the default)")
     t.add_argument("--compile", action="store_true", help="torch.compile the model")
     t.add_argument("--no-resume", action="store_true", help="start over even if RUN/last.pt exists")
+    t.add_argument("--threads", type=int, help="CPU threads; use 1 per process when the cores are shared "
+                   "(OpenMP threads that wait for busy cores slow training several-fold)")
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=cmd_train)
 
@@ -140,6 +171,17 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--data", required=True)
     e.add_argument("--baseline-run", help="a run trained with --no-attention, for the ablation row")
     e.set_defaults(func=cmd_evaluate)
+
+    t1 = sub.add_parser("table1", help="the paper's Table I: predicted vs true effects in three stick cases")
+    t1.add_argument("--run", required=True)
+    t1.set_defaults(func=cmd_table1)
+
+    sy = sub.add_parser("symbols", help="symbol counts, prototypes (Fig. 4), examples (Fig. 5) and purity")
+    sy.add_argument("--run", required=True)
+    sy.add_argument("--data", required=True)
+    sy.add_argument("--symbol", help="bit string of the symbol to show examples of")
+    sy.add_argument("--min-count", type=int, default=100, help="a symbol is frequent from this many objects")
+    sy.set_defaults(func=cmd_symbols)
     return p
 
 

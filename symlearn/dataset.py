@@ -127,7 +127,7 @@ def effect_statistics(data: InteractionData) -> dict:
     eff = data.effect[data.mask]
     return {"samples": len(data), "objects": int(data.mask.sum()),
             "objects_per_sample": round(float(data.mask.sum() / max(len(data), 1)), 3),
-            "mean_abs_effect_mm": dict(zip("xyz", np.round(np.abs(eff).mean(0) * 1000, 1).tolist())),
+            "mean_abs_effect_mm": dict(zip("xyz", [round(float(v), 1) for v in np.abs(eff).mean(0) * 1000])),
             "moved_fraction": round(float((np.linalg.norm(eff, axis=1) > 0.01).mean()), 3),
             "grasp_fraction": round(float((data.grasped >= 0).mean()), 3)}
 
