@@ -182,6 +182,10 @@ def build_parser() -> argparse.ArgumentParser:
     sy.add_argument("--symbol", help="bit string of the symbol to show examples of")
     sy.add_argument("--min-count", type=int, default=100, help="a symbol is frequent from this many objects")
     sy.set_defaults(func=cmd_symbols)
+
+    from symlearn.cli_planning import add_planning_commands
+
+    add_planning_commands(sub)
     return p
 
 

@@ -1,0 +1,135 @@
+"""Planning sub-commands of the `symlearn` CLI: train-transition, problems, plan, benchmark.
+
+symlearn.cli's build_parser calls `add_planning_commands(sub)`; each command maps its flags onto
+a config and calls one library function, returning an exit code. Errors are raised as
+ValueError / RuntimeError with one-line messages, which the main CLI prints.
+
+    symlearn train-transition --run runs/paper --data data/paper --preset paper
+    symlearn problems --out problems/p13 --n 50 --objects 1-3 --length 1-4 --seed 0
+    symlearn plan --run runs/paper --problem problems/p13/problem_0000.json --planner astar --closed-loop
+    symlearn benchmark --run runs/paper --problems problems/p13 --planners astar,astar-ucs --out bench.json
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+
+def _int_range(text: str) -> tuple[int, int]:
+    """'1-3' -> (1, 3); '4' -> (4, 4)."""
+    try:
+        lo, _, hi = text.partition("-")
+        lo_i, hi_i = int(lo), int(hi or lo)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"range {text!r} must look like 1-3 or 4") from None
+    if lo_i > hi_i:
+        raise argparse.ArgumentTypeError(f"range {text!r} is empty")
+    return lo_i, hi_i
+
+
+def _planner_list(text: str) -> list[str]:
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names:
+        raise argparse.ArgumentTypeError("give at least one planner, e.g. astar,astar-ucs")
+    return names
+
+
+def cmd_train_transition(args: argparse.Namespace) -> int:
+    from symlearn.transition import TransitionConfig, train_transition
+
+    over = {"epochs": args.epochs} if args.epochs is not None else {}
+    cfg = TransitionConfig.preset(args.preset, **over)
+    print(f"train-transition: preset {cfg.preset}, {cfg.epochs} epochs, seed {args.seed}, run {args.run}, "
+          f"data {args.data}", file=sys.stderr)
+    m = train_transition(Path(args.run), Path(args.data), cfg, seed=args.seed, show_progress=not args.quiet)
+    test = m["test"]
+    print(json.dumps({"run": args.run, "best_val_loss": m["best_val_loss"],
+                      "test": {k: test[k] for k in ("bit_accuracy", "object_accuracy", "scene_accuracy")},
+                      "rollout_scene_accuracy": {n: r["scene_accuracy"] for n, r in test["rollout"].items()}},
+                     indent=2))
+    return 0
+
+
+def cmd_problems(args: argparse.Namespace) -> int:
+    from symlearn.problems import generate_problems
+
+    print(f"problems: {args.n} problems, objects {args.objects[0]}-{args.objects[1]}, length "
+          f"{args.length[0]}-{args.length[1]}, seed {args.seed} -> {args.out}", file=sys.stderr)
+    paths = generate_problems(Path(args.out), args.n, objects=args.objects, length=args.length, seed=args.seed)
+    print(f"wrote {len(paths)} problems to {args.out}")
+    return 0
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    from symlearn.benchmark import get_planner
+    from symlearn.checkpoint import load_effect_model
+    from symlearn.execution import ExecutionConfig, run_problem
+    from symlearn.problems import load_problem
+    from symlearn.simulator import TabletopSimulator
+    from symlearn.transition import LearnedTransition
+
+    fn = get_planner(args.planner)
+    problem = load_problem(Path(args.problem))
+    encoder, _ = load_effect_model(Path(args.run))
+    transition = LearnedTransition.from_run(Path(args.run))
+    cfg = ExecutionConfig(closed_loop=args.closed_loop, max_replans=args.max_replans, timeout_s=args.timeout)
+    with TabletopSimulator() as sim:
+        row = run_problem(sim, encoder, transition, problem, args.planner, fn, cfg)
+    print(f"{problem.name} [{args.planner}{', closed loop' if row.closed_loop else ''}]: found {row.found} "
+          f"({row.status}), length {row.plan_length} (generator {row.generator_length}), "
+          f"time {row.planning_time_s:.3f} s, expansions {row.expansions}, success {row.success}, "
+          f"symbolic match {row.symbolic_match}, max distance {row.max_distance_m} m, replans {row.replans}, "
+          f"failure {row.failure_stage}")
+    return 0
+
+
+def cmd_benchmark(args: argparse.Namespace) -> int:
+    from symlearn.benchmark import benchmark, format_table, get_planner
+
+    for name in args.planners:
+        get_planner(name)
+    res = benchmark(Path(args.run), Path(args.problems), args.planners, Path(args.out), closed_loop=args.closed_loop,
+                    timeout_s=args.timeout, max_replans=args.max_replans, show_progress=not args.quiet)
+    print(format_table(res))
+    print(f"wrote {args.out}")
+    return 0
+
+
+def add_planning_commands(sub) -> None:
+    """Add train-transition, problems, plan and benchmark to the CLI's sub-parsers."""
+    t = sub.add_parser("train-transition", help="train the symbolic transition model m(z) on a run's codes")
+    t.add_argument("--run", required=True, help="run directory with the trained effect model (best.pt)")
+    t.add_argument("--data", required=True, help="the data set to encode")
+    t.add_argument("--preset", default="paper", choices=["paper", "quick"])
+    t.add_argument("--epochs", type=int)
+    t.add_argument("--seed", type=int, default=0)
+    t.add_argument("--quiet", action="store_true")
+    t.set_defaults(func=cmd_train_transition)
+
+    p = sub.add_parser("problems", help="generate planning problems (initial scene, goal scene) in the simulator")
+    p.add_argument("--out", required=True, help="directory for the problem JSON files")
+    p.add_argument("--n", type=int, default=20, help="number of problems")
+    p.add_argument("--objects", type=_int_range, default=(1, 3), help="objects per scene, e.g. 1-3 or 4-5")
+    p.add_argument("--length", type=_int_range, default=(1, 4), help="generator actions per problem, e.g. 1-4")
+    p.add_argument("--seed", type=int, default=0)
+    p.set_defaults(func=cmd_problems)
+
+    for name, helptext in (("plan", "plan one problem with the learned symbols and execute it"),
+                           ("benchmark", "plan and execute every problem of a directory with several planners")):
+        c = sub.add_parser(name, help=helptext)
+        c.add_argument("--run", required=True, help="run directory with best.pt and transition.pt")
+        if name == "plan":
+            c.add_argument("--problem", required=True, help="problem JSON file")
+            c.add_argument("--planner", default="astar")
+        else:
+            c.add_argument("--problems", required=True, help="directory of problem JSON files")
+            c.add_argument("--planners", type=_planner_list, default=["astar", "astar-ucs"],
+                           help="comma-separated planner names")
+            c.add_argument("--out", required=True, help="benchmark JSON file")
+            c.add_argument("--quiet", action="store_true")
+        c.add_argument("--closed-loop", action="store_true", help="replan when the scene departs from the prediction")
+        c.add_argument("--max-replans", type=int, default=3)
+        c.add_argument("--timeout", type=float, default=30.0, help="seconds per planner call")
+        c.set_defaults(func=cmd_plan if name == "plan" else cmd_benchmark)

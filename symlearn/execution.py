@@ -1,0 +1,179 @@
+"""Executing symbolic plans in the simulator: open loop, or closed loop with replanning.
+
+A plan (a PlanResult from any planner) is run action by action with `sim.step` from the
+problem's initial poses. After each action the real scene is rendered and encoded; the codes
+are compared with the planner's predicted state. Success is geometric (every object within
+2 cm of its goal position); the symbolic match (final codes == goal codes) is reported beside
+it. With `closed_loop=True`, a departure from the prediction triggers replanning from the
+observed codes, at most `max_replans` times.
+
+    >>> row = run_problem(sim, encoder, transition, problem, "astar", get_planner("astar"),
+    ...                   ExecutionConfig(closed_loop=True))                       # doctest: +SKIP
+    >>> row.found, row.plan_length, row.success, row.failure_stage               # doctest: +SKIP
+    (True, 2, True, None)
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass
+from typing import Callable
+
+import numpy as np
+
+from search.result import PlanResult, PlanStatus
+from search.symbolic import SymbolicGoal, TransitionFn
+from symlearn.problems import GOAL_TOLERANCE_M, Problem, goal_codes, max_goal_distance, place_scene
+from symlearn.transition import encode_observation
+from symlearn.world import decode_action
+
+PlannerFn = Callable[[TransitionFn, np.ndarray, SymbolicGoal, float], PlanResult]
+FAILURE_STAGES = (None, "no_plan", "timeout", "execution", "goal_mismatch")
+
+
+@dataclass(frozen=True)
+class ExecutionConfig:
+    """How plans are executed and judged."""
+
+    tolerance_m: float = GOAL_TOLERANCE_M  # every object within 2 cm of its goal position
+    closed_loop: bool = False  # replan when the observed codes depart from the prediction
+    max_replans: int = 3  # bound on replanning calls per problem
+    timeout_s: float = 30.0  # per planner call
+
+    def __post_init__(self) -> None:
+        if not self.tolerance_m > 0:
+            raise ValueError(f"tolerance_m={self.tolerance_m} must be positive")
+        if self.max_replans < 0:
+            raise ValueError(f"max_replans={self.max_replans} must be >= 0")
+        if not self.timeout_s > 0:
+            raise ValueError(f"timeout_s={self.timeout_s} must be positive")
+
+
+@dataclass(frozen=True)
+class ExecutionResult:
+    """What executing a plan did: geometric and symbolic outcome, trajectory of observed codes."""
+
+    success: bool  # every object within tolerance of its goal position
+    symbolic_match: bool  # final observed codes == goal codes
+    max_distance_m: float  # largest object distance to its goal position
+    executed: tuple[int, ...]  # action ids actually run, across replans
+    observed_states: tuple[tuple[int, ...], ...]  # codes at the start and after each executed action
+    diverged: bool  # the observed codes departed from a prediction at some step
+    on_prediction: bool  # the last plan's steps all matched their predictions (end state included)
+    replans: int
+    replan_failed: bool  # a replanning call found no plan, so execution stopped
+    off_table: bool  # some object fell off the table
+
+
+def _codes(sim, encoder) -> tuple[int, ...]:
+    return tuple(int(c) for c in encode_observation(encoder, sim.observe()))
+
+
+def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: np.ndarray,
+                 config: ExecutionConfig = ExecutionConfig(),
+                 replan: Callable[[np.ndarray], PlanResult] | None = None) -> ExecutionResult:
+    """Run plan.plan from the problem's initial poses; closed loop replans with `replan(observed_codes)`."""
+    if config.closed_loop and replan is None:
+        raise ValueError("closed-loop execution needs a replan function")
+    goal = tuple(int(c) for c in goal)
+    place_scene(sim, problem.initial)
+    codes = _codes(sim, encoder)
+    observed, executed = [codes], []
+    actions, predicted = list(plan.plan), list(plan.predicted_states)
+    t, replans, diverged, segment_ok, replan_failed, off_table = 0, 0, False, True, False, False
+    while t < len(actions):
+        res = sim.step(decode_action(actions[t]))
+        off_table |= res.off_table
+        executed.append(actions[t])
+        codes = _codes(sim, encoder)
+        observed.append(codes)
+        if predicted and codes != predicted[t + 1]:
+            diverged, segment_ok = True, False
+            if config.closed_loop and replans < config.max_replans:
+                replans += 1
+                new = replan(np.asarray(codes, np.int64))
+                if not new.found:
+                    replan_failed = True
+                    break
+                actions, predicted, t, segment_ok = list(new.plan), list(new.predicted_states), 0, True
+                continue
+        t += 1
+    if not predicted:  # a planner without predictions: judge the end state only
+        segment_ok = codes == goal
+    dist = max_goal_distance(sim.get_scene(), problem.goal)
+    return ExecutionResult(success=dist <= config.tolerance_m and not off_table, symbolic_match=codes == goal,
+                           max_distance_m=dist, executed=tuple(executed), observed_states=tuple(observed),
+                           diverged=diverged, on_prediction=segment_ok and not replan_failed, replans=replans,
+                           replan_failed=replan_failed, off_table=off_table)
+
+
+@dataclass(frozen=True)
+class ProblemRun:
+    """One benchmark row: a planner on a problem, planned and executed."""
+
+    problem: str
+    planner: str
+    found: bool
+    status: str  # PlanStatus value of the initial planning call
+    plan_length: int | None  # None when no plan was found
+    planning_time_s: float
+    expansions: int | None
+    success: bool
+    symbolic_match: bool
+    max_distance_m: float | None  # None when nothing was executed
+    closed_loop: bool
+    replans: int
+    failure_stage: str | None  # None, "no_plan", "timeout", "execution" or "goal_mismatch"
+    generator_length: int
+    message: str = ""
+
+    def __post_init__(self) -> None:
+        if self.failure_stage not in FAILURE_STAGES:
+            raise ValueError(f"unknown failure stage {self.failure_stage!r}; known: {FAILURE_STAGES}")
+        if self.success and self.failure_stage is not None:
+            raise ValueError("a successful run has no failure stage")
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+
+def failure_stage(plan: PlanResult, ex: ExecutionResult | None) -> str | None:
+    """Where a run failed: no plan, timeout, execution departing from predictions, or goal tolerance."""
+    if not plan.found:
+        return "timeout" if plan.status is PlanStatus.TIMEOUT else "no_plan"
+    if ex is None or ex.success:
+        return None
+    return "goal_mismatch" if ex.on_prediction else "execution"
+
+
+def safe_plan(planner: str, planner_fn: PlannerFn, transition: TransitionFn, start: np.ndarray,
+              goal: SymbolicGoal, timeout_s: float) -> PlanResult:
+    """Call a planner; an exception it raises becomes an ERROR result, so one problem cannot stop a benchmark."""
+    t0 = time.perf_counter()
+    try:
+        return planner_fn(transition, np.asarray(start, np.int64), goal, timeout_s)
+    except (ValueError, RuntimeError, OSError) as e:
+        msg = " ".join(f"{type(e).__name__}: {e}".split())[:300]
+        return PlanResult(planner=planner, status=PlanStatus.ERROR, plan=(), predicted_states=(), expansions=None,
+                          planning_time_s=time.perf_counter() - t0, message=msg)
+
+
+def run_problem(sim, encoder, transition: TransitionFn, problem: Problem, planner: str, planner_fn: PlannerFn,
+                config: ExecutionConfig = ExecutionConfig(), initial_plan: PlanResult | None = None) -> ProblemRun:
+    """Encode start and goal, plan (or reuse initial_plan), execute, and report one row."""
+    goal = goal_codes(sim, encoder, problem)
+    place_scene(sim, problem.initial)
+    start = encode_observation(encoder, sim.observe())
+    sym_goal = SymbolicGoal(tuple(int(c) for c in goal))
+    plan = initial_plan or safe_plan(planner, planner_fn, transition, start, sym_goal, config.timeout_s)
+    ex = None
+    if plan.found:
+        ex = execute_plan(sim, problem, plan, encoder, goal, config,
+                          replan=lambda codes: safe_plan(planner, planner_fn, transition, codes, sym_goal,
+                                                         config.timeout_s))
+    return ProblemRun(
+        problem=problem.name, planner=planner, found=plan.found, status=plan.status.value,
+        plan_length=len(plan.plan) if plan.found else None, planning_time_s=plan.planning_time_s,
+        expansions=plan.expansions, success=bool(ex and ex.success), symbolic_match=bool(ex and ex.symbolic_match),
+        max_distance_m=None if ex is None else round(ex.max_distance_m, 5), closed_loop=config.closed_loop,
+        replans=0 if ex is None else ex.replans, failure_stage=failure_stage(plan, ex),
+        generator_length=problem.generator_length, message=plan.message)

@@ -1,0 +1,258 @@
+"""Executing plans in the simulator, failure stages, closed-loop replanning, the benchmark and its registry.
+
+The encoder and transition here are untrained (seeded) networks: these tests check the plumbing,
+not the quality of learned symbols.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+
+import numpy as np
+import pytest
+import torch
+
+from search.result import PlanResult, PlanStatus
+from symlearn import benchmark as bench
+from symlearn.checkpoint import save_checkpoint
+from symlearn.cli_planning import add_planning_commands
+from symlearn.execution import ExecutionConfig, ProblemRun, execute_plan, run_problem
+from symlearn.models import AttentiveDeepSym, ModelConfig
+from symlearn.problems import GOAL_TOLERANCE_M, generate_problems, goal_codes, load_problem, scene_codes
+from symlearn.transition import (TRANSITION_FILE, LearnedTransition, TransitionConfig, TransitionNet, _file_sha,
+                                 save_transition)
+from symlearn.world import action_id
+
+
+def _seeded(make, seed: int):
+    with torch.random.fork_rng(devices=[]):
+        torch.manual_seed(seed)
+        return make().eval()
+
+
+@pytest.fixture(scope="module")
+def encoder():
+    return _seeded(lambda: AttentiveDeepSym(ModelConfig.preset("quick")), 0)
+
+
+@pytest.fixture(scope="module")
+def problems(tmp_path_factory, sim):
+    out = tmp_path_factory.mktemp("exec_problems")
+    return [load_problem(p) for p in generate_problems(out, 2, objects=(2, 3), length=(1, 3), seed=7, sim=sim)]
+
+
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory, encoder):
+    """A run directory holding an (untrained) effect model and a transition model tied to it."""
+    d = tmp_path_factory.mktemp("exec_run")
+    save_checkpoint(d / "best.pt", model=encoder)
+    net = _seeded(lambda: TransitionNet(TransitionConfig.preset("quick", bits=encoder.cfg.bits)), 1)
+    save_transition(d / TRANSITION_FILE, net, {"effect_model_sha256": _file_sha(d / "best.pt")})
+    return d
+
+
+def _plan(actions, states, planner="test") -> PlanResult:
+    return PlanResult(planner=planner, status=PlanStatus.SOLVED, plan=tuple(actions),
+                      predicted_states=tuple(tuple(int(c) for c in s) for s in states), expansions=0,
+                      planning_time_s=0.0)
+
+
+def _wrong(codes) -> tuple[int, ...]:
+    """A state the real scene will not be in: every code with its lowest bit flipped."""
+    return tuple(int(c) ^ 1 for c in codes)
+
+
+def _empty_pick(problem) -> int:
+    """An action that moves nothing: pick at a location no object covers."""
+    from symlearn.world import LOCATIONS
+
+    pos = problem.initial.positions()[:, :2]
+    free = [i for i, (x, y) in enumerate(LOCATIONS) if np.min(np.abs(pos - (x, y)).max(1)) > 0.25]
+    assert free, "test scene covers every location"
+    return action_id(free[0], free[0])
+
+
+# ------------------------------------------------------------------------------- execute_plan
+
+
+def test_empty_plan_is_not_a_success(sim, encoder, problems):
+    pr = problems[0]
+    goal = goal_codes(sim, encoder, pr)
+    start = scene_codes(sim, encoder, pr.initial)
+    ex = execute_plan(sim, pr, _plan([], [start]), encoder, goal)
+    assert pr.generator_length >= 1
+    assert not ex.success and ex.max_distance_m > GOAL_TOLERANCE_M
+    assert ex.executed == () and ex.replans == 0
+
+
+def test_generator_plan_succeeds(sim, encoder, problems):
+    for pr in problems:
+        goal = goal_codes(sim, encoder, pr)
+        plan = PlanResult(planner="generator", status=PlanStatus.SOLVED, plan=pr.actions, predicted_states=(),
+                          expansions=None, planning_time_s=0.0)
+        ex = execute_plan(sim, pr, plan, encoder, goal)
+        assert ex.success and ex.max_distance_m <= GOAL_TOLERANCE_M, pr.name
+        assert ex.symbolic_match  # the same poses render the same crops and codes
+        assert ex.executed == pr.actions and len(ex.observed_states) == pr.generator_length + 1
+
+
+@pytest.mark.parametrize("max_replans", [0, 1, 3])
+def test_closed_loop_replans_are_bounded(sim, encoder, problems, max_replans):
+    pr = problems[0]
+    goal = goal_codes(sim, encoder, pr)
+    start = scene_codes(sim, encoder, pr.initial)
+    a = _empty_pick(pr)
+    calls = []
+
+    def liar(codes):  # always predicts a state the scene never reaches
+        calls.append(tuple(codes))
+        return _plan([a], [codes, _wrong(codes)])
+
+    cfg = ExecutionConfig(closed_loop=True, max_replans=max_replans)
+    ex = execute_plan(sim, pr, _plan([a], [start, _wrong(start)]), encoder, goal, cfg, replan=liar)
+    assert ex.replans == len(calls) == max_replans
+    assert len(ex.executed) == max_replans + 1
+    assert ex.diverged and not ex.on_prediction and not ex.success
+
+
+def test_closed_loop_stops_when_replanning_fails(sim, encoder, problems):
+    pr = problems[0]
+    goal = goal_codes(sim, encoder, pr)
+    start = scene_codes(sim, encoder, pr.initial)
+    a = _empty_pick(pr)
+    fail = PlanResult(planner="t", status=PlanStatus.UNSOLVABLE, plan=(), predicted_states=(), expansions=3,
+                      planning_time_s=0.0)
+    plan = _plan([a, a, a], [start, _wrong(start), start, start])
+    ex = execute_plan(sim, pr, plan, encoder, goal, ExecutionConfig(closed_loop=True), replan=lambda c: fail)
+    assert ex.replan_failed and ex.replans == 1 and len(ex.executed) == 1
+
+
+def test_closed_loop_needs_a_replan_function(sim, encoder, problems):
+    with pytest.raises(ValueError, match="replan"):
+        execute_plan(sim, problems[0], _plan([], [(0,) * problems[0].k]), encoder, [0] * problems[0].k,
+                     ExecutionConfig(closed_loop=True))
+
+
+# ------------------------------------------------------------------------------- run_problem and failure stages
+
+
+def _fixed(result_of):
+    """A planner function returning result_of(start_codes, goal)."""
+    return lambda transition, start, goal, timeout_s: result_of(start, goal)
+
+
+@pytest.mark.parametrize("status, stage", [(PlanStatus.UNSOLVABLE, "no_plan"), (PlanStatus.NODE_LIMIT, "no_plan"),
+                                           (PlanStatus.TIMEOUT, "timeout"), (PlanStatus.ERROR, "no_plan")])
+def test_no_plan_stages(sim, encoder, run_dir, problems, status, stage):
+    fn = _fixed(lambda s, g: PlanResult(planner="t", status=status, plan=(), predicted_states=(), expansions=None,
+                                        planning_time_s=0.0))
+    row = run_problem(sim, encoder, LearnedTransition.from_run(run_dir), problems[0], "t", fn)
+    assert not row.found and row.failure_stage == stage and row.plan_length is None
+    assert not row.success and row.max_distance_m is None and row.status == status.value
+
+
+def test_raising_planner_becomes_an_error_row(sim, encoder, run_dir, problems):
+    def boom(*args):
+        raise RuntimeError("engine crashed\nwith two lines")
+
+    row = run_problem(sim, encoder, LearnedTransition.from_run(run_dir), problems[0], "boom", boom)
+    assert row.status == "error" and row.failure_stage == "no_plan" and "engine crashed" in row.message
+    assert "\n" not in row.message
+
+
+def test_execution_and_goal_mismatch_stages(sim, encoder, run_dir, problems):
+    pr = problems[0]
+    tr = LearnedTransition.from_run(run_dir)
+    a = _empty_pick(pr)
+    departs = _fixed(lambda s, g: _plan([a], [s, _wrong(s)]))  # predicts a change that never happens
+    row = run_problem(sim, encoder, tr, pr, "departs", departs)
+    assert row.found and not row.success and row.failure_stage == "execution"
+    stays = _fixed(lambda s, g: _plan([a], [s, s]))  # correct prediction, but the scene is far from the goal
+    row = run_problem(sim, encoder, tr, pr, "stays", stays)
+    assert row.found and not row.success and row.failure_stage == "goal_mismatch"
+    generator = _fixed(lambda s, g: PlanResult(planner="gen", status=PlanStatus.SOLVED, plan=pr.actions,
+                                               predicted_states=(), expansions=None, planning_time_s=0.0))
+    row = run_problem(sim, encoder, tr, pr, "gen", generator)
+    assert row.success and row.failure_stage is None and row.plan_length == pr.generator_length
+
+
+def test_run_problem_closed_loop_row(sim, encoder, run_dir, problems):
+    pr = problems[0]
+    a = _empty_pick(pr)
+    liar = _fixed(lambda s, g: _plan([a], [s, _wrong(s)]))
+    row = run_problem(sim, encoder, LearnedTransition.from_run(run_dir), pr, "liar", liar,
+                      ExecutionConfig(closed_loop=True, max_replans=2))
+    assert row.closed_loop and row.replans == 2 and row.failure_stage == "execution"
+    assert json.loads(json.dumps(row.to_json()))["replans"] == 2
+
+
+def test_problem_run_validation():
+    base = dict(problem="p", planner="astar", found=True, status="solved", plan_length=1, planning_time_s=0.1,
+                expansions=2, success=False, symbolic_match=False, max_distance_m=0.3, closed_loop=False,
+                replans=0, generator_length=1)
+    with pytest.raises(ValueError, match="unknown failure stage"):
+        ProblemRun(**base, failure_stage="physics")
+    with pytest.raises(ValueError, match="no failure stage"):
+        ProblemRun(**{**base, "success": True}, failure_stage="execution")
+
+
+# ------------------------------------------------------------------------------- benchmark and registry
+
+
+def test_benchmark_writes_summary_and_rows(tmp_path, sim, run_dir, problems):
+    pdir = tmp_path / "problems"
+    generate_problems(pdir, 2, objects=(1, 2), length=(1, 2), seed=11, sim=sim)
+    out = tmp_path / "bench.json"
+    res = bench.benchmark(run_dir, pdir, ["astar", "astar-ucs"], out, closed_loop=True, timeout_s=2.0,
+                          show_progress=False)
+    saved = json.loads(out.read_text())
+    assert saved["summary"] == res["summary"] and len(saved["rows"]) == 2 * 2 * 2
+    for name in ("astar", "astar-ucs"):
+        s = saved["summary"][name]
+        assert {"success_rate", "found_rate", "median_time_s", "mean_plan_length", "mean_generator_length",
+                "success_rate_closed_loop"} <= set(s)
+        assert 0.0 <= s["success_rate"] <= 1.0 and 0.0 <= s["found_rate"] <= 1.0
+    assert {r["closed_loop"] for r in saved["rows"]} == {False, True}
+    assert "astar-ucs" in bench.format_table(res)
+
+
+def test_unknown_planner_lists_known_ones(tmp_path, run_dir):
+    with pytest.raises(ValueError, match="unknown planner 'fast-downward'; known: astar, astar-ucs") as info:
+        bench.benchmark(run_dir, tmp_path, ["astar", "fast-downward"], tmp_path / "b.json")
+    assert "\n" not in str(info.value)
+
+
+def test_register_planner(monkeypatch):
+    monkeypatch.setattr(bench, "PLANNERS", dict(bench.PLANNERS))
+    fn = _fixed(lambda s, g: None)
+    bench.register_planner("pyperplan", fn)
+    assert bench.get_planner("pyperplan") is fn
+    with pytest.raises(ValueError, match="already registered"):
+        bench.register_planner("astar", fn)
+    bench.register_planner("astar", fn, replace=True)
+    assert bench.get_planner("astar") is fn
+    with pytest.raises(ValueError, match="without commas"):
+        bench.register_planner("a,b", fn)
+
+
+def test_cli_parses_planning_commands():
+    p = argparse.ArgumentParser(prog="symlearn")
+    sub = p.add_subparsers(dest="command", required=True)
+    add_planning_commands(sub)
+    a = p.parse_args(["problems", "--out", "x", "--n", "3", "--objects", "4-5", "--length", "2", "--seed", "1"])
+    assert (a.objects, a.length, a.n) == ((4, 5), (2, 2), 3) and a.func.__name__ == "cmd_problems"
+    a = p.parse_args(["benchmark", "--run", "r", "--problems", "d", "--planners", "astar,astar-ucs", "--out", "o",
+                      "--closed-loop"])
+    assert a.planners == ["astar", "astar-ucs"] and a.closed_loop and a.func.__name__ == "cmd_benchmark"
+    a = p.parse_args(["plan", "--run", "r", "--problem", "f.json", "--planner", "astar-ucs", "--timeout", "5"])
+    assert a.planner == "astar-ucs" and a.timeout == 5.0 and not a.closed_loop and a.func.__name__ == "cmd_plan"
+    a = p.parse_args(["train-transition", "--run", "r", "--data", "d", "--preset", "quick", "--epochs", "4"])
+    assert (a.preset, a.epochs, a.seed) == ("quick", 4, 0) and a.func.__name__ == "cmd_train_transition"
+
+
+def test_cli_problems_command(tmp_path):
+    p = argparse.ArgumentParser(prog="symlearn")
+    add_planning_commands(p.add_subparsers(dest="command", required=True))
+    args = p.parse_args(["problems", "--out", str(tmp_path / "pp"), "--n", "1", "--objects", "1-2", "--seed", "2"])
+    assert args.func(args) == 0
+    assert load_problem(tmp_path / "pp" / "problem_0000.json").k in (1, 2)

@@ -1,0 +1,150 @@
+"""Planning problems: generation in the simulator, JSON round trip, replay, refusal of malformed files."""
+from __future__ import annotations
+
+import copy
+import json
+
+import numpy as np
+import pytest
+
+from symlearn.problems import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, ProblemConfig, generate_problems,
+                               load_problem, load_problems, max_goal_distance, save_problem)
+from symlearn.world import ObjectType, Scene, decode_action
+
+
+@pytest.fixture(scope="module")
+def problem_dir(tmp_path_factory, sim):
+    out = tmp_path_factory.mktemp("problems") / "p13"
+    generate_problems(out, 4, objects=(1, 3), length=(1, 4), seed=3, sim=sim)
+    return out
+
+
+def _replay(sim, problem: Problem) -> Scene:
+    sim.reset(problem.initial)
+    for a in problem.actions:
+        sim.step(decode_action(a))
+    return sim.get_scene()
+
+
+def test_generation_writes_valid_problems(problem_dir):
+    loaded = load_problems(problem_dir)
+    assert [p.name for p, _ in loaded] == ["problem_0000.json", "problem_0001.json", "problem_0002.json",
+                                        "problem_0003.json"]
+    for _, pr in loaded:
+        assert 1 <= pr.k <= 3 and 1 <= pr.generator_length <= 4
+        assert pr.initial.k == pr.goal.k == pr.k
+        assert max_goal_distance(pr.initial, pr.goal) > GOAL_TOLERANCE_M  # never trivially solved
+
+
+def test_round_trip(problem_dir, tmp_path):
+    for path, pr in load_problems(problem_dir):
+        assert Problem.from_json(json.loads(json.dumps(pr.to_json()))) == pr
+        save_problem(tmp_path / path.name, pr)
+        assert load_problem(tmp_path / path.name) == pr
+        assert (tmp_path / path.name).read_text() == path.read_text()
+
+
+def test_generator_actions_reach_the_goal(problem_dir, sim):
+    for _, pr in load_problems(problem_dir):
+        assert max_goal_distance(_replay(sim, pr), pr.goal) <= GOAL_TOLERANCE_M, pr.name
+
+
+def test_generation_is_reproducible(problem_dir, tmp_path, sim):
+    generate_problems(tmp_path / "again", 2, objects=(1, 3), length=(1, 4), seed=3, sim=sim)
+    for name in ("problem_0000.json", "problem_0001.json"):
+        a, b = load_problem(problem_dir / name), load_problem(tmp_path / "again" / name)
+        assert a.spec == b.spec and a.actions == b.actions
+        np.testing.assert_allclose(a.goal.positions(), b.goal.positions(), atol=1e-4)
+
+
+def test_four_to_five_objects(tmp_path, sim):
+    paths = generate_problems(tmp_path / "p45", 2, objects=(4, 5), length=(1, 2), seed=1, sim=sim)
+    for p in paths:
+        pr = load_problem(p)
+        assert pr.k in (4, 5) and sum(t == ObjectType.STICK for t, _ in pr.spec) <= 1
+        assert max_goal_distance(_replay(sim, pr), pr.goal) <= GOAL_TOLERANCE_M
+
+
+@pytest.mark.parametrize("objects, length", [((0, 2), (1, 2)), ((3, 6), (1, 2)), ((2, 1), (1, 2)),
+                                             ((1, 3), (0, 2)), ((1, 3), (3, 2))])
+def test_problem_config_refuses_bad_ranges(objects, length):
+    with pytest.raises(ValueError, match="range"):
+        ProblemConfig(objects=objects, length=length)
+
+
+def test_generate_refuses_zero_problems(tmp_path):
+    with pytest.raises(ValueError, match="at least 1"):
+        generate_problems(tmp_path / "none", 0)
+
+
+def _corrupt(d: dict, how: str) -> dict:
+    d = copy.deepcopy(d)
+    if how == "missing_goal":
+        del d["goal"]
+    elif how == "wrong_version":
+        d["version"] = PROBLEM_VERSION + 1
+    elif how == "wrong_format":
+        d["format"] = "pddl"
+    elif how == "seed_not_int":
+        d["seed"] = "three"
+    elif how == "location_out_of_range":
+        d["spec"][0][1] = 9
+    elif how == "unknown_type":
+        d["spec"][0][0] = "sphere"
+    elif how == "action_out_of_range":
+        d["actions"][0] = 36
+    elif how == "action_not_int":
+        d["actions"][0] = 1.5
+    elif how == "length_mismatch":
+        d["generator_length"] = len(d["actions"]) + 1
+    elif how == "short_position":
+        d["goal"]["objects"][0]["position"] = [0.5, 0.0]
+    elif how == "nan_position":
+        d["initial"]["objects"][0]["position"][2] = float("nan")
+    elif how == "scene_type_mismatch":
+        d["goal"]["objects"] = d["goal"]["objects"][:-1] or [{"type": "cube", "position": [0.5, 0, 0.45]}] * 2
+    elif how == "spec_not_list":
+        d["spec"] = {"cube": 3}
+    return d
+
+
+CORRUPTIONS = ["missing_goal", "wrong_version", "wrong_format", "seed_not_int", "location_out_of_range",
+               "unknown_type", "action_out_of_range", "action_not_int", "length_mismatch", "short_position",
+               "nan_position", "scene_type_mismatch", "spec_not_list"]
+
+
+@pytest.mark.parametrize("how", CORRUPTIONS)
+def test_malformed_problem_files_are_refused(problem_dir, tmp_path, how):
+    good = json.loads((problem_dir / "problem_0000.json").read_text())
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(_corrupt(good, how)))
+    with pytest.raises(ValueError, match="problem") as info:
+        load_problem(path)
+    msg = str(info.value)
+    assert "\n" not in msg and ("problem_0000" in msg or "bad.json" in msg), msg
+
+
+def test_unreadable_files_are_refused(tmp_path):
+    (tmp_path / "x.json").write_text("{not json")
+    with pytest.raises(ValueError, match="x.json: not valid JSON"):
+        load_problem(tmp_path / "x.json")
+    with pytest.raises(ValueError, match="no such file"):
+        load_problem(tmp_path / "missing.json")
+    (tmp_path / "list.json").write_text("[1, 2]")
+    with pytest.raises(ValueError, match="expected a JSON object"):
+        load_problem(tmp_path / "list.json")
+    with pytest.raises(ValueError, match="no problem directory"):
+        load_problems(tmp_path / "missing_dir")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError, match="no problem files"):
+        load_problems(tmp_path / "empty")
+
+
+def test_problem_validation_fails_on_purpose(problem_dir):
+    pr = load_problem(problem_dir / "problem_0000.json")
+    with pytest.raises(ValueError, match="out of range"):
+        Problem(pr.name, pr.seed, pr.spec, pr.initial, (99,), pr.goal)
+    with pytest.raises(ValueError, match="do not match the spec"):
+        Problem(pr.name, pr.seed, pr.spec, Scene(), pr.actions, pr.goal)
+    with pytest.raises(ValueError, match="objects"):
+        Problem(pr.name, pr.seed, (), Scene(), pr.actions, Scene())

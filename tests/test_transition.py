@@ -1,0 +1,233 @@
+"""The symbolic transition model m(z): architecture, masked loss, training files, checkpoint, protocol."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import torch
+
+from search.learned_astar import plan_symbolic
+from search.symbolic import SymbolicGoal
+from symlearn.checkpoint import load_effect_model
+from symlearn.collect import CollectConfig, collect
+from symlearn.dataset import load_split
+from symlearn.training import TrainConfig, train
+from symlearn.transition import (METRICS_FILE, ROLLOUT_STEPS, TRANSITION_FILE, LearnedTransition, TransitionConfig,
+                                 TransitionData, TransitionError, TransitionNet, build_transition_data,
+                                 encode_observation, load_transition, masked_bce, rollout_chains, save_transition,
+                                 train_transition)
+from symlearn.world import ObjectType
+
+BITS = 8
+
+
+def _net(seed: int = 0, **over) -> TransitionNet:
+    with torch.random.fork_rng(devices=[]):
+        torch.manual_seed(seed)
+        return TransitionNet(TransitionConfig.preset("quick", bits=BITS, **over)).eval()
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    """A tiny data set, a one-epoch effect model and a quickly trained transition model."""
+    root = tmp_path_factory.mktemp("transition")
+    collect(root / "d", CollectConfig(n=48, seed=5, shard_size=4), show_progress=False)
+    train(root / "d", root / "run", TrainConfig.preset("quick", epochs=1, batch_size=8, bf16=False),
+          show_progress=False)
+    metrics = train_transition(root / "run", root / "d", TransitionConfig.preset("quick", epochs=3), seed=0)
+    return root / "run", root / "d", metrics
+
+
+# ------------------------------------------------------------------------------- architecture
+
+
+def test_forward_shapes_and_padding_is_ignored():
+    net = _net()
+    g = torch.Generator().manual_seed(0)
+    codes = torch.randint(0, 2, (4, 3, BITS), generator=g).float()
+    mask = torch.tensor([[1, 1, 1], [1, 1, 0], [1, 0, 0], [0, 0, 0]]).bool()
+    act = torch.tensor([0, 7, 21, 35])
+    with torch.no_grad():
+        out = net(codes, mask, act)
+        noisy = codes.clone()
+        noisy[~mask] = 1.0 - noisy[~mask]  # padded slots hold garbage
+        out2 = net(noisy, mask, act)
+    assert out.logits.shape == (4, 3, BITS) and out.codes.shape == (4, 3, BITS)
+    assert torch.isfinite(out.logits).all()  # even the scene without real objects
+    assert (out.logits[~mask] == 0).all() and (out.codes[~mask] == 0).all()
+    torch.testing.assert_close(out.logits[mask], out2.logits[mask])
+    assert set(out.codes.unique().tolist()) <= {0.0, 1.0}
+
+
+def test_forward_refuses_bad_shapes():
+    net = _net()
+    with pytest.raises(ValueError, match="codes must be"):
+        net(torch.zeros(2, 3, BITS + 1), torch.ones(2, 3, dtype=torch.bool), torch.zeros(2, dtype=torch.long))
+    with pytest.raises(ValueError, match="actions must be"):
+        net(torch.zeros(2, 3, BITS), torch.ones(2, 3, dtype=torch.bool), torch.zeros(3, dtype=torch.long))
+
+
+def test_bce_counts_real_objects_only():
+    g = torch.Generator().manual_seed(1)
+    logits = torch.randn(3, 4, BITS, generator=g)
+    target = torch.randint(0, 2, (3, 4, BITS), generator=g).float()
+    mask = torch.tensor([[1, 1, 0, 0], [1, 0, 0, 0], [1, 1, 1, 1]]).bool()
+    want = torch.nn.functional.binary_cross_entropy_with_logits(logits[mask], target[mask])
+    torch.testing.assert_close(masked_bce(logits, target, mask), want)
+    logits2 = logits.clone()
+    logits2[~mask] = 100.0  # confidently wrong padding changes nothing
+    torch.testing.assert_close(masked_bce(logits2, target, mask), want)
+
+
+def test_config_validation_and_presets():
+    with pytest.raises(ValueError, match="divisible"):
+        TransitionConfig(hidden=30, n_heads=4)
+    with pytest.raises(ValueError, match="unknown preset"):
+        TransitionConfig.preset("huge")
+    assert TransitionConfig.preset("quick").hidden < TransitionConfig.preset("paper").hidden
+    cfg = TransitionConfig.preset("quick", epochs=2)
+    assert TransitionConfig.from_json(json.loads(json.dumps(cfg.to_json()))) == cfg
+
+
+def test_rollout_chains_follow_episodes():
+    episode = np.array([0, 0, 0, 1, 1, 2])
+    step = np.array([0, 1, 2, 0, 1, 0])
+    z = np.zeros((6, 1, BITS), np.float32)
+    data = TransitionData(z, np.zeros(6, np.int64), z, np.ones((6, 1), bool), episode, step)
+    assert rollout_chains(data, 1).tolist() == [[0], [1], [2], [3], [4], [5]]
+    assert rollout_chains(data, 2).tolist() == [[0, 1], [1, 2], [3, 4]]
+    assert rollout_chains(data, 3).tolist() == [[0, 1, 2]]
+    assert rollout_chains(data, 4).shape == (0, 4)
+
+
+# ------------------------------------------------------------------------------- data and training
+
+
+def test_encoded_codes_chain_within_episodes(run):
+    run_dir, data_dir, _ = run
+    encoder, _ = load_effect_model(run_dir)
+    data = load_split(data_dir, "train")
+    td = build_transition_data(encoder, data)
+    assert td.before.shape == data.pre_depth.shape[:2] + (encoder.cfg.bits,)
+    assert set(np.unique(td.before).tolist()) <= {0.0, 1.0}
+    assert not td.before[~td.mask].any() and not td.after[~td.mask].any()
+    again = build_transition_data(encoder, data, batch_size=5)  # deterministic, batch-size independent
+    np.testing.assert_array_equal(td.after, again.after)
+    # the after-crops of step t are the before-crops of step t + 1: same codes
+    pairs = rollout_chains(td, 2)
+    assert len(pairs)
+    np.testing.assert_array_equal(td.after[pairs[:, 0]], td.before[pairs[:, 1]])
+
+
+def test_train_transition_writes_files_and_metrics(run):
+    run_dir, _, metrics = run
+    assert (run_dir / TRANSITION_FILE).exists()
+    m = json.loads((run_dir / METRICS_FILE).read_text())
+    test = m["test"]
+    for key in ("bit_accuracy", "object_accuracy", "scene_accuracy"):
+        assert 0.0 <= test[key] <= 1.0
+    assert set(test["rollout"]) == {str(n) for n in range(1, ROLLOUT_STEPS + 1)}
+    for r in test["rollout"].values():
+        assert r["n"] == 0 or 0.0 <= r["scene_accuracy"] <= 1.0
+    assert test["rollout"]["1"]["scene_accuracy"] == test["scene_accuracy"]
+    assert len(m["history"]) == 3 and m["transition_config"]["preset"] == "quick"
+    assert m["seed"] == 0 and m["data_fingerprint"] and "torch" in m["versions"]
+    blob = torch.load(run_dir / TRANSITION_FILE, map_location="cpu", weights_only=True)
+    assert json.loads(blob["config"])["bits"] == metrics["effect_model_bits"]
+
+
+# ------------------------------------------------------------------------------- checkpoint refusals
+
+
+def test_checkpoint_round_trip(tmp_path):
+    net = _net(seed=3)
+    save_transition(tmp_path / "t.pt", net, {"note": "x"})
+    back, meta = load_transition(tmp_path / "t.pt")
+    assert meta == {"note": "x"}
+    for a, b in zip(net.state_dict().values(), back.state_dict().values()):
+        torch.testing.assert_close(a, b)
+
+
+def test_refuses_foreign_and_mismatched_files(run, tmp_path):
+    run_dir, _, _ = run
+    with pytest.raises(TransitionError, match="no transition model"):
+        load_transition(tmp_path / "missing.pt")
+    with pytest.raises(TransitionError, match="not a symlearn transition-model"):
+        load_transition(run_dir / "best.pt")  # the effect model's checkpoint
+    (tmp_path / "junk.pt").write_bytes(b"not a checkpoint at all")
+    with pytest.raises(TransitionError, match="not a readable checkpoint"):
+        load_transition(tmp_path / "junk.pt")
+    blob = torch.load(run_dir / TRANSITION_FILE, map_location="cpu", weights_only=True)
+    torch.save({**blob, "format_version": 99}, tmp_path / "future.pt")
+    with pytest.raises(TransitionError, match="format 99"):
+        load_transition(tmp_path / "future.pt")
+    with pytest.raises(TransitionError, match="another transition config"):
+        load_transition(run_dir / TRANSITION_FILE, expect_config=TransitionConfig.preset("paper"))
+    with pytest.raises(TransitionError) as info:
+        load_transition(tmp_path / "junk.pt")
+    assert "\n" not in str(info.value)
+
+
+def test_refuses_transition_of_another_effect_model(run, tmp_path):
+    run_dir, _, _ = run
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / TRANSITION_FILE).write_bytes((run_dir / TRANSITION_FILE).read_bytes())
+    blob = (run_dir / "best.pt").read_bytes()
+    (other / "best.pt").write_bytes(blob[:-1] + bytes([blob[-1] ^ 1]))  # any change to the encoder's file
+    with pytest.raises(TransitionError, match="another effect model"):
+        LearnedTransition.from_run(other)
+    assert LearnedTransition.from_run(run_dir).bits == load_effect_model(run_dir)[0].cfg.bits
+
+
+# ------------------------------------------------------------------------------- planning interface
+
+
+def test_learned_transition_protocol():
+    m = LearnedTransition(_net(seed=4))
+    rng = np.random.default_rng(0)
+    codes = rng.integers(0, 1 << BITS, (36, 3))
+    actions = np.arange(36)
+    out = m(codes, actions)
+    assert out.shape == (36, 3) and out.dtype == np.int64
+    assert out.min() >= 0 and out.max() < 1 << BITS
+    np.testing.assert_array_equal(out, m(codes, actions))  # deterministic
+    np.testing.assert_array_equal(out[5:6], m(codes[5:6], actions[5:6]))  # batch independent
+    perm = np.array([2, 0, 1])
+    np.testing.assert_array_equal(m(codes[:, perm], actions), out[:, perm])  # permutation equivariant
+    assert m(np.zeros((0, 3), np.int64), np.zeros(0, np.int64)).shape == (0, 3)
+
+
+@pytest.mark.parametrize("codes, actions, match", [
+    (np.zeros(3, np.int64), np.zeros(1, np.int64), "codes must be"),
+    (np.zeros((2, 3), np.int64), np.zeros(3, np.int64), "codes must be"),
+    (np.zeros((1, 3)), np.zeros(1, np.int64), "integers"),
+    (np.full((1, 3), 256), np.zeros(1, np.int64), "codes must lie"),
+    (np.zeros((1, 3), np.int64), np.array([36]), "action ids"),
+])
+def test_learned_transition_refuses_bad_input(codes, actions, match):
+    with pytest.raises(ValueError, match=match):
+        LearnedTransition(_net())(codes, actions)
+
+
+def test_astar_runs_on_learned_transition():
+    m = LearnedTransition(_net(seed=5))
+    start = np.array([3, 200], np.int64)
+    nxt = m(start[None].repeat(36, 0), np.arange(36))
+    changed = np.flatnonzero((nxt != start).any(1))
+    goal_state = nxt[changed[0]] if len(changed) else start
+    res = plan_symbolic(m, start, SymbolicGoal(tuple(int(c) for c in goal_state)), uniform_cost=True, timeout_s=5)
+    assert res.found and len(res.plan) <= 1
+    assert res.predicted_states[-1] == tuple(int(c) for c in goal_state)
+
+
+def test_encode_observation_of_live_scene(run, sim):
+    run_dir, _, _ = run
+    encoder, _ = load_effect_model(run_dir)
+    sim.build([(ObjectType.CUBE, 3), (ObjectType.STICK, 4)])
+    obs = sim.observe()
+    codes = encode_observation(encoder, obs)
+    assert codes.shape == (2,) and codes.dtype == np.int64
+    assert codes.min() >= 0 and codes.max() < 1 << encoder.cfg.bits
+    np.testing.assert_array_equal(codes, encode_observation(encoder, sim.observe()))
