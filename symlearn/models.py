@@ -73,7 +73,8 @@ class ModelConfig:
 
 PRESETS = {
     "paper": ModelConfig(),
-    "quick": ModelConfig(conv_channels=(16, 32, 64, 64), d_model=64, n_heads=4, n_layers=2, ff_dim=256,
+    # 32 px crops (the stored 64 px average-pooled) and narrow layers: about 20x less compute a crop.
+    "quick": ModelConfig(crop=32, conv_channels=(32, 64, 64, 64), d_model=64, n_heads=4, n_layers=2, ff_dim=256,
                          decoder_hidden=(128, 128, 128)),
 }
 
@@ -111,6 +112,10 @@ class Encoder(nn.Module):
         self.channels_last = True  # oneDNN's convolutions run faster on NHWC, with bf16 most of all
 
     def forward(self, crops: torch.Tensor) -> torch.Tensor:
+        if crops.shape[-1] != self.cfg.crop:  # a smaller model crop: average-pool the stored 64 px crops
+            if crops.shape[-1] % self.cfg.crop:
+                raise ValueError(f"crops of {crops.shape[-1]} px cannot be pooled to {self.cfg.crop} px")
+            crops = F.avg_pool2d(crops, crops.shape[-1] // self.cfg.crop)
         d = crops[:, :1]
         depth = torch.where(d > 0, (self.cfg.depth_ref - d) / self.cfg.depth_scale, torch.zeros_like(d))
         x = torch.cat([depth, crops[:, 1:]], dim=1)  # (N, 3, S, S)
@@ -167,7 +172,7 @@ class AttentiveDeepSym(nn.Module):
 
     def forward(self, crops: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor,
                 generator: torch.Generator | None = None) -> EffectOutput:
-        if crops.dim() != 5 or crops.shape[:2] != mask.shape or crops.shape[2] != 3:
+        if crops.dim() != 5 or crops.shape[:2] != mask.shape or crops.shape[2] != 3 or crops.shape[-1] != crops.shape[-2]:
             raise ValueError(f"crops must be (B, K, 3, S, S) matching mask (B, K); got {tuple(crops.shape)} "
                              f"and {tuple(mask.shape)}")
         if actions.shape != mask.shape[:1]:

@@ -42,6 +42,8 @@ class TrainConfig:
     batch_size: int = 128  # scenes per step
     lr: float = 5e-4
     weight_decay: float = 0.0
+    cosine_lr: bool = True  # decay the learning rate to lr_min_ratio * lr over the epochs (cosine)
+    lr_min_ratio: float = 0.05
     seed: int = 0
     bf16: bool = True  # bfloat16 autocast on CPU (AMX) or GPU; weights stay float32
     compile: bool = False  # torch.compile the model
@@ -51,7 +53,7 @@ class TrainConfig:
     def preset(name: str, **overrides) -> "TrainConfig":
         model_over = {k: overrides.pop(k) for k in list(overrides) if k in ModelConfig.__dataclass_fields__}
         base = {"paper": dict(epochs=60, batch_size=128, lr=5e-4),
-                "quick": dict(epochs=12, batch_size=64, lr=1e-3)}
+                "quick": dict(epochs=40, batch_size=64, lr=1e-3)}
         if name not in base:
             raise ValueError(f"unknown preset {name!r}; known: paper, quick")
         return TrainConfig(model=ModelConfig.preset(name, **model_over), preset=name, **{**base[name], **overrides})
@@ -166,8 +168,8 @@ def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, 
     if cfg.max_train_samples:
         train_data = InteractionData(**{f.name: getattr(train_data, f.name)[: cfg.max_train_samples]
                                         for f in dataclasses.fields(InteractionData)})
-    if train_data.pre_depth.shape[-1] != cfg.model.crop:
-        raise TrainingError(f"data crops are {train_data.pre_depth.shape[-1]} px but the model expects {cfg.model.crop}")
+    if train_data.pre_depth.shape[-1] % cfg.model.crop:
+        raise TrainingError(f"data crops of {train_data.pre_depth.shape[-1]} px do not pool to the model's {cfg.model.crop} px")
     mean, std = effect_normalization(train_data)
     tr, va = to_tensors(train_data, mean, std), to_tensors(val_data, mean, std)
 
@@ -200,6 +202,8 @@ def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, 
     step_fn = torch.compile(net) if cfg.compile else net
 
     for epoch in range(start_epoch, cfg.epochs):
+        for group in opt.param_groups:
+            group["lr"] = epoch_lr(cfg, epoch)
         model.train()
         perm = torch.randperm(len(tr), generator=gen)
         per_rank = len(perm) // world
@@ -227,7 +231,7 @@ def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, 
         pred = predict_effects(model, va, bf16=cfg.bf16)
         val_loss = float(masked_mse(pred, va.effect, va.mask))
         row = {"epoch": epoch + 1, "train_loss": round(total / n_batches, 5), "val_loss": round(val_loss, 5),
-               "val_mae_mm": mae_mm(pred, va, std), "crops_per_s": round(seen * world / train_time, 1),
+               "val_mae_mm": mae_mm(pred, va, std), "lr": round(epoch_lr(cfg, epoch), 7), "crops_per_s": round(seen * world / train_time, 1),
                "epoch_time_s": round(train_time, 1)}
         history.append(row)
         if rank == 0:
@@ -252,6 +256,14 @@ def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, 
             atomic_write_json(run_dir / "metrics.json", {**result, "data_fingerprint": fingerprint,
                                                          "world_size": world})
     return result
+
+
+def epoch_lr(cfg: TrainConfig, epoch: int) -> float:
+    """Learning rate of an epoch: constant, or cosine from lr down to lr * lr_min_ratio."""
+    if not cfg.cosine_lr or cfg.epochs <= 1:
+        return cfg.lr
+    w = 0.5 * (1 + math.cos(math.pi * epoch / (cfg.epochs - 1)))
+    return cfg.lr * (cfg.lr_min_ratio + (1 - cfg.lr_min_ratio) * w)
 
 
 def _resumable(train_config: dict) -> dict:

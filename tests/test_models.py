@@ -6,7 +6,7 @@ from symlearn.models import AttentiveDeepSym, ModelConfig, gumbel_sigmoid, maske
 CFG = ModelConfig.preset("quick")
 
 
-def _batch(b=4, k=3, s=CFG.crop, seed=0):
+def _batch(b=4, k=3, s=64, seed=0):
     g = torch.Generator().manual_seed(seed)
     x = torch.rand(b, k, 3, s, s, generator=g) * 1.5
     mask = torch.ones(b, k, dtype=torch.bool)

@@ -1,0 +1,354 @@
+"""Write learned rules as PDDL text: a lifted conditional-effects domain or a grounded STRIPS task.
+
+Two encodings of the same rules (see /work/shared/PDDL_NOTES.md for what each planner takes):
+
+* Conditional form (`conditional_domain` + `problem_pddl`): one parameterless action
+  `pick-P-release-R` per real action that changes something, whose effect is
+  `(forall (?o - obj) (and (when <rule condition> <rule effect>) ...))`, one `when` per rule.
+  PDDL evaluates every `when` in the pre-state and applies all of them at once, which is
+  exactly apply_rules' simultaneous update; the rules of one (action, own code) are mutually
+  exclusive (RuleSet checks it), so one step of the plan is one step of the network. Plans
+  read as the robot's own actions. The context on other objects is written with `exists`:
+  "some other object has X" is `(exists (?z - obj) (code-X ?z))`; the `(not (= ?z ?o))`
+  guard is added only when X is ?o's own code, since each object holds exactly one code
+  (true in the initial state and kept by every effect), so another code can only be on
+  another object. "At least n" uses n pairwise-distinct variables; "none" and "fewer than
+  n" are the negations. Fast Downward and SymK take it as written.
+* STRIPS form (`strips_pddl`): for ONE problem, the joint states reachable from its initial
+  state under the rules are enumerated (breadth first, bounded by max_states); each
+  (state, real action) that changes something becomes the ground action
+  `pick-P-release-R-sN` (N = the state's index) whose precondition is the full joint
+  assignment and whose effect changes exactly the objects that change. Objects are domain
+  constants; only :strips and :typing are needed, so every planner (pyperplan,
+  fast-downward-opt) takes it. Its size grows with the reachable state space.
+
+Names: codes are predicates `code-<bits, MSB first>` (`code-00011011`), objects `o0, o1, ...`.
+Every function returns a string; write_text_atomic puts one on disk.
+
+    >>> from pddl_export.rules import Rule, RuleSet
+    >>> rs = RuleSet(bits=2, vocabulary=(1, 2), max_objects=2, n_rules_before_generalization=1,
+    ...              rules=(Rule(action=5, code_from=1, code_to=2),))
+    >>> for line in conditional_domain(rs, model_hash="abc").splitlines()[:3]:
+    ...     print(line)
+    ;; symlearn learned domain (conditional form)
+    ;; model-hash: abc
+    ;; vocabulary-size: 2
+    >>> "(:goal (and (code-10 o0)))" in problem_pddl(rs, [1, 2], [2, None], model_hash="abc")
+    True
+    >>> t = strips_pddl(rs, [1, 1], [2, 2], model_hash="abc")   # both objects change at once
+    >>> t.n_states, t.n_actions
+    (2, 1)
+"""
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from pddl_export.rules import INF, Rule, RuleSet, apply_rules_batch
+from search.symbolic import N_ACTIONS, SymbolicGoal, code_str
+
+N_LOCATIONS = 6  # action id = pick * 6 + release
+OBJECT_TYPE = "obj"
+_ACTION_RE = re.compile(r"^pick-([0-5])-release-([0-5])(?:-s[0-9]+)?$", re.IGNORECASE)
+_CODE_RE = re.compile(r"^code-([01]+)$", re.IGNORECASE)
+_OBJECT_RE = re.compile(r"^o([0-9]+)$", re.IGNORECASE)
+
+
+# ----------------------------------------------------------------------------- names
+
+
+def pddl_name(text: str) -> str:
+    """A valid PDDL name from any text: lowercase letters, digits, '-' and '_', starting with a letter."""
+    name = re.sub(r"[^a-z0-9_-]+", "-", str(text).strip().lower()).strip("-_")
+    if not name:
+        raise ValueError(f"cannot make a PDDL name from {text!r}")
+    return name if name[0].isalpha() else f"x-{name}"
+
+
+def code_predicate(code: int, bits: int) -> str:
+    """'code-00011011' for code 27 with 8 bits."""
+    return f"code-{code_str(code, bits)}"
+
+
+def code_from_predicate(name: str) -> int:
+    """Inverse of code_predicate."""
+    m = _CODE_RE.match(name)
+    if not m:
+        raise ValueError(f"{name!r} is not a code predicate")
+    return int(m.group(1), 2)
+
+
+def object_name(index: int) -> str:
+    return f"o{int(index)}"
+
+
+def object_index(name: str) -> int:
+    """Inverse of object_name."""
+    m = _OBJECT_RE.match(name)
+    if not m:
+        raise ValueError(f"{name!r} is not an object name")
+    return int(m.group(1))
+
+
+def action_name(action: int) -> str:
+    """'pick-P-release-R' for action id P * 6 + R."""
+    if not 0 <= int(action) < N_ACTIONS:
+        raise ValueError(f"action must lie in 0..{N_ACTIONS - 1}, got {action}")
+    return f"pick-{int(action) // N_LOCATIONS}-release-{int(action) % N_LOCATIONS}"
+
+
+def action_id_from_name(name: str) -> int:
+    """Action id of 'pick-P-release-R' or of a grounded 'pick-P-release-R-sN'."""
+    m = _ACTION_RE.match(name)
+    if not m:
+        raise ValueError(f"{name!r} does not name a real action (pick-P-release-R[-sN])")
+    return int(m.group(1)) * N_LOCATIONS + int(m.group(2))
+
+
+# ----------------------------------------------------------------------------- text pieces
+
+
+def _header(kind: str, model_hash: str, rules: RuleSet, extra: Sequence[str] = ()) -> list[str]:
+    one_line = " ".join(str(model_hash).split())
+    lines = [
+        f";; symlearn learned {kind}",
+        f";; model-hash: {one_line}",
+        f";; vocabulary-size: {len(rules.vocabulary)}",
+        f";; rules: {rules.n_rules} (before generalization: {rules.n_rules_before_generalization})",
+        f";; exact for scenes of up to {rules.max_objects} objects",
+    ]
+    return lines + [f";; {x}" for x in extra]
+
+
+def _count_formula(code: int, n: int, own_code: int, bits: int) -> tuple[str, bool]:
+    """'at least n OTHER objects have `code`' and whether it uses equality."""
+    vs = ["?z"] if n == 1 else [f"?z{i}" for i in range(1, n + 1)]
+    parts = [f"(not (= {a} {b}))" for i, a in enumerate(vs) for b in vs[i + 1:]]
+    if code == own_code:
+        parts += [f"(not (= {v} ?o))" for v in vs]
+    parts += [f"({code_predicate(code, bits)} {v})" for v in vs]
+    body = parts[0] if len(parts) == 1 else f"(and {' '.join(parts)})"
+    return f"(exists ({' '.join(vs)} - {OBJECT_TYPE}) {body})", len(parts) > n
+
+
+@dataclass(frozen=True)
+class _Condition:
+    text: str
+    uses_exists: bool
+    uses_negation: bool
+    uses_equality: bool
+
+
+def _rule_condition(rule: Rule, bits: int) -> _Condition:
+    conds = [f"({code_predicate(rule.code_from, bits)} ?o)"]
+    eq = neg = False
+    for x, (lo, hi) in rule.bounds().items():
+        if lo >= 1:
+            text, e = _count_formula(x, lo, rule.code_from, bits)
+            conds.append(text)
+            eq |= e
+        if hi < INF:
+            text, e = _count_formula(x, hi, rule.code_from, bits)
+            conds.append(f"(not {text})")
+            eq, neg = eq | e, True
+    neg |= eq  # (not (= ..)) is a negative literal too
+    text = conds[0] if len(conds) == 1 else f"(and {' '.join(conds)})"
+    return _Condition(text, len(conds) > 1, neg, eq)
+
+
+def _requirements(*flags: str) -> str:
+    return f"(:requirements {' '.join(flags)})"
+
+
+def conditional_domain(rules: RuleSet, model_hash: str, name: str = "symlearn") -> str:
+    """Domain text: one parameterless conditional-effects action per real action with rules."""
+    bits = rules.bits
+    by_action: dict[int, list[Rule]] = {}
+    for r in rules.rules:
+        by_action.setdefault(r.action, []).append(r)
+    actions, uses = [], {"exists": False, "neg": False, "eq": False}
+    for a in sorted(by_action):
+        whens = []
+        for r in by_action[a]:
+            c = _rule_condition(r, bits)
+            uses["exists"] |= c.uses_exists
+            uses["neg"] |= c.uses_negation
+            uses["eq"] |= c.uses_equality
+            frm, to = code_predicate(r.code_from, bits), code_predicate(r.code_to, bits)
+            whens.append(f"      (when {c.text}\n        (and (not ({frm} ?o)) ({to} ?o)))")
+        actions.append(
+            f"  (:action {action_name(a)}\n"
+            f"    :parameters ()\n"
+            f"    :precondition (and)\n"
+            f"    :effect (forall (?o - {OBJECT_TYPE}) (and\n" + "\n".join(whens) + ")))")
+    flags = [":strips", ":typing"] + ([":conditional-effects"] if actions else [])
+    flags += [":existential-preconditions"] if uses["exists"] else []
+    flags += [":negative-preconditions"] if uses["neg"] else []
+    flags += [":equality"] if uses["eq"] else []
+    preds = " ".join(f"({code_predicate(c, bits)} ?o - {OBJECT_TYPE})" for c in rules.codes)
+    lines = _header("domain (conditional form)", model_hash, rules, [f"actions: {len(actions)}"])
+    lines += [f"(define (domain {pddl_name(name)})", f"  {_requirements(*flags)}",
+              f"  (:types {OBJECT_TYPE})", f"  (:predicates {preds})"]
+    lines += actions + [")", ""]
+    return "\n".join(lines)
+
+
+def _checked_task(rules: RuleSet, init: Sequence[int], goal: SymbolicGoal | Sequence[int | None]) -> tuple[tuple[int, ...], SymbolicGoal]:
+    init_t = tuple(int(c) for c in init)
+    goal_g = goal if isinstance(goal, SymbolicGoal) else SymbolicGoal(tuple(goal))
+    if not init_t:
+        raise ValueError("a problem needs at least one object")
+    if len(goal_g.codes) != len(init_t):
+        raise ValueError(f"goal has {len(goal_g.codes)} objects, init has {len(init_t)}")
+    known = set(rules.codes)
+    unknown = sorted({c for c in init_t + goal_g.codes if c is not None} - known)
+    if unknown:
+        raise ValueError(f"codes {unknown} are not in the learned vocabulary (no PDDL predicate); "
+                         "add them to the vocabulary before distilling")
+    return init_t, goal_g
+
+
+def _goal_text(goal: SymbolicGoal, bits: int) -> str:
+    atoms = [f"({code_predicate(c, bits)} {object_name(i)})" for i, c in enumerate(goal.codes) if c is not None]
+    return f"(:goal (and {' '.join(atoms)}))"
+
+
+def problem_pddl(
+    rules: RuleSet,
+    init: Sequence[int],
+    goal: SymbolicGoal | Sequence[int | None],
+    model_hash: str,
+    name: str = "task",
+    domain_name: str = "symlearn",
+) -> str:
+    """Problem text for the conditional form: objects o0.., their codes, the fixed goal codes."""
+    init_t, goal_g = _checked_task(rules, init, goal)
+    bits = rules.bits
+    objs = " ".join(object_name(i) for i in range(len(init_t)))
+    facts = " ".join(f"({code_predicate(c, bits)} {object_name(i)})" for i, c in enumerate(init_t))
+    lines = _header("problem", model_hash, rules, [f"objects: {len(init_t)}"])
+    lines += [f"(define (problem {pddl_name(name)})", f"  (:domain {pddl_name(domain_name)})",
+              f"  (:objects {objs} - {OBJECT_TYPE})", f"  (:init {facts})",
+              f"  {_goal_text(goal_g, bits)})", ""]
+    return "\n".join(lines)
+
+
+# ----------------------------------------------------------------------------- STRIPS form
+
+
+class StateLimitError(RuntimeError):
+    """The reachable joint state space is larger than max_states."""
+
+
+@dataclass(frozen=True)
+class StripsTask:
+    """A grounded STRIPS domain and problem for one initial state."""
+
+    domain: str
+    problem: str
+    n_states: int  # reachable joint states
+    n_actions: int  # ground actions (state, real action) that change something
+
+    def __post_init__(self) -> None:
+        if self.n_states < 1 or self.n_actions < 0:
+            raise ValueError("need n_states >= 1 and n_actions >= 0")
+
+
+def reachable_transitions(rules: RuleSet, init: Sequence[int], max_states: int = 100_000) -> tuple[list[tuple[int, ...]], list[tuple[int, int, int]]]:
+    """Breadth-first reachable joint states and their changing edges (state index, action, next index).
+
+    States are numbered in breadth-first order; each layer is expanded with one batched
+    apply_rules_batch call over (frontier states x actions with rules).
+    """
+    start = tuple(int(c) for c in init)
+    index, states = {start: 0}, [start]
+    edges: list[tuple[int, int, int]] = []
+    actions = np.array(rules.actions, np.int64)
+    frontier = [0]
+    while frontier and len(actions):
+        pre = np.array([states[i] for i in frontier], np.int64)  # (F, K)
+        nxt = apply_rules_batch(rules, np.repeat(pre, len(actions), axis=0), np.tile(actions, len(pre)))
+        new_frontier = []
+        for r, row in enumerate(nxt.tolist()):
+            i, a, succ = frontier[r // len(actions)], int(actions[r % len(actions)]), tuple(row)
+            if succ == states[i]:
+                continue
+            if succ not in index:
+                if len(states) >= max_states:
+                    raise StateLimitError(
+                        f"more than {max_states} joint states reachable from {list(start)}; "
+                        "use the conditional form or raise max_states")
+                index[succ] = len(states)
+                states.append(succ)
+                new_frontier.append(index[succ])
+            edges.append((i, a, index[succ]))
+        frontier = new_frontier
+    return states, edges
+
+
+def strips_pddl(
+    rules: RuleSet,
+    init: Sequence[int],
+    goal: SymbolicGoal | Sequence[int | None],
+    model_hash: str,
+    name: str = "task",
+    domain_name: str = "symlearn-strips",
+    max_states: int = 100_000,
+) -> StripsTask:
+    """Grounded STRIPS domain + problem over the states reachable from `init` (see module doc)."""
+    init_t, goal_g = _checked_task(rules, init, goal)
+    bits = rules.bits
+    states, edges = reachable_transitions(rules, init_t, max_states)
+    objs = [object_name(i) for i in range(len(init_t))]
+
+    def atom(code: int, i: int) -> str:
+        return f"({code_predicate(code, bits)} {objs[i]})"
+
+    actions = []
+    for i, a, j in edges:
+        pre, post = states[i], states[j]
+        eff = [x for k, (c, d) in enumerate(zip(pre, post)) if c != d for x in (f"(not {atom(c, k)})", atom(d, k))]
+        actions.append(
+            f"  (:action {action_name(a)}-s{i}\n    :parameters ()\n"
+            f"    :precondition (and {' '.join(atom(c, k) for k, c in enumerate(pre))})\n"
+            f"    :effect (and {' '.join(eff)}))")
+    codes = sorted(set(rules.codes) | {c for s in states for c in s})
+    preds = " ".join(f"({code_predicate(c, bits)} ?o - {OBJECT_TYPE})" for c in codes)
+    extra = [f"objects: {len(objs)}", f"reachable states: {len(states)}", f"ground actions: {len(actions)}"]
+    dom = _header("domain (grounded STRIPS form)", model_hash, rules, extra)
+    dom += [f"(define (domain {pddl_name(domain_name)})", f"  {_requirements(':strips', ':typing')}",
+            f"  (:types {OBJECT_TYPE})", f"  (:constants {' '.join(objs)} - {OBJECT_TYPE})",
+            f"  (:predicates {preds})"]
+    dom += actions + [")", ""]
+    prob = _header("problem (grounded STRIPS form)", model_hash, rules, extra[:1])
+    prob += [f"(define (problem {pddl_name(name)})", f"  (:domain {pddl_name(domain_name)})",
+             f"  (:init {' '.join(atom(c, k) for k, c in enumerate(init_t))})",
+             f"  {_goal_text(goal_g, bits)})", ""]
+    return StripsTask("\n".join(dom), "\n".join(prob), len(states), len(actions))
+
+
+# ----------------------------------------------------------------------------- files
+
+
+def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
+    """Write text to path via a temporary file in the same folder and os.replace."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path

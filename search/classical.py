@@ -1,0 +1,323 @@
+"""Solve exported PDDL with classical planners through unified-planning, as a PlanResult.
+
+    >>> from search.classical import solve_pddl
+    >>> r = solve_pddl(domain_text, problem_text, planner="fast-downward", timeout_s=10)  # doctest: +SKIP
+    >>> r.status, r.plan, r.extra["planner_time_s"]                                      # doctest: +SKIP
+    (<PlanStatus.SOLVED: 'solved'>, (3, 22), 0.41)
+
+The whole call (parse, compile, plan, map back, validate, simulate) runs in a child process
+that the caller kills if it does not answer within timeout_s + grace_s, so no planner can
+hang the caller; the planner itself gets the time left of timeout_s. Pyperplan has no time
+limit of its own: a run that ends after timeout_s is reported as TIMEOUT. Fast Downward and
+SymK run as subprocesses in their own session, killed by unified-planning at the time left;
+grace_s leaves room for that before the guard fires.
+
+When the chosen engine does not accept the problem as written, unified-planning compilers
+are applied in the order of /work/shared/PDDL_NOTES.md (quantifiers removing, grounding,
+disjunctive- and negative-conditions removing), each only when needed. Conditional effects
+are compiled away only on request (compile_conditional_effects=True): that compiler makes
+2^(number of conditional effects) actions per action, so for pyperplan and
+fast-downward-opt the grounded STRIPS form of pddl_export.pddl_writer is the scalable route.
+Plans of the compiled problem are mapped back (map_back_action_instance, in reverse order),
+validated on the original problem with unified-planning's PlanValidator, converted to
+action ids by name (`pick-P-release-R[-sN]` -> P * 6 + R) and replayed with the
+SequentialSimulator to report the predicted symbolic states (objects `o<i>`, predicates
+`code-<bits>`).
+"""
+from __future__ import annotations
+
+import math
+import multiprocessing as mp
+import re
+import time
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
+from pddl_export.pddl_writer import action_id_from_name, code_from_predicate, object_index
+from search.result import PlanResult, PlanStatus
+
+
+@dataclass(frozen=True)
+class PlannerSpec:
+    """How one planner name maps onto a unified-planning engine."""
+
+    engine: str  # name in unified-planning's engine factory
+    optimal: bool  # guarantees a shortest plan (unit costs)
+    native_timeout: bool  # the engine enforces the timeout itself (a killed subprocess)
+
+    def __post_init__(self) -> None:
+        if not self.engine:
+            raise ValueError("engine must be a non-empty engine name")
+
+
+PLANNERS: dict[str, PlannerSpec] = {
+    "fast-downward": PlannerSpec("fast-downward", optimal=False, native_timeout=True),
+    "fast-downward-opt": PlannerSpec("fast-downward-opt", optimal=True, native_timeout=True),
+    "symk": PlannerSpec("symk", optimal=False, native_timeout=True),
+    "symk-opt": PlannerSpec("symk-opt", optimal=True, native_timeout=True),
+    "pyperplan": PlannerSpec("pyperplan", optimal=False, native_timeout=False),
+}
+
+_EXPANDED_RE = re.compile(r"Expanded (\d+) state", re.IGNORECASE)
+
+
+def _one_line(text: Any, limit: int = 300) -> str:
+    s = " ".join(str(text).split())
+    return s if len(s) <= limit else s[: limit - 3] + "..."
+
+
+def _result(planner: str, status: PlanStatus, t0: float, message: str = "", **extra: Any) -> PlanResult:
+    return PlanResult(planner=planner, status=status, plan=(), predicted_states=(), expansions=None,
+                      planning_time_s=time.perf_counter() - t0, message=_one_line(message), extra=extra)
+
+
+def _status_from_up(status: Any) -> PlanStatus:
+    """The one adapter from unified-planning's PlanGenerationResultStatus to PlanStatus."""
+    from unified_planning.engines import PlanGenerationResultStatus as S
+
+    return {
+        S.SOLVED_SATISFICING: PlanStatus.SOLVED,
+        S.SOLVED_OPTIMALLY: PlanStatus.SOLVED,
+        S.UNSOLVABLE_PROVEN: PlanStatus.UNSOLVABLE,
+        S.UNSOLVABLE_INCOMPLETELY: PlanStatus.UNSOLVABLE,
+        S.TIMEOUT: PlanStatus.TIMEOUT,
+    }.get(status, PlanStatus.ERROR)
+
+
+def _compile_steps(compile_conditional_effects: bool):
+    """(compilation kind name, whether the problem needs it) in the order PDDL_NOTES.md gives."""
+    return [
+        ("QUANTIFIERS_REMOVING", lambda p, k: k.has_existential_conditions() or k.has_universal_conditions()
+         or k.has_forall_effects()),
+        ("CONDITIONAL_EFFECTS_REMOVING", lambda p, k: compile_conditional_effects and k.has_conditional_effects()),
+        ("GROUNDING", lambda p, k: any(a.parameters for a in p.actions)),
+        ("DISJUNCTIVE_CONDITIONS_REMOVING", lambda p, k: k.has_disjunctive_conditions()),
+        ("NEGATIVE_CONDITIONS_REMOVING", lambda p, k: k.has_negative_conditions()),
+    ]
+
+
+def _decode_state(state: Any, objects: list, fluents: list) -> tuple[int, ...]:
+    """Per object (o0, o1, ...) the code whose predicate holds; -1 if not exactly one."""
+    out = []
+    for o in objects:
+        held = [code for code, f in fluents if state.get_value(f(o)).bool_constant_value()]
+        out.append(held[0] if len(held) == 1 else -1)
+    return tuple(out)
+
+
+def _predicted_states(problem: Any, plan: Any) -> tuple[tuple[tuple[int, ...], ...], str]:
+    """Replay the plan on the original problem; ((), why) when objects/predicates are not ours."""
+    from unified_planning.shortcuts import SequentialSimulator
+
+    try:
+        objects = sorted(problem.all_objects, key=lambda o: object_index(o.name))
+        fluents = [(code_from_predicate(f.name), f) for f in problem.fluents]
+    except ValueError as e:
+        return (), f"no predicted states: {e}"
+    if [object_index(o.name) for o in objects] != list(range(len(objects))):
+        return (), "no predicted states: objects are not o0..oK-1"
+    with SequentialSimulator(problem) as sim:
+        state = sim.get_initial_state()
+        states = [_decode_state(state, objects, fluents)]
+        for ai in plan.actions:
+            state = sim.apply(state, ai)
+            states.append(_decode_state(state, objects, fluents))
+    if any(c < 0 for s in states for c in s):
+        return (), "no predicted states: some object does not hold exactly one code"
+    return tuple(states), ""
+
+
+def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: float,
+                compile_conditional_effects: bool) -> PlanResult:
+    """The whole pipeline in this process; never raises (ERROR instead)."""
+    t0 = time.perf_counter()
+    deadline = t0 + timeout_s
+    spec = PLANNERS[planner]
+    try:
+        from unified_planning.engines import CompilationKind, PlanGenerationResultStatus, ValidationResultStatus
+        from unified_planning.io import PDDLReader
+        from unified_planning.shortcuts import Compiler, MinimizeSequentialPlanLength, OneshotPlanner, PlanValidator
+        from unified_planning.shortcuts import get_environment
+    except ImportError as e:
+        return _result(planner, PlanStatus.ERROR, t0, f"unified-planning is not installed: {e}")
+    env = get_environment()
+    env.credits_stream = None
+    if spec.engine not in env.factory.engines:
+        return _result(planner, PlanStatus.ERROR, t0, f"engine {spec.engine!r} is not installed")
+    engine_cls = env.factory.engine(spec.engine)
+    try:
+        original = PDDLReader(env).parse_problem_string(domain_text, problem_text)
+    except Exception as e:  # noqa: BLE001 - any parser failure is reported, not raised
+        return _result(planner, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}")
+    t_parse = time.perf_counter() - t0
+
+    problem, chain, names = original, [], []
+    if (original.kind.has_conditional_effects() and not compile_conditional_effects
+            and not engine_cls.supported_kind().has_conditional_effects()):
+        return _result(planner, PlanStatus.ERROR, t0, f"{planner} does not support CONDITIONAL_EFFECTS; use the "
+                       "grounded STRIPS form (pddl_export.pddl_writer.strips_pddl) or compile_conditional_effects=True",
+                       engine=spec.engine, parse_time_s=t_parse)
+    try:
+        if spec.optimal:  # ask for a shortest plan explicitly, so the status says SOLVED_OPTIMALLY
+            with_metric = original.clone()
+            with_metric.add_quality_metric(MinimizeSequentialPlanLength())
+            if engine_cls.supports(with_metric.kind):
+                problem = with_metric
+        for kind_name, needed in _compile_steps(compile_conditional_effects):
+            if engine_cls.supports(problem.kind):
+                break
+            if not needed(problem, problem.kind):
+                continue
+            kind = CompilationKind[kind_name]
+            with Compiler(problem_kind=problem.kind, compilation_kind=kind) as compiler:
+                compiled = compiler.compile(problem, kind)
+            chain.append(compiled)
+            names.append(kind_name.lower())
+            problem = compiled.problem
+            if time.perf_counter() > deadline:
+                return _result(planner, PlanStatus.TIMEOUT, t0, f"time limit reached while compiling ({kind_name.lower()})")
+    except Exception as e:  # noqa: BLE001
+        return _result(planner, PlanStatus.ERROR, t0, f"compilation failed: {type(e).__name__}: {e}")
+    t_compile = time.perf_counter() - t0 - t_parse
+    extra: dict[str, Any] = {
+        "engine": spec.engine, "parse_time_s": t_parse, "compile_time_s": t_compile,
+        "compilers": ",".join(names), "n_actions": len(problem.actions)}
+    if not engine_cls.supports(problem.kind):
+        missing = sorted(set(problem.kind.features) - set(engine_cls.supported_kind().features))
+        hint = ("; use the grounded STRIPS form (pddl_export.pddl_writer.strips_pddl)"
+                if "CONDITIONAL_EFFECTS" in missing else "")
+        return _result(planner, PlanStatus.ERROR, t0, f"{planner} does not support {', '.join(missing)}{hint}", **extra)
+
+    remaining = deadline - time.perf_counter()
+    if remaining <= 0:
+        return _result(planner, PlanStatus.TIMEOUT, t0, "time limit reached before planning", **extra)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with OneshotPlanner(name=spec.engine) as engine:
+                t1 = time.perf_counter()
+                res = engine.solve(problem, timeout=remaining if spec.native_timeout else None)
+                planner_time = time.perf_counter() - t1
+    except Exception as e:  # noqa: BLE001
+        return _result(planner, PlanStatus.ERROR, t0, f"{planner} failed: {type(e).__name__}: {e}", **extra)
+    extra.update(planner_time_s=planner_time, up_status=res.status.name,
+                 optimal=res.status == PlanGenerationResultStatus.SOLVED_OPTIMALLY)
+    logs = " ".join(m.message for m in (res.log_messages or []))
+    found = _EXPANDED_RE.findall(logs)
+    expansions = int(found[-1]) if found else None
+    status = _status_from_up(res.status)
+    if not spec.native_timeout and time.perf_counter() > deadline:
+        return _result(planner, PlanStatus.TIMEOUT, t0, f"{planner} ran past the {timeout_s:g} s limit "
+                       f"({planner_time:.3f} s; it has no time limit of its own)", **extra)
+    if status is not PlanStatus.SOLVED:
+        why = {PlanStatus.UNSOLVABLE: "no plan exists" if res.status == PlanGenerationResultStatus.UNSOLVABLE_PROVEN
+               else "search space exhausted (no proof of unsolvability)",
+               PlanStatus.TIMEOUT: f"{planner} hit the {timeout_s:g} s time limit"}.get(
+                   status, f"{planner} ended with {res.status.name}")
+        return _result(planner, status, t0, why, **extra)
+    if res.plan is None:
+        return _result(planner, PlanStatus.ERROR, t0, f"{planner} reported {res.status.name} without a plan", **extra)
+    try:
+        t2 = time.perf_counter()
+        plan = res.plan
+        for compiled in reversed(chain):
+            plan = plan.replace_action_instances(compiled.map_back_action_instance)
+        with PlanValidator(problem_kind=original.kind, plan_kind=plan.kind) as validator:
+            check = validator.validate(original, plan)
+        extra["validate_time_s"] = time.perf_counter() - t2
+        if check.status != ValidationResultStatus.VALID:
+            reason = getattr(check, "reason", None) or getattr(check, "inapplicable_action", None) or ""
+            return _result(planner, PlanStatus.ERROR, t0, f"plan failed validation on the original problem {reason}", **extra)
+        ids = tuple(action_id_from_name(ai.action.name) for ai in plan.actions)
+        states, note = _predicted_states(original, plan)
+    except Exception as e:  # noqa: BLE001
+        return _result(planner, PlanStatus.ERROR, t0, f"plan mapping/validation failed: {type(e).__name__}: {e}", **extra)
+    if note:
+        extra["note"] = note
+    return PlanResult(planner=planner, status=PlanStatus.SOLVED, plan=ids, predicted_states=states,
+                      expansions=expansions, planning_time_s=time.perf_counter() - t0, extra=extra)
+
+
+def _worker(conn: Any, *args: Any) -> None:
+    try:
+        result = _solve_here(*args).to_json()
+    except BaseException as e:  # noqa: BLE001 - the parent must hear about anything
+        result = {"error": _one_line(f"{type(e).__name__}: {e}")}
+    try:
+        conn.send(result)
+    finally:
+        conn.close()
+
+
+def _context() -> Any:
+    methods = mp.get_all_start_methods()
+    return mp.get_context("fork" if "fork" in methods else "spawn")
+
+
+def solve_pddl(
+    domain_text: str,
+    problem_text: str,
+    planner: str,
+    timeout_s: float,
+    *,
+    compile_conditional_effects: bool = False,
+    grace_s: float = 3.0,
+) -> PlanResult:
+    """Run one classical planner on PDDL text; every failure comes back as a status, never raised.
+
+    Planners: "fast-downward" (satisficing), "fast-downward-opt", "symk", "symk-opt",
+    "pyperplan". The call takes at most about timeout_s + grace_s seconds.
+    """
+    t0 = time.perf_counter()
+    if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
+        raise ValueError(f"timeout_s must be a positive number, got {timeout_s!r}")
+    if not (math.isfinite(grace_s) and grace_s >= 0):
+        raise ValueError(f"grace_s must be >= 0, got {grace_s!r}")
+    name = str(planner)
+    if name not in PLANNERS:
+        return _result(name or "unknown", PlanStatus.ERROR, t0, f"unknown planner {name!r}; known: {', '.join(PLANNERS)}",
+                       total_time_s=time.perf_counter() - t0)
+    try:  # import here so a forked child starts with unified-planning loaded
+        import unified_planning.shortcuts  # noqa: F401
+        from unified_planning.shortcuts import get_environment
+
+        get_environment().credits_stream = None
+    except ImportError as e:
+        return _result(name, PlanStatus.ERROR, t0, f"unified-planning is not installed: {e}",
+                       total_time_s=time.perf_counter() - t0)
+    ctx = _context()
+    recv, send = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_worker, args=(send, domain_text, problem_text, name, float(timeout_s),
+                                             compile_conditional_effects), daemon=True)
+    answer: Any = None  # stays None if the child dies (or on an exception here); "late" on the guard
+    proc.start()
+    send.close()
+    try:
+        if recv.poll(timeout_s + grace_s):
+            try:
+                answer = recv.recv()
+            except EOFError:
+                answer = None
+        else:
+            answer = "late"
+    finally:
+        recv.close()
+        if not isinstance(answer, dict):
+            proc.kill()
+        proc.join(5.0)
+    total = time.perf_counter() - t0
+    if answer == "late":
+        return _result(name, PlanStatus.TIMEOUT, t0, f"no answer within {timeout_s:g} s + {grace_s:g} s grace; "
+                       "planner process killed", total_time_s=total)
+    if answer is None:
+        return _result(name, PlanStatus.ERROR, t0, f"planner process died (exit code {proc.exitcode})", total_time_s=total)
+    if "error" in answer:
+        return _result(name, PlanStatus.ERROR, t0, answer["error"], total_time_s=total)
+    inner = PlanResult.from_json(answer)
+    extra = dict(inner.extra)
+    extra["total_time_s"] = total
+    extra.setdefault("planner_time_s", 0.0)
+    return PlanResult(planner=inner.planner, status=inner.status, plan=inner.plan,
+                      predicted_states=inner.predicted_states, expansions=inner.expansions,
+                      planning_time_s=total, message=inner.message, extra=extra)

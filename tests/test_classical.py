@@ -1,0 +1,145 @@
+"""Classical planners on exported PDDL: valid plans, optimal lengths, and honest failures.
+
+Uses the ToyRobot network of test_pddl_export (3-bit codes, stick with rider, occlusion).
+Each planner test skips, with the reason, when that engine is not installed.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+from pddl_export.enumeration import enumerate_transitions
+from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl
+from pddl_export.rules import distil_rules
+from search.classical import PLANNERS, PlannerSpec, solve_pddl
+from search.result import PlanStatus
+from search.symbolic import SymbolicGoal
+from test_pddl_export import FAR, NEAR, RIDER, RIDER_M, STICK, TOY_VOCAB, UNDER, ToyRobot
+
+
+@dataclass(frozen=True)
+class TinyProblem:
+    """A named start/goal pair with its known shortest plan length under ToyRobot."""
+
+    name: str
+    init: tuple[int, ...]
+    goal: tuple[int | None, ...]
+    optimal_length: int
+
+
+STICK_CARRIES_RIDER = TinyProblem("stick-carries-rider", (NEAR, STICK, NEAR), (RIDER_M, None, None), 2)
+UNCOVER_TWICE = TinyProblem("uncover-twice", (UNDER, FAR), (NEAR, NEAR), 3)  # U,F -> U,N -> F,N -> N,N
+NEVER = TinyProblem("stick-never-rides", (STICK,), (RIDER,), -1)  # a lone stick never becomes a rider
+
+
+def _installed(planner: str) -> bool:
+    from unified_planning.shortcuts import get_environment
+
+    return PLANNERS[planner].engine in get_environment().factory.engines
+
+
+def _require(planner: str) -> None:
+    if not _installed(planner):
+        pytest.skip(f"unified-planning engine {PLANNERS[planner].engine!r} is not installed")
+
+
+@pytest.fixture(scope="module")
+def rules():
+    return distil_rules(enumerate_transitions(ToyRobot(), TOY_VOCAB, max_objects=3))
+
+
+def _conditional(rules, p: TinyProblem) -> tuple[str, str]:
+    return conditional_domain(rules, "test"), problem_pddl(rules, p.init, p.goal, "test", name=p.name)
+
+
+def _strips(rules, p: TinyProblem) -> tuple[str, str]:
+    task = strips_pddl(rules, p.init, p.goal, "test", name=p.name)
+    return task.domain, task.problem
+
+
+def _check_plan(result, p: TinyProblem) -> None:
+    """The plan reaches the goal under the NETWORK, and predicted states are the network's rollout."""
+    assert result.status is PlanStatus.SOLVED, result.message
+    net, states = ToyRobot(), [np.array(p.init)]
+    for a in result.plan:
+        states.append(net(states[-1][None], np.array([a]))[0])
+    assert SymbolicGoal(p.goal).satisfied(states[-1])[0]
+    assert result.predicted_states == tuple(tuple(int(c) for c in s) for s in states)
+    assert len(result.plan) >= p.optimal_length
+    assert result.extra["total_time_s"] >= result.extra["planner_time_s"] > 0
+
+
+@pytest.mark.parametrize("planner", ["fast-downward", "symk"])
+def test_conditional_form_satisficing(rules, planner):
+    _require(planner)
+    result = solve_pddl(*_conditional(rules, UNCOVER_TWICE), planner=planner, timeout_s=20)
+    _check_plan(result, UNCOVER_TWICE)
+    assert result.extra["compilers"] == ""  # taken as written
+
+
+def test_conditional_form_optimal_with_symk(rules):
+    _require("symk-opt")
+    result = solve_pddl(*_conditional(rules, STICK_CARRIES_RIDER), planner="symk-opt", timeout_s=20)
+    _check_plan(result, STICK_CARRIES_RIDER)
+    assert len(result.plan) == STICK_CARRIES_RIDER.optimal_length and result.extra["optimal"]
+
+
+@pytest.mark.parametrize("planner", ["fast-downward", "fast-downward-opt", "symk", "pyperplan"])
+def test_strips_form_every_planner(rules, planner):
+    _require(planner)
+    result = solve_pddl(*_strips(rules, UNCOVER_TWICE), planner=planner, timeout_s=20)
+    _check_plan(result, UNCOVER_TWICE)
+    if PLANNERS[planner].optimal:
+        assert len(result.plan) == UNCOVER_TWICE.optimal_length and result.extra["optimal"]
+    if planner.startswith("fast-downward"):
+        assert result.expansions is not None and result.expansions >= 0
+
+
+def test_conditional_form_refused_by_fd_opt_with_a_reason(rules):
+    _require("fast-downward-opt")
+    result = solve_pddl(*_conditional(rules, STICK_CARRIES_RIDER), planner="fast-downward-opt", timeout_s=20)
+    assert result.status is PlanStatus.ERROR and "STRIPS" in result.message and result.plan == ()
+
+
+@pytest.mark.parametrize("planner,form", [("fast-downward", "conditional"), ("pyperplan", "strips")])
+def test_unsolvable(rules, planner, form):
+    _require(planner)
+    texts = _conditional(rules, NEVER) if form == "conditional" else _strips(rules, NEVER)
+    result = solve_pddl(*texts, planner=planner, timeout_s=20)
+    assert result.status is PlanStatus.UNSOLVABLE and result.plan == () and result.message
+
+
+@pytest.mark.parametrize("planner", ["fast-downward", "pyperplan"])
+def test_tiny_timeout_is_reported(rules, planner):
+    _require(planner)
+    result = solve_pddl(*_strips(rules, UNCOVER_TWICE), planner=planner, timeout_s=0.001)
+    assert result.status is PlanStatus.TIMEOUT and result.plan == ()
+
+
+def test_guard_kills_a_runaway_call(rules):
+    _require("pyperplan")
+    t0 = time.perf_counter()
+    # Compiling conditional effects away blows up (2^n actions); the outer guard must stop it.
+    result = solve_pddl(*_conditional(rules, STICK_CARRIES_RIDER), planner="pyperplan", timeout_s=0.5,
+                        compile_conditional_effects=True, grace_s=0.5)
+    assert result.status is PlanStatus.TIMEOUT
+    assert time.perf_counter() - t0 < 10
+
+
+def test_unknown_and_missing_planners_are_errors(rules, monkeypatch):
+    texts = _strips(rules, UNCOVER_TWICE)
+    result = solve_pddl(*texts, planner="no-such-planner", timeout_s=5)
+    assert result.status is PlanStatus.ERROR and "unknown planner" in result.message
+    monkeypatch.setitem(PLANNERS, "ghost", PlannerSpec("ghost-engine", optimal=False, native_timeout=True))
+    result = solve_pddl(*texts, planner="ghost", timeout_s=5)
+    assert result.status is PlanStatus.ERROR and "not installed" in result.message
+
+
+def test_bad_pddl_and_bad_timeout(rules):
+    result = solve_pddl("(define (domain", "(define", planner="fast-downward", timeout_s=5)
+    assert result.status is PlanStatus.ERROR and "parse" in result.message
+    with pytest.raises(ValueError):
+        solve_pddl(*_strips(rules, UNCOVER_TWICE), planner="fast-downward", timeout_s=0)

@@ -1,0 +1,455 @@
+"""Enumeration, exact rule distillation and PDDL export, checked against hand-made networks.
+
+ToyRobot mimics what the learned network does on the tabletop with 3-bit codes: a near cube
+is placed on the far row unless a stick is there (then it lands on the stick, unless the
+stick already carries a rider), the stick moves and carries its rider, three far cubes make
+the bottom ones occluded, uncovering needs the ABSENCE of far cubes, and one action changes
+nothing. RandomEquivariant is an arbitrary permutation-equivariant function (a random table
+over (action, own code, multiset of others)) that stresses exactness.
+"""
+from __future__ import annotations
+
+import itertools
+import re
+from math import comb
+
+import numpy as np
+import pytest
+
+from pddl_export.enumeration import enumerate_transitions, multiset_indices, vocabulary_closure
+from pddl_export.pddl_writer import (
+    StateLimitError,
+    action_id_from_name,
+    action_name,
+    code_from_predicate,
+    code_predicate,
+    conditional_domain,
+    object_name,
+    pddl_name,
+    problem_pddl,
+    reachable_transitions,
+    strips_pddl,
+    write_text_atomic,
+)
+from pddl_export.rules import (
+    AmbiguousRulesError,
+    NotEquivariantError,
+    Rule,
+    RuleSet,
+    apply_rules,
+    apply_rules_batch,
+    distil_rules,
+    rule_fidelity,
+)
+from search.symbolic import N_ACTIONS
+
+NEAR, FAR, STICK, RIDER, UNDER, STICK_M, RIDER_M = 1, 2, 3, 4, 5, 6, 7
+A_PLACE, A_STACK, A_STICK, A_UNCOVER, A_BACK, A_NOOP = 3, 10, 22, 24, 27, 35
+TOY_VOCAB = (NEAR, FAR, STICK, RIDER, UNDER, STICK_M, RIDER_M)
+
+
+class ToyRobot:
+    """Hand-made permutation-equivariant transition function with 3-bit codes (see module doc)."""
+
+    bits = 3
+
+    def __call__(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        codes = np.asarray(codes, np.int64)
+        a = np.asarray(actions)[:, None]
+
+        def others(x: int) -> np.ndarray:  # (B, K) how many OTHER objects have code x
+            return (codes == x).sum(1, keepdims=True) - (codes == x)
+
+        out = codes.copy()
+        changes = [
+            ((a == A_PLACE) & (codes == NEAR) & (others(STICK) == 0), FAR),
+            ((a == A_PLACE) & (codes == NEAR) & (others(STICK) > 0) & (others(RIDER) == 0), RIDER),
+            ((a == A_STACK) & (codes == FAR) & (others(FAR) >= 2), UNDER),
+            ((a == A_STICK) & (codes == STICK), STICK_M),
+            ((a == A_STICK) & (codes == RIDER) & (others(STICK) > 0), RIDER_M),
+            ((a == A_BACK) & (codes == STICK_M), STICK),
+            ((a == A_BACK) & (codes == RIDER_M) & (others(STICK_M) > 0), RIDER),
+            ((a == A_UNCOVER) & (codes == FAR), NEAR),
+            ((a == A_UNCOVER) & (codes == UNDER) & (others(FAR) == 0), FAR),
+        ]
+        for mask, value in changes:  # masks read the pre-state `codes`: simultaneous update
+            out[mask] = value
+        return out
+
+
+class RandomEquivariant:
+    """Random outcome per (action, own code, sorted others); only `actions` ever change anything."""
+
+    def __init__(self, bits: int, vocab: tuple[int, ...], actions: tuple[int, ...], seed: int, p_change: float = 0.4):
+        self.bits, self.vocab, self.actions, self.p = bits, vocab, set(actions), p_change
+        self.rng = np.random.default_rng(seed)
+        self.table: dict = {}
+
+    def outcome(self, a: int, own: int, others: tuple[int, ...]) -> int:
+        key = (a, own, tuple(sorted(others)))
+        if key not in self.table:
+            change = a in self.actions and self.rng.random() < self.p
+            self.table[key] = int(self.rng.choice(self.vocab)) if change else own
+        return self.table[key]
+
+    def __call__(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        out = np.array(codes, np.int64)
+        for b, (row, a) in enumerate(zip(np.asarray(codes).tolist(), np.asarray(actions).tolist())):
+            for i, c in enumerate(row):
+                out[b, i] = self.outcome(a, c, tuple(row[:i] + row[i + 1:]))
+        return out
+
+
+class PositionDependent:
+    """Not equivariant: object 0 behaves differently from the others."""
+
+    bits = 2
+
+    def __call__(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        out = np.array(codes, np.int64)
+        out[:, 0] = np.where(actions == 0, 3, out[:, 0])
+        return out
+
+
+@pytest.fixture(scope="module")
+def toy():
+    enum = enumerate_transitions(ToyRobot(), TOY_VOCAB, max_objects=3)
+    return enum, distil_rules(enum)
+
+
+@pytest.fixture(scope="module")
+def random_nets():
+    """Three random equivariant functions over 2-bit codes, a few changing actions each."""
+    out = []
+    for seed in range(3):
+        net = RandomEquivariant(2, (0, 1, 2), actions=(0, 7, 35), seed=seed)
+        enum = enumerate_transitions(net, (0, 1, 2), max_objects=3)
+        out.append((net, enum, distil_rules(enum)))
+    return out
+
+
+# ----------------------------------------------------------------------------- enumeration
+
+
+@pytest.mark.parametrize("n,k", [(1, 1), (1, 3), (3, 1), (4, 2), (5, 3), (3, 4)])
+def test_multiset_indices_match_itertools(n, k):
+    want = np.array(list(itertools.combinations_with_replacement(range(n), k)))
+    assert np.array_equal(multiset_indices(n, k), want)
+
+
+def test_enumeration_counts_and_batches(toy):
+    enum, _ = toy
+    v = len(TOY_VOCAB)
+    assert [len(b.scenes) for b in enum.blocks] == [comb(v + k - 1, k) for k in (1, 2, 3)]
+    assert enum.n_queries == sum(comb(v + k - 1, k) for k in (1, 2, 3)) * N_ACTIONS
+    assert enum.n_calls == 3 and enum.queries_per_s > 0
+    small = enumerate_transitions(ToyRobot(), TOY_VOCAB, max_objects=3, batch_size=100)
+    assert small.n_calls == sum(-(-len(b.scenes) * N_ACTIONS // 100) for b in enum.blocks)
+    for b, s in zip(enum.blocks, small.blocks):
+        assert np.array_equal(b.next_codes, s.next_codes)
+    with pytest.raises(ValueError):
+        enum.blocks[0].next_codes[0, 0] = 0  # read-only arrays
+
+
+def test_enumeration_matches_slow_reference(toy):
+    enum, _ = toy
+    net = ToyRobot()
+    for b in enum.blocks:
+        scenes = list(itertools.combinations_with_replacement(TOY_VOCAB, b.n_objects))
+        assert np.array_equal(b.scenes, np.array(scenes))
+        for r, (scene, a) in enumerate(itertools.product(scenes, range(N_ACTIONS))):
+            want = net(np.array([scene]), np.array([a]))[0]
+            assert b.actions[r] == a and np.array_equal(b.next_codes[r], want)
+
+
+def test_vocabulary_closure_reaches_fixed_point():
+    closure = vocabulary_closure(ToyRobot(), [NEAR, STICK], max_objects=3)
+    assert closure.converged and closure.vocabulary == TOY_VOCAB
+    assert closure.added == ((FAR, RIDER, STICK_M), (UNDER, RIDER_M))
+    assert closure.enumeration.vocabulary == TOY_VOCAB
+    assert closure.n_queries > closure.enumeration.n_queries
+    short = vocabulary_closure(ToyRobot(), [NEAR, STICK], max_objects=3, max_iterations=1)
+    assert not short.converged and short.missing == (FAR, RIDER, STICK_M)
+
+
+def test_enumeration_refuses_bad_input():
+    with pytest.raises(ValueError):
+        enumerate_transitions(ToyRobot(), [8], max_objects=2)  # does not fit in 3 bits
+    with pytest.raises(ValueError):
+        enumerate_transitions(ToyRobot(), [], max_objects=2)
+    with pytest.raises(ValueError):
+        enumerate_transitions(ToyRobot(), [1], max_objects=0)
+
+
+# ----------------------------------------------------------------------------- rules
+
+
+def test_toy_rules_are_exact_and_general(toy):
+    enum, rs = toy
+    assert set(rs.rules) == {
+        Rule(A_PLACE, NEAR, FAR, forbids=(STICK,)),
+        Rule(A_PLACE, NEAR, RIDER, requires=(STICK,), forbids=(RIDER,)),
+        Rule(A_STACK, FAR, UNDER, at_least=((FAR, 2),)),
+        Rule(A_STICK, STICK, STICK_M),
+        Rule(A_STICK, RIDER, RIDER_M, requires=(STICK,)),
+        Rule(A_BACK, STICK_M, STICK),
+        Rule(A_BACK, RIDER_M, RIDER, requires=(STICK_M,)),
+        Rule(A_UNCOVER, FAR, NEAR),
+        Rule(A_UNCOVER, UNDER, FAR, forbids=(FAR,)),
+    }
+    assert A_NOOP not in rs.actions and rs.actions == (A_PLACE, A_STACK, A_STICK, A_UNCOVER, A_BACK)
+    assert rs.n_rules < rs.n_rules_before_generalization
+    fid = rule_fidelity(rs, enum)
+    assert fid.fraction == 1.0 and fid.n_transitions == enum.n_queries and not fid.mismatches
+    assert rule_fidelity(rs, enum, reference=True).n_exact == enum.n_queries
+
+
+def test_n_rules_before_generalization_counts_changing_cases(toy):
+    enum, rs = toy
+    cases = set()
+    for b in enum.blocks:
+        for scene, a, nxt in zip(b.states.tolist(), b.actions.tolist(), b.next_codes.tolist()):
+            for i, (c, d) in enumerate(zip(scene, nxt)):
+                if c != d:
+                    cases.add((a, c, tuple(sorted(scene[:i] + scene[i + 1:]))))
+    assert rs.n_rules_before_generalization == len(cases)
+
+
+def test_random_functions_are_reproduced_exactly(random_nets):
+    rng = np.random.default_rng(0)
+    for _, enum, rs in random_nets:
+        fid = rule_fidelity(rs, enum)
+        assert fid.fraction == 1.0 and fid.n_object_codes_exact == fid.n_object_codes
+        assert rule_fidelity(rs, enum, reference=True).fraction == 1.0
+        assert set(rs.actions) <= {0, 7, 35}
+        # batched and reference semantics agree beyond the enumerated scene sizes too
+        codes = rng.choice([0, 1, 2], size=(200, 5))
+        actions = rng.choice([0, 7, 35, 1], size=200)
+        batch = apply_rules_batch(rs, codes, actions)
+        for row, a, got in zip(codes, actions, batch):
+            assert np.array_equal(apply_rules(rs, row, int(a)), got)
+    assert any(r.at_least or r.fewer_than for _, _, rs in random_nets for r in rs.rules)
+
+
+def test_apply_rules_is_simultaneous():
+    rules = (Rule(0, 1, 2), Rule(0, 2, 1))  # swap codes 1 and 2 in one step
+    assert apply_rules(rules, np.array([1, 2, 2]), 0).tolist() == [2, 1, 1]
+    assert apply_rules(rules, np.array([1, 2]), 5).tolist() == [1, 2]
+    with pytest.raises(AmbiguousRulesError):
+        apply_rules((Rule(0, 1, 2), Rule(0, 1, 3)), np.array([1]), 0)
+
+
+def test_rule_and_ruleset_validation():
+    with pytest.raises(ValueError):
+        Rule(0, 1, 1)  # no change
+    with pytest.raises(ValueError):
+        Rule(36, 1, 2)
+    with pytest.raises(ValueError):
+        Rule(0, 1, 2, requires=(3,), forbids=(3,))
+    with pytest.raises(ValueError):
+        Rule(0, 1, 2, at_least=((3, 1),))
+    with pytest.raises(ValueError):
+        Rule(0, 1, 2, at_least=((3, 3),), fewer_than=((3, 2),))
+    ok = RuleSet(2, (1, 2, 3), 2, (Rule(0, 1, 2, forbids=(3,)), Rule(0, 1, 3, requires=(3,))), 2)
+    assert ok.n_rules == 2 and ok.codes == (1, 2, 3)
+    with pytest.raises(ValueError, match="mutually exclusive"):  # the exactness pitfall of PDDL_NOTES
+        RuleSet(2, (1, 2, 3), 2, (Rule(0, 1, 2), Rule(0, 1, 3, requires=(3,))), 2)
+    with pytest.raises(ValueError):
+        RuleSet(2, (1, 2, 3), 2, (Rule(0, 1, 4),), 1)  # code 4 does not fit in 2 bits
+    assert Rule(0, 1, 2, requires=(3,), fewer_than=((3, 2),)).matches({3: 1})
+    assert not Rule(0, 1, 2, requires=(3,), fewer_than=((3, 2),)).matches({3: 2})
+
+
+def test_non_equivariant_network_is_refused():
+    enum = enumerate_transitions(PositionDependent(), (0, 1), max_objects=2)
+    with pytest.raises(NotEquivariantError):
+        distil_rules(enum)
+
+
+# ----------------------------------------------------------------------------- PDDL text
+
+
+def _pddl_parse(domain: str, problem: str):
+    """Parse with the independent `pddl` package (its parser leaves sys.tracebacklimit at 0 on errors)."""
+    import sys
+
+    from pddl.parser.domain import DomainParser
+    from pddl.parser.problem import ProblemParser
+
+    old = getattr(sys, "tracebacklimit", None)
+    try:
+        return DomainParser()(domain), ProblemParser()(problem)
+    finally:
+        if old is None and hasattr(sys, "tracebacklimit"):
+            del sys.tracebacklimit
+
+
+def _up_parse(domain: str, problem: str):
+    from unified_planning.io import PDDLReader
+    from unified_planning.shortcuts import get_environment
+
+    get_environment().credits_stream = None
+    return PDDLReader().parse_problem_string(domain, problem)
+
+
+def test_names():
+    assert code_predicate(27, 8) == "code-00011011" and code_from_predicate("code-00011011") == 27
+    assert action_name(3 * 6 + 4) == "pick-3-release-4"
+    assert action_id_from_name("pick-3-release-4") == 22 and action_id_from_name("PICK-3-release-4-s17") == 22
+    assert object_name(2) == "o2"
+    assert pddl_name("My Model/v2.pt") == "my-model-v2-pt" and pddl_name("3d") == "x-3d"
+    for bad in ("pick-6-release-0", "move", "pick-1-release-2-x"):
+        with pytest.raises(ValueError):
+            action_id_from_name(bad)
+    with pytest.raises(ValueError):
+        pddl_name("!!!")
+
+
+def test_conditional_domain_parses_with_both_parsers(toy, tmp_path):
+    from pddl import parse_domain, parse_problem
+    from pddl.requirements import Requirements as R
+
+    _, rs = toy
+    domain = conditional_domain(rs, model_hash="sha256:abc\ndef", name="Learned Symbols")
+    problem = problem_pddl(rs, [NEAR, STICK, NEAR], [RIDER_M, None, None], model_hash="sha256:abc", name="t1",
+                           domain_name="Learned Symbols")
+    header = [ln for ln in domain.splitlines() if ln.startswith(";;")]
+    assert ";; model-hash: sha256:abc def" in header and ";; vocabulary-size: 7" in header
+    assert f";; rules: 9 (before generalization: {rs.n_rules_before_generalization})" in header
+    assert re.findall(r"\(:action (\S+)", domain) == [action_name(a) for a in rs.actions]
+    d, p = _pddl_parse(domain, problem)
+    assert d.requirements == {R.STRIPS, R.TYPING, R.CONDITIONAL_EFFECTS, R.EXISTENTIAL_PRECONDITION,
+                              R.NEG_PRECONDITION, R.EQUALITY}
+    assert {a.name for a in d.actions} == {action_name(a) for a in rs.actions} and p.name == "t1"
+    dpath = write_text_atomic(tmp_path / "domain.pddl", domain)
+    ppath = write_text_atomic(tmp_path / "problem.pddl", problem)
+    assert parse_domain(dpath).name == "learned-symbols" and len(parse_problem(ppath).objects) == 3
+    up_problem = _up_parse(domain, problem)
+    assert {a.name for a in up_problem.actions} == {action_name(a) for a in rs.actions}
+    assert len(up_problem.all_objects) == 3 and len(up_problem.goals) == 1
+
+
+def test_requirements_follow_what_is_used():
+    plain = RuleSet(2, (1, 2), 2, (Rule(0, 1, 2),), 1)
+    assert "(:requirements :strips :typing :conditional-effects)" in conditional_domain(plain, "h")
+    absent = RuleSet(2, (1, 2, 3), 2, (Rule(0, 1, 2, forbids=(3,)),), 1)
+    assert "(:requirements :strips :typing :conditional-effects :existential-preconditions " \
+           ":negative-preconditions)" in conditional_domain(absent, "h")
+    empty = RuleSet(2, (1, 2), 2, (), 0)
+    text = conditional_domain(empty, "h")
+    assert "(:requirements :strips :typing)" in text and ":action" not in text
+    _up_parse(text, problem_pddl(empty, [1], [2], "h"))
+
+
+def test_problem_writer_checks_codes(toy):
+    _, rs = toy
+    text = problem_pddl(rs, [NEAR, FAR], [None, UNDER], model_hash="h")
+    assert "(:init (code-001 o0) (code-010 o1))" in text and "(:goal (and (code-101 o1)))" in text
+    with pytest.raises(ValueError, match="vocabulary"):
+        problem_pddl(rs, [0, FAR], [None, UNDER], model_hash="h")
+    with pytest.raises(ValueError):
+        problem_pddl(rs, [NEAR, FAR], [UNDER], model_hash="h")
+    with pytest.raises(ValueError):
+        problem_pddl(rs, [NEAR], [None], model_hash="h")  # a goal must fix something
+
+
+def _simulate_conditional(domain: str, rs: RuleSet, enum) -> tuple[int, int]:
+    """Apply every PDDL action to every enumerated scene with UP's SequentialSimulator.
+
+    Returns (transitions compared, transitions where PDDL and network agree on every object).
+    Actions absent from the domain must be no-ops of the network.
+    """
+    from unified_planning.model.state import UPState
+    from unified_planning.shortcuts import SequentialSimulator
+
+    n = agree = 0
+    for b in enum.blocks:
+        k = b.n_objects
+        first = b.scenes[0].tolist()
+        prob = _up_parse(domain, problem_pddl(rs, first, [first[0]] + [None] * (k - 1), "h"))
+        em = prob.environment.expression_manager
+        objs = [prob.object(object_name(i)) for i in range(k)]
+        fluents = {c: prob.fluent(code_predicate(c, rs.bits)) for c in rs.codes}
+        acts = {a.name: a for a in prob.actions}
+        with SequentialSimulator(prob) as sim:
+            for scene, a, want in zip(b.states.tolist(), b.actions.tolist(), b.next_codes.tolist()):
+                n += 1
+                act = acts.get(action_name(a))
+                if act is None:
+                    agree += want == scene
+                    continue
+                state = UPState({fluents[c](o): em.Bool(scene[i] == c) for i, o in enumerate(objs) for c in fluents},
+                                prob)
+                nxt = sim.apply(state, act, ())
+                got = [[c for c in fluents if nxt.get_value(fluents[c](o)).bool_constant_value()] for o in objs]
+                agree += got == [[c] for c in want]
+    return n, agree
+
+
+def test_fidelity_through_the_pddl_is_exact(toy, random_nets):
+    enum, rs = toy
+    n, agree = _simulate_conditional(conditional_domain(rs, "h"), rs, enum)
+    assert n == enum.n_queries and agree == n
+    _, enum_r, rs_r = random_nets[0]
+    n, agree = _simulate_conditional(conditional_domain(rs_r, "h"), rs_r, enum_r)
+    assert n == enum_r.n_queries and agree == n
+
+
+def test_strips_form_is_strips_only_and_round_trips(toy):
+    from pddl.requirements import Requirements as R
+    from unified_planning.shortcuts import SequentialSimulator
+
+    _, rs = toy
+    init, goal = [NEAR, STICK, NEAR, UNDER], [RIDER_M, None, None, FAR]  # 4 objects: beyond enumeration
+    task = strips_pddl(rs, init, goal, model_hash="h")
+    states, edges = reachable_transitions(rs, init)
+    assert task.n_states == len(states) and task.n_actions == len(edges) > 0
+    d, p = _pddl_parse(task.domain, task.problem)
+    assert d.requirements == {R.STRIPS, R.TYPING}
+    assert "(not" not in "".join(re.findall(r":precondition (.*)", task.domain)) and "forall" not in task.domain
+    prob = _up_parse(task.domain, task.problem)
+    kind = prob.kind
+    assert not (kind.has_negative_conditions() or kind.has_conditional_effects() or kind.has_existential_conditions())
+    # Walk the reachable states through the PDDL and compare each step with the network.
+    net, objs = ToyRobot(), sorted(prob.all_objects, key=lambda o: o.name)
+    fluents = {c: prob.fluent(code_predicate(c, rs.bits)) for c in rs.codes}
+
+    def decode(state):
+        return tuple(next(c for c, f in fluents.items() if state.get_value(f(o)).bool_constant_value()) for o in objs)
+
+    with SequentialSimulator(prob) as sim:
+        frontier, seen = [sim.get_initial_state()], set()
+        while frontier:
+            state = frontier.pop()
+            codes = decode(state)
+            if codes in seen:
+                continue
+            seen.add(codes)
+            by_action = {}
+            for act in prob.actions:
+                if sim.is_applicable(state, act, ()):
+                    by_action.setdefault(action_id_from_name(act.name), []).append(act)
+            want = net(np.tile(codes, (N_ACTIONS, 1)), np.arange(N_ACTIONS))
+            for a in range(N_ACTIONS):
+                acts = by_action.get(a, [])
+                assert len(acts) <= 1  # one ground action per (state, real action)
+                if not acts:
+                    assert tuple(want[a]) == codes
+                    continue
+                nxt = sim.apply(state, acts[0], ())
+                assert decode(nxt) == tuple(want[a])
+                frontier.append(nxt)
+    assert seen == set(states)
+
+
+def test_strips_state_limit(toy):
+    _, rs = toy
+    with pytest.raises(StateLimitError):
+        strips_pddl(rs, [NEAR, STICK, NEAR, UNDER], [FAR, None, None, None], model_hash="h", max_states=2)
+
+
+def test_write_text_atomic(tmp_path):
+    path = tmp_path / "sub" / "d.pddl"
+    write_text_atomic(path, "one")
+    write_text_atomic(path, "two")
+    assert path.read_text() == "two" and sorted(p.name for p in path.parent.iterdir()) == ["d.pddl"]
