@@ -364,6 +364,9 @@ def _generalize(lo: np.ndarray, hi: np.ndarray, ys: np.ndarray, counts: np.ndarr
     return lo[alive], hi[alive], ys[alive]
 
 
+MAX_WIDEN_BOXES = 40  # larger groups keep the decision tree's (exact, disjoint) leaves unwidened
+
+
 def _group_rules(counts: np.ndarray, outcomes: np.ndarray, own: int, max_level: int) -> list[tuple[Bounds, int]]:
     """Exact, mutually exclusive changing rules (box over vocab indices, outcome) for one (a, c)."""
     if np.all(outcomes == own):
@@ -373,7 +376,10 @@ def _group_rules(counts: np.ndarray, outcomes: np.ndarray, own: int, max_level: 
     table, feats = _feature_table(counts, outcomes, max_level)
     lo, hi, ys = _tree_leaves(table, feats, outcomes, counts.shape[1])
     change = ys != own
-    lo, hi, ys = _generalize(lo[change], hi[change], ys[change], counts, outcomes)
+    if change.sum() <= MAX_WIDEN_BOXES:  # the greedy widening is quadratic in the boxes; leaves are exact too
+        lo, hi, ys = _generalize(lo[change], hi[change], ys[change], counts, outcomes)
+    else:
+        lo, hi, ys = lo[change], hi[change], ys[change]
     rules = []
     for blo, bhi, y in zip(lo, hi, ys):
         box = {int(x): (int(blo[x]), int(bhi[x])) for x in np.flatnonzero((blo > 0) | (bhi < INF))}

@@ -78,6 +78,16 @@ def summarize_rows(rows: list[ProblemRun]) -> dict:
              "mean_plan_length": round(statistics.mean(r.plan_length for r in found), 3) if found else None,
              "mean_generator_length": round(statistics.mean(r.generator_length for r in found), 3) if found else None,
              "failure_stages": stages}
+        for key in ("planner_time_s", "pddl_write_time_s"):
+            vals = [r.timings[key] for r in base if key in r.timings]
+            if vals:
+                s[f"median_{key}"] = round(statistics.median(vals), 5)
+        s["median_time_s_by_objects"] = {
+            str(k): round(statistics.median(r.planning_time_s for r in base if r.n_objects == k), 5)
+            for k in sorted({r.n_objects for r in base})}
+        s["success_rate_by_objects"] = {
+            str(k): _rate([r for r in open_rows if r.n_objects == k], "success")
+            for k in sorted({r.n_objects for r in open_rows})}
         if closed:
             s["success_rate_closed_loop"] = _rate(closed, "success")
             s["mean_replans_closed_loop"] = round(statistics.mean(r.replans for r in closed), 3)

@@ -127,6 +127,25 @@ def cmd_symbols(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_export_pddl(args: argparse.Namespace) -> int:
+    from symlearn.export_pddl import ExportConfig, export_pddl
+
+    cfg = ExportConfig(max_objects=args.max_objects, min_count=args.min_count, closure=args.closure,
+                       pddl_fidelity_cases=args.pddl_fidelity_cases, seed=args.seed)
+    out = Path(args.out) if args.out else None
+    rep = export_pddl(Path(args.run), Path(args.data), cfg, out)
+    where = out or Path(args.run) / "pddl"
+    print(f"vocabulary {rep['vocabulary_size']} codes; {rep['n_enumerated_cases']} enumerated cases at "
+          f"{rep['enumeration_queries_per_s']:.0f} queries/s; rules {rep['n_rules_before_generalization']} -> "
+          f"{rep['n_rules']} after generalization over {rep['n_actions_with_rules']} actions")
+    print(f"fidelity (rules, every case) {rep['fidelity']:.4f}; through the PDDL "
+          f"({rep['pddl_fidelity_cases']} sampled cases) {rep['pddl_fidelity']}")
+    for d in rep["disagreements"][:5]:
+        print(f"  disagreement: {d}")
+    print(f"wrote {where / 'domain.pddl'}, rules.json, report.json")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="symlearn", description="Learn planning symbols from robot interaction.")
     sub = p.add_subparsers(dest="command", required=True)
@@ -182,6 +201,18 @@ def build_parser() -> argparse.ArgumentParser:
     sy.add_argument("--symbol", help="bit string of the symbol to show examples of")
     sy.add_argument("--min-count", type=int, default=100, help="a symbol is frequent from this many objects")
     sy.set_defaults(func=cmd_symbols)
+
+    x = sub.add_parser("export-pddl", help="distil the transition network into rules and a PDDL domain")
+    x.add_argument("--run", required=True)
+    x.add_argument("--data", required=True, help="the data set whose training codes form the vocabulary")
+    x.add_argument("--out", help="output directory (default RUN/pddl)")
+    x.add_argument("--max-objects", type=int, default=3, help="largest enumerated scene")
+    x.add_argument("--min-count", type=int, default=1, help="training objects a code needs to enter the vocabulary")
+    x.add_argument("--closure", action="store_true", help="add codes the network produces (to a fixed point)")
+    x.add_argument("--pddl-fidelity-cases", type=int, default=500,
+                   help="cases simulated through the PDDL (-1: every enumerated case)")
+    x.add_argument("--seed", type=int, default=0)
+    x.set_defaults(func=cmd_export_pddl)
 
     from symlearn.cli_planning import add_planning_commands
 

@@ -70,13 +70,18 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from symlearn.simulator import TabletopSimulator
     from symlearn.transition import LearnedTransition
 
-    fn = get_planner(args.planner)
+    from symlearn.pddl_planners import register_pddl_planners
+
     problem = load_problem(Path(args.problem))
+    register_pddl_planners(Path(args.run), [args.planner], write_dir=Path(args.run) / "pddl" / "problems" / problem.name)
+    fn = get_planner(args.planner)
     encoder, _ = load_effect_model(Path(args.run))
     transition = LearnedTransition.from_run(Path(args.run))
     cfg = ExecutionConfig(closed_loop=args.closed_loop, max_replans=args.max_replans, timeout_s=args.timeout)
     with TabletopSimulator() as sim:
         row = run_problem(sim, encoder, transition, problem, args.planner, fn, cfg)
+    if (Path(args.run) / "pddl" / "problems" / problem.name).exists():
+        print(f"wrote {Path(args.run) / 'pddl' / 'problems' / problem.name / 'problem.pddl'}")
     print(f"{problem.name} [{args.planner}{', closed loop' if row.closed_loop else ''}]: found {row.found} "
           f"({row.status}), length {row.plan_length} (generator {row.generator_length}), "
           f"time {row.planning_time_s:.3f} s, expansions {row.expansions}, success {row.success}, "
@@ -87,7 +92,9 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 def cmd_benchmark(args: argparse.Namespace) -> int:
     from symlearn.benchmark import benchmark, format_table, get_planner
+    from symlearn.pddl_planners import register_pddl_planners
 
+    register_pddl_planners(Path(args.run), args.planners)
     for name in args.planners:
         get_planner(name)
     res = benchmark(Path(args.run), Path(args.problems), args.planners, Path(args.out), closed_loop=args.closed_loop,

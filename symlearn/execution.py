@@ -15,7 +15,7 @@ observed codes, at most `max_replans` times.
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from typing import Callable
 
 import numpy as np
@@ -27,7 +27,7 @@ from symlearn.transition import encode_observation
 from symlearn.world import decode_action
 
 PlannerFn = Callable[[TransitionFn, np.ndarray, SymbolicGoal, float], PlanResult]
-FAILURE_STAGES = (None, "no_plan", "timeout", "execution", "goal_mismatch")
+FAILURE_STAGES = (None, "no_plan", "timeout", "execution", "goal_mismatch", "rules_vs_net")
 
 
 @dataclass(frozen=True)
@@ -122,9 +122,11 @@ class ProblemRun:
     max_distance_m: float | None  # None when nothing was executed
     closed_loop: bool
     replans: int
-    failure_stage: str | None  # None, "no_plan", "timeout", "execution" or "goal_mismatch"
+    failure_stage: str | None  # one of FAILURE_STAGES
     generator_length: int
     message: str = ""
+    n_objects: int = 0
+    timings: dict = field(default_factory=dict)  # planner-specific, e.g. pddl_write_time_s, planner_time_s
 
     def __post_init__(self) -> None:
         if self.failure_stage not in FAILURE_STAGES:
@@ -142,6 +144,8 @@ def failure_stage(plan: PlanResult, ex: ExecutionResult | None) -> str | None:
         return "timeout" if plan.status is PlanStatus.TIMEOUT else "no_plan"
     if ex is None or ex.success:
         return None
+    if plan.extra.get("rules_vs_net"):  # the network would not have predicted the PDDL plan's states
+        return "rules_vs_net"
     return "goal_mismatch" if ex.on_prediction else "execution"
 
 
@@ -176,4 +180,5 @@ def run_problem(sim, encoder, transition: TransitionFn, problem: Problem, planne
         expansions=plan.expansions, success=bool(ex and ex.success), symbolic_match=bool(ex and ex.symbolic_match),
         max_distance_m=None if ex is None else round(ex.max_distance_m, 5), closed_loop=config.closed_loop,
         replans=0 if ex is None else ex.replans, failure_stage=failure_stage(plan, ex),
-        generator_length=problem.generator_length, message=plan.message)
+        generator_length=problem.generator_length, message=plan.message, n_objects=problem.k,
+        timings={k: v for k, v in plan.extra.items() if k.endswith("_s")})

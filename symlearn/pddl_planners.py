@@ -1,0 +1,95 @@
+"""Classical planners on the exported PDDL, as entries of the benchmark's planner registry.
+
+Each planner writes the problem for the start and goal codes (and, for STRIPS-only planners,
+the grounded STRIPS form of the domain for this problem), calls the planner through
+unified-planning (search.classical), and checks the plan against the network: if rolling the
+transition network along the plan gives other states than the PDDL predicted, the result is
+marked `rules_vs_net`. PDDL writing time and the planner's own time are reported separately.
+
+    >>> register_pddl_planners(Path("runs/paper"))  # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import dataclasses
+import time
+from pathlib import Path
+
+import numpy as np
+
+from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl, write_text_atomic
+from pddl_export.rules import RuleSet
+from search.classical import solve_pddl
+from search.result import PlanResult, PlanStatus
+from search.symbolic import SymbolicGoal, TransitionFn
+from symlearn.benchmark import PLANNERS, register_planner
+from symlearn.export_pddl import load_rules
+
+# registry name -> (unified-planning engine name in search.classical, PDDL form)
+PDDL_PLANNERS = {
+    "fast-downward": ("fast-downward", "conditional"),
+    "symk": ("symk", "conditional"),
+    "pyperplan": ("pyperplan", "strips"),
+    "fast-downward-opt": ("fast-downward-opt", "strips"),
+}
+
+
+def network_agrees(transition: TransitionFn, plan: PlanResult) -> bool:
+    """Whether the network, run along the plan, predicts the same states as the planner did."""
+    if not plan.predicted_states:
+        return True
+    state = np.asarray(plan.predicted_states[0], np.int64)
+    for a, want in zip(plan.plan, plan.predicted_states[1:]):
+        state = transition(state[None], np.array([a]))[0]
+        if tuple(int(c) for c in state) != tuple(want):
+            return False
+    return True
+
+
+def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Path | None = None):
+    """A benchmark planner function for registry name `name` over the exported rules.
+
+    With `write_dir`, every problem it writes is also saved there (problem.pddl, then
+    problem_2.pddl for a replan, ...; STRIPS planners save their grounded domain beside it).
+    """
+    engine, form = PDDL_PLANNERS[name]
+    domain = conditional_domain(rules, model_hash) if form == "conditional" else None
+    calls = [0]
+
+    def plan(transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
+        t0 = time.perf_counter()
+        init = [int(c) for c in start]
+        try:
+            if form == "strips":
+                task = strips_pddl(rules, init, goal, model_hash)
+                dom, prob = task.domain, task.problem
+            else:
+                dom, prob = domain, problem_pddl(rules, init, goal, model_hash)
+        except (ValueError, RuntimeError) as e:  # codes outside the vocabulary, too many states
+            return PlanResult(planner=name, status=PlanStatus.ERROR, plan=(), predicted_states=(), expansions=None,
+                              planning_time_s=time.perf_counter() - t0, message=" ".join(str(e).split())[:300])
+        if write_dir is not None:
+            calls[0] += 1
+            suffix = "" if calls[0] == 1 else f"_{calls[0]}"
+            Path(write_dir).mkdir(parents=True, exist_ok=True)
+            write_text_atomic(Path(write_dir) / f"problem{suffix}.pddl", prob)
+            if form == "strips":
+                write_text_atomic(Path(write_dir) / f"domain_strips{suffix}.pddl", dom)
+        write_s = time.perf_counter() - t0
+        res = solve_pddl(dom, prob, engine, max(timeout_s - write_s, 0.001))
+        extra = dict(res.extra, pddl_write_time_s=round(write_s, 5))
+        if res.found:
+            extra["rules_vs_net"] = not network_agrees(transition, res)
+        return dataclasses.replace(res, planner=name, planning_time_s=write_s + res.planning_time_s, extra=extra)
+
+    return plan
+
+
+def register_pddl_planners(run_dir: Path, names: list[str] | None = None, write_dir: Path | None = None) -> list[str]:
+    """Register the PDDL planners over RUN/pddl/rules.json (replacing earlier registrations)."""
+    names = list(PDDL_PLANNERS) if names is None else [n for n in names if n in PDDL_PLANNERS]
+    if not names:
+        return []
+    rules, model_hash = load_rules(Path(run_dir))
+    for n in names:
+        register_planner(n, make_pddl_planner(rules, model_hash, n, write_dir), replace=n in PLANNERS)
+    return names
