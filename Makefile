@@ -20,9 +20,19 @@ $(VENV)/.installed: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q -e '.[dev]'
 	touch $@
 
+# The whole pipeline at the quick preset on a small data set (a few minutes on 2 cores).
 demo: $(VENV)/.installed
 	$(BIN)/symlearn scenarios
-	$(BIN)/symlearn collect --out data/demo --n 240 --workers 2 --seed 0
+	$(BIN)/symlearn collect --out data/demo --n 600 --workers 2 --seed 0 --quiet
+	$(BIN)/symlearn train --data data/demo --out runs/demo --preset quick --epochs 10 --quiet
+	$(BIN)/symlearn evaluate --run runs/demo --data data/demo
+	$(BIN)/symlearn table1 --run runs/demo
+	$(BIN)/symlearn symbols --run runs/demo --data data/demo --min-count 20
+	$(BIN)/symlearn train-transition --run runs/demo --data data/demo --preset quick --epochs 10 --quiet
+	$(BIN)/symlearn export-pddl --run runs/demo --data data/demo --max-objects 2 --min-count 5 --pddl-fidelity-cases 100
+	$(BIN)/symlearn problems --out problems/demo --n 5 --objects 1-3 --length 1-2 --seed 0
+	$(BIN)/symlearn benchmark --run runs/demo --problems problems/demo --planners astar,fast-downward,pyperplan \
+		--out runs/demo/benchmark.json --quiet
 
 test: $(VENV)/.installed
 	$(BIN)/python -m pytest -q
@@ -34,4 +44,4 @@ bench: $(VENV)/.installed
 	$(BIN)/python bench/collect.py --out bench/results/collect.json
 
 clean:
-	rm -rf $(VENV) data/demo .pytest_cache
+	rm -rf $(VENV) data/demo runs/demo problems/demo .pytest_cache

@@ -28,15 +28,17 @@ def test_padding_does_not_change_real_objects(attention):
 
 
 def test_attention_lets_objects_influence_each_other():
-    model = AttentiveDeepSym(CFG).eval()
-    x, mask, a = _batch()
-    out1 = model(x, mask, a)
-    x2 = x.clone()
-    x2[3, 2] = torch.rand_like(x2[3, 2])  # change another object of scene 3
-    out2 = model(x2, mask, a)
-    assert not torch.allclose(out1.effect[3, 0], out2.effect[3, 0])
+    """Another object's code changes an object's predicted effect only when attention is on."""
+    torch.manual_seed(0)
+    mask = torch.ones(1, 3, dtype=torch.bool)
+    codes = torch.tensor([[[0, 1, 0, 1, 1, 0, 0, 1], [1, 1, 0, 0, 1, 0, 1, 0], [0, 0, 0, 0, 0, 0, 0, 0]]]).float()
+    other = codes.clone()
+    other[0, 1] = 1 - other[0, 1]  # flip every bit of object 1
+    a = torch.tensor([7])
+    att = AttentiveDeepSym(CFG).eval()
+    assert not torch.allclose(att.decode(codes, mask, a)[0, 0], att.decode(other, mask, a)[0, 0])
     base = AttentiveDeepSym(ModelConfig.preset("quick", attention=False)).eval()
-    torch.testing.assert_close(base(x, mask, a).effect[3, 0], base(x2, mask, a).effect[3, 0])
+    torch.testing.assert_close(base.decode(codes, mask, a)[0, 0], base.decode(other, mask, a)[0, 0])
 
 
 def test_masked_mse_ignores_padding():
