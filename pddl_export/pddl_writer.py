@@ -346,6 +346,7 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
             f.write(text)
             f.flush()
             os.fsync(f.fileno())
+        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a written domain is meant to be read by others
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):

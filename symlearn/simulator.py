@@ -71,8 +71,9 @@ class SimConfig:
     # rider drops and it tips at smaller sideways accelerations. With 1.5 and 3.0, a tower of two
     # cubes on a stick's end (table1_case3) rides along intact.
     accel_free: float = 20.0  # m/s^2, tool without a load
-    accel_loaded: float = 1.5  # m/s^2, horizontal moves holding an object
-    accel_loaded_vertical: float = 3.0  # m/s^2, lifting or lowering an object
+    accel_loaded: float = 1.5  # m/s^2, horizontal moves holding a stick (riders may sit on it)
+    accel_loaded_vertical: float = 3.0  # m/s^2, lifting or lowering a stick
+    accel_cube: float = 6.0  # m/s^2, any move holding a cube: only the topmost object is taken, so none rides on it
     min_segment_s: float = 0.08
     pause_s: float = 0.05  # hold still before releasing, so the object does not swing off
     settle_max_s: float = 1.0  # extra settling, stopped early once everything is still
@@ -280,6 +281,8 @@ class TabletopSimulator:
         self._move((px, py, hit_z + 0.004), free)
         grasped = self._grasp(hit) if hit in self.body_ids else -1
         if grasped >= 0:
+            if self.types[grasped] == ObjectType.CUBE:
+                loaded = vertical = cfg.accel_cube
             lo, _ = pb.getAABB(self.body_ids[grasped], physicsClientId=self.cid)
             travel = min(above + (self._tool_pos()[2] - lo[2]), TABLE_TOP_Z + cfg.max_travel_z)
             self._move((px, py, travel), vertical)
