@@ -79,6 +79,8 @@ def cmd_train(args: argparse.Namespace) -> int:
                                    max_train_samples=args.max_train_samples).items() if v is not None}
     if args.no_attention:
         over["attention"] = False
+    if args.constant_lr:
+        over["cosine_lr"] = False
     cfg = TrainConfig.preset(args.preset, bf16=not args.no_bf16, compile=args.compile, **over)
     if args.threads:
         import torch
@@ -177,6 +179,7 @@ def build_parser() -> argparse.ArgumentParser:
     t.add_argument("--seed", type=int)
     t.add_argument("--max-train-samples", type=int, help="train on the first N samples only")
     t.add_argument("--no-attention", action="store_true", help="the DeepSym baseline without attention")
+    t.add_argument("--constant-lr", action="store_true", help="no cosine decay of the learning rate")
     t.add_argument("--no-bf16", action="store_true", help="plain float32 (bf16 autocast is the default)")
     t.add_argument("--compile", action="store_true", help="torch.compile the model")
     t.add_argument("--no-resume", action="store_true", help="start over even if RUN/last.pt exists")
