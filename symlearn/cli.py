@@ -11,16 +11,7 @@ import sys
 import time
 from pathlib import Path
 
-
-def _objects_range(text: str) -> tuple[int, int]:
-    try:
-        lo, _, hi = text.partition("-")
-        lo_i, hi_i = int(lo), int(hi or lo)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"object range {text!r} must look like 1-3 or 4") from None
-    if lo_i > hi_i:
-        raise argparse.ArgumentTypeError(f"object range {text!r} is empty")
-    return lo_i, hi_i
+from symlearn.cli_planning import _int_range
 
 
 def cmd_collect(args: argparse.Namespace) -> int:
@@ -157,7 +148,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--n", type=int, default=12000, help="number of samples (actions)")
     c.add_argument("--workers", type=int, default=1, help="worker processes")
     c.add_argument("--seed", type=int, default=0)
-    c.add_argument("--objects", type=_objects_range, default=None,
+    c.add_argument("--objects", type=_int_range, default=None,
                    help="objects per scene, e.g. 4-5 (default: the paper's mix of 1-3)")
     c.add_argument("--shard-size", type=int, default=250, help="samples per shard")
     c.add_argument("--quiet", action="store_true", help="no progress bar")

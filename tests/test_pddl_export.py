@@ -353,46 +353,26 @@ def test_problem_writer_checks_codes(toy):
         problem_pddl(rs, [NEAR], [None], model_hash="h")  # a goal must fix something
 
 
-def _simulate_conditional(domain: str, rs: RuleSet, enum) -> tuple[int, int]:
-    """Apply every PDDL action to every enumerated scene with UP's SequentialSimulator.
-
-    Returns (transitions compared, transitions where PDDL and network agree on every object).
-    Actions absent from the domain must be no-ops of the network.
-    """
-    from unified_planning.model.state import UPState
-    from unified_planning.shortcuts import SequentialSimulator
-
-    n = agree = 0
-    for b in enum.blocks:
-        k = b.n_objects
-        first = b.scenes[0].tolist()
-        prob = _up_parse(domain, problem_pddl(rs, first, [first[0]] + [None] * (k - 1), "h"))
-        em = prob.environment.expression_manager
-        objs = [prob.object(object_name(i)) for i in range(k)]
-        fluents = {c: prob.fluent(code_predicate(c, rs.bits)) for c in rs.codes}
-        acts = {a.name: a for a in prob.actions}
-        with SequentialSimulator(prob) as sim:
-            for scene, a, want in zip(b.states.tolist(), b.actions.tolist(), b.next_codes.tolist()):
-                n += 1
-                act = acts.get(action_name(a))
-                if act is None:
-                    agree += want == scene
-                    continue
-                state = UPState({fluents[c](o): em.Bool(scene[i] == c) for i, o in enumerate(objs) for c in fluents},
-                                prob)
-                nxt = sim.apply(state, act, ())
-                got = [[c for c in fluents if nxt.get_value(fluents[c](o)).bool_constant_value()] for o in objs]
-                agree += got == [[c] for c in want]
-    return n, agree
-
-
 def test_fidelity_through_the_pddl_is_exact(toy, random_nets):
+    from pddl_export.fidelity import pddl_fidelity
+
     enum, rs = toy
-    n, agree = _simulate_conditional(conditional_domain(rs, "h"), rs, enum)
-    assert n == enum.n_queries and agree == n
+    fid = pddl_fidelity(conditional_domain(rs, "h"), rs, enum)
+    assert fid.n_cases == enum.n_queries and fid.n_agree == fid.n_cases and not fid.disagreements
     _, enum_r, rs_r = random_nets[0]
-    n, agree = _simulate_conditional(conditional_domain(rs_r, "h"), rs_r, enum_r)
-    assert n == enum_r.n_queries and agree == n
+    fid = pddl_fidelity(conditional_domain(rs_r, "h"), rs_r, enum_r)
+    assert fid.n_cases == enum_r.n_queries and fid.fraction == 1.0
+
+
+def test_pddl_fidelity_catches_a_wrong_domain_and_samples(toy):
+    from pddl_export.fidelity import pddl_fidelity
+
+    enum, rs = toy
+    broken = RuleSet(rs.bits, rs.vocabulary, rs.max_objects, rs.rules[1:], rs.n_rules_before_generalization)
+    fid = pddl_fidelity(conditional_domain(broken, "h"), rs, enum)
+    assert fid.fraction < 1.0 and fid.disagreements
+    sample = pddl_fidelity(conditional_domain(rs, "h"), rs, enum, max_cases=50, seed=1)
+    assert sample.n_cases == 50 and sample.n_enumerated == enum.n_queries and sample.fraction == 1.0
 
 
 def test_strips_form_is_strips_only_and_round_trips(toy):
