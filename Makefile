@@ -20,18 +20,20 @@ $(VENV)/.installed: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q -e '.[dev]'
 	touch $@
 
-# The whole pipeline at the quick preset on a small data set (a few minutes on 2 cores).
+# The whole pipeline at the quick preset on a small data set (about 10 minutes on 2 cores).
+# Classical planners run in `make test` (tests/test_pddl_pipeline.py) and examples/: the domain distilled
+# from a learned network is large (docs/BENCHMARKS.md), so the demo benchmarks the learned-net A*.
 demo: $(VENV)/.installed
 	$(BIN)/symlearn scenarios
-	$(BIN)/symlearn collect --out data/demo --n 600 --workers 2 --seed 0 --quiet
-	$(BIN)/symlearn train --data data/demo --out runs/demo --preset quick --epochs 10 --quiet
+	$(BIN)/symlearn collect --out data/demo --n 3000 --workers 2 --seed 0 --quiet
+	$(BIN)/symlearn train --data data/demo --out runs/demo --preset quick --epochs 30 --quiet
 	$(BIN)/symlearn evaluate --run runs/demo --data data/demo
 	$(BIN)/symlearn table1 --run runs/demo
 	$(BIN)/symlearn symbols --run runs/demo --data data/demo --min-count 20
-	$(BIN)/symlearn train-transition --run runs/demo --data data/demo --preset quick --epochs 10 --quiet
-	$(BIN)/symlearn export-pddl --run runs/demo --data data/demo --max-objects 2 --min-count 5 --pddl-fidelity-cases 100
-	$(BIN)/symlearn problems --out problems/demo --n 5 --objects 1-3 --length 1-2 --seed 0
-	$(BIN)/symlearn benchmark --run runs/demo --problems problems/demo --planners astar,fast-downward,pyperplan \
+	$(BIN)/symlearn train-transition --run runs/demo --data data/demo --preset quick --epochs 20 --quiet
+	$(BIN)/symlearn export-pddl --run runs/demo --data data/demo --max-objects 2 --min-count 5 --pddl-fidelity-cases 0
+	$(BIN)/symlearn problems --out problems/demo --n 10 --objects 1-3 --length 1-2 --seed 0
+	$(BIN)/symlearn benchmark --run runs/demo --problems problems/demo --planners astar,astar-ucs --closed-loop \
 		--out runs/demo/benchmark.json --quiet
 
 test: $(VENV)/.installed

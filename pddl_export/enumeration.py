@@ -95,6 +95,7 @@ class Enumeration:
     blocks: tuple[SceneBlock, ...]  # one per scene size 1..max_objects
     n_calls: int  # calls made to the transition function
     seconds: float  # wall clock spent inside those calls
+    complete: bool = True  # every multiset of each size; False: a chosen set of scenes (e.g. observed ones)
 
     def __post_init__(self) -> None:
         vocab = tuple(int(c) for c in self.vocabulary)
@@ -106,6 +107,10 @@ class Enumeration:
         if [b.n_objects for b in self.blocks] != list(range(1, self.max_objects + 1)):
             raise ValueError("need exactly one block per scene size 1..max_objects")
         for b in self.blocks:
+            if not self.complete:
+                if len(b.scenes) and not np.isin(b.scenes, vocab).all():
+                    raise ValueError(f"{b.n_objects}-object block has codes outside the vocabulary")
+                continue
             want = comb(len(vocab) + b.n_objects - 1, b.n_objects)
             if len(b.scenes) != want:
                 raise ValueError(f"{b.n_objects}-object block has {len(b.scenes)} scenes, want {want}")
@@ -153,9 +158,36 @@ def enumerate_transitions(
     if batch_size < 1:
         raise ValueError(f"batch_size must be >= 1, got {batch_size}")
     vocab_arr = np.array(vocab, np.int64)
+    scenes = [vocab_arr[multiset_indices(len(vocab), k)] for k in range(1, max_objects + 1)]
+    return _query(transition, bits, vocab, scenes, batch_size, complete=True)
+
+
+def enumerate_scenes(transition: TransitionFn, vocabulary: Sequence[int], scenes: Sequence[Sequence[int]],
+                     max_objects: int = 3, batch_size: int = 65536) -> Enumeration:
+    """Ask `transition` for the given scenes only (as sorted multisets, duplicates dropped) times all 36 actions.
+
+    For scenes that can occur (for instance those observed in the training data) rather than every
+    multiset of codes: the network's answers on impossible scenes then constrain nothing.
+    """
+    bits = int(transition.bits)
+    vocab = _checked_vocabulary(vocabulary, bits)
+    by_size: list[set] = [set() for _ in range(max_objects)]
+    for sc in scenes:
+        sc = tuple(sorted(int(c) for c in sc))
+        if not 1 <= len(sc) <= max_objects:
+            raise ValueError(f"scene {sc} has {len(sc)} objects, expected 1..{max_objects}")
+        by_size[len(sc) - 1].add(sc)
+    arrays = [np.array(sorted(s), np.int64).reshape(-1, k) for k, s in enumerate(by_size, 1)]
+    return _query(transition, bits, vocab, arrays, batch_size, complete=False)
+
+
+def _query(transition: TransitionFn, bits: int, vocab: tuple[int, ...], scene_arrays: list[np.ndarray],
+           batch_size: int, complete: bool) -> Enumeration:
+    """Every scene of every size times the 36 actions, in batched calls of at most batch_size rows."""
+    if batch_size < 1:
+        raise ValueError(f"batch_size must be >= 1, got {batch_size}")
     blocks, n_calls, seconds = [], 0, 0.0
-    for k in range(1, max_objects + 1):
-        scenes = vocab_arr[multiset_indices(len(vocab), k)]  # (S, k)
+    for k, scenes in enumerate(scene_arrays, 1):
         n_rows = len(scenes) * N_ACTIONS
         actions = np.tile(np.arange(N_ACTIONS, dtype=np.int64), len(scenes))  # (S*36,)
         next_codes = np.empty((n_rows, k), np.int64)
@@ -173,7 +205,7 @@ def enumerate_transitions(
                 raise ValueError(f"transition returned codes outside 0..{(1 << bits) - 1}")
             next_codes[start:stop] = out
         blocks.append(SceneBlock(k, scenes, actions, next_codes))
-    return Enumeration(bits, vocab, max_objects, tuple(blocks), n_calls, seconds)
+    return Enumeration(bits, vocab, len(scene_arrays), tuple(blocks), n_calls, seconds, complete)
 
 
 @dataclass(frozen=True, eq=False)

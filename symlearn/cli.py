@@ -124,7 +124,7 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
     from symlearn.export_pddl import ExportConfig, export_pddl
 
     cfg = ExportConfig(max_objects=args.max_objects, min_count=args.min_count, closure=args.closure,
-                       pddl_fidelity_cases=args.pddl_fidelity_cases, seed=args.seed)
+                       pddl_fidelity_cases=args.pddl_fidelity_cases, scenes=args.scenes, seed=args.seed)
     out = Path(args.out) if args.out else None
     rep = export_pddl(Path(args.run), Path(args.data), cfg, out)
     where = out or Path(args.run) / "pddl"
@@ -202,7 +202,9 @@ def build_parser() -> argparse.ArgumentParser:
     x.add_argument("--out", help="output directory (default RUN/pddl)")
     x.add_argument("--max-objects", type=int, default=3, help="largest enumerated scene")
     x.add_argument("--min-count", type=int, default=1, help="training objects a code needs to enter the vocabulary")
-    x.add_argument("--closure", action="store_true", help="add codes the network produces (to a fixed point)")
+    x.add_argument("--scenes", default="observed", choices=["observed", "all"],
+                   help="enumerate the code multisets of training scenes (default) or every multiset")
+    x.add_argument("--closure", action="store_true", help="with --scenes all: add codes the network produces")
     x.add_argument("--pddl-fidelity-cases", type=int, default=500,
                    help="cases simulated through the PDDL (-1: every enumerated case)")
     x.add_argument("--seed", type=int, default=0)

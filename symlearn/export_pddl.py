@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pddl_export.enumeration import enumerate_transitions, vocabulary_closure
+from pddl_export.enumeration import enumerate_scenes, enumerate_transitions, vocabulary_closure
 from pddl_export.fidelity import pddl_fidelity
 from pddl_export.pddl_writer import conditional_domain, write_text_atomic
 from pddl_export.rules import Rule, RuleSet, distil_rules, rule_fidelity
@@ -38,32 +38,58 @@ class ExportConfig:
     min_count: int = 1  # a code enters the vocabulary once this many training objects have it
     closure: bool = False  # also add codes the network produces from enumerated scenes
     pddl_fidelity_cases: int = 500  # sampled cases simulated through the PDDL (0: none; -1: all)
+    # "observed": the code multisets of training scenes (and their sub-multisets); "all": every multiset
+    # of vocabulary codes. A learned network answers impossible scenes (three objects on one spot)
+    # arbitrarily, and exact rules for those answers swell the domain (316k rules for 60 codes, K = 3).
+    scenes: str = "observed"
     seed: int = 0
 
     def __post_init__(self) -> None:
         if not 1 <= self.max_objects <= 5:
             raise ValueError(f"max_objects={self.max_objects} must lie in 1..5")
+        if self.scenes not in ("observed", "all"):
+            raise ValueError(f"scenes={self.scenes!r}: expected observed or all")
 
 
 def file_sha256(path: Path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-def training_vocabulary(run_dir: Path, data_dir: Path) -> dict[int, int]:
-    """Code -> number of training objects (pre- and post-states) the encoder gives it."""
+def training_codes(run_dir: Path, data_dir: Path) -> tuple[np.ndarray, np.ndarray]:
+    """The encoder's integer codes of every training sample's objects before and after: two (N, K), -1 padding."""
+    from search.symbolic import codes_from_bits
     from symlearn.checkpoint import load_effect_model
     from symlearn.dataset import load_split
-    from search.symbolic import codes_from_bits
     from symlearn.transition import encode_crops
 
     model, _ = load_effect_model(run_dir)
     data = load_split(data_dir, "train")
-    counts: dict[int, int] = {}
+    out = []
     for depth, origin in ((data.pre_depth, data.pre_origin), (data.post_depth, data.post_origin)):
-        codes = codes_from_bits(encode_crops(model, depth, origin, data.mask).round())[data.mask]
-        for c, n in zip(*np.unique(codes, return_counts=True)):
-            counts[int(c)] = counts.get(int(c), 0) + int(n)
-    return dict(sorted(counts.items(), key=lambda kv: -kv[1]))
+        codes = codes_from_bits(encode_crops(model, depth, origin, data.mask).round())
+        out.append(np.where(data.mask, codes, -1))
+    return out[0], out[1]
+
+
+def code_counts(*code_arrays: np.ndarray) -> dict[int, int]:
+    """Code -> number of object occurrences, most frequent first (padding -1 ignored)."""
+    flat = np.concatenate([c[c >= 0] for c in code_arrays])
+    uniq, n = np.unique(flat, return_counts=True)
+    return {int(c): int(k) for c, k in sorted(zip(uniq, n), key=lambda t: -t[1])}
+
+
+def observed_scenes(vocab: set[int], max_objects: int, *code_arrays: np.ndarray) -> list[tuple[int, ...]]:
+    """Distinct code multisets of observed scenes whose codes all lie in the vocabulary, and their sub-multisets."""
+    from itertools import combinations
+
+    out: set[tuple[int, ...]] = set()
+    for arr in code_arrays:
+        for row in np.unique(np.sort(arr, axis=1), axis=0):
+            sc = tuple(int(c) for c in row if c >= 0)
+            if sc and len(sc) <= max_objects and set(sc) <= vocab:
+                for k in range(1, len(sc) + 1):
+                    out.update(combinations(sc, k))
+    return sorted(out)
 
 
 def rules_to_json(rules: RuleSet) -> dict:
@@ -108,11 +134,15 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     transition = LearnedTransition.from_run(run_dir)
     model_hash = file_sha256(run_dir / TRANSITION_FILE)[:16]
     t0 = time.perf_counter()
-    counts = training_vocabulary(run_dir, data_dir)
+    pre, post = training_codes(run_dir, data_dir)
+    counts = code_counts(pre, post)
     vocab = sorted(c for c, n in counts.items() if n >= cfg.min_count)
     t_vocab = time.perf_counter() - t0
     added: list[int] = []
-    if cfg.closure:
+    if cfg.scenes == "observed":
+        enum = enumerate_scenes(transition, vocab, observed_scenes(set(vocab), cfg.max_objects, pre, post),
+                                cfg.max_objects)
+    elif cfg.closure:
         clo = vocabulary_closure(transition, vocab, cfg.max_objects)
         enum, added = clo.enumeration, list(clo.added)
     else:
@@ -132,6 +162,7 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     produced = set(int(c) for c in enum.produced_codes())
     report = {
         "run": str(run_dir), "model_hash": model_hash, "config": dataclasses.asdict(cfg),
+        "scenes": cfg.scenes, "n_enumerated_scenes": enum.n_scenes,
         "vocabulary_size": len(vocab), "vocabulary_counts": {code_str(c, rules.bits): counts.get(c, 0) for c in vocab},
         "closure_added": [code_str(c, rules.bits) for c in added],
         "codes_produced_outside_vocabulary": sorted(code_str(c, rules.bits) for c in produced - set(vocab) - set(added)),

@@ -433,3 +433,19 @@ def test_write_text_atomic(tmp_path):
     write_text_atomic(path, "one")
     write_text_atomic(path, "two")
     assert path.read_text() == "two" and sorted(p.name for p in path.parent.iterdir()) == ["d.pddl"]
+
+
+def test_enumerate_scenes_queries_only_given_scenes_and_distils_exactly(toy):
+    from pddl_export.enumeration import enumerate_scenes
+
+    enum_all, _ = toy
+    net = ToyRobot()
+    vocab = enum_all.vocabulary
+    scenes = [(vocab[0],), (vocab[1], vocab[0]), (vocab[0], vocab[1]), (vocab[2], vocab[2], vocab[1])]
+    enum = enumerate_scenes(net, vocab, scenes, max_objects=3)
+    assert not enum.complete and enum.n_scenes == 3 and enum.n_queries == 3 * 36  # the duplicate pair counted once
+    assert [len(b.scenes) for b in enum.blocks] == [1, 1, 1]
+    rs = distil_rules(enum)
+    assert rule_fidelity(rs, enum).fraction == 1.0
+    with pytest.raises(ValueError, match="objects, expected"):
+        enumerate_scenes(net, vocab, [tuple(vocab[:1]) * 4], max_objects=3)
