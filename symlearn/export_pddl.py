@@ -57,18 +57,14 @@ def file_sha256(path: Path) -> str:
 
 def training_codes(run_dir: Path, data_dir: Path) -> tuple[np.ndarray, np.ndarray]:
     """The encoder's integer codes of every training sample's objects before and after: two (N, K), -1 padding."""
-    from search.symbolic import codes_from_bits
     from symlearn.checkpoint import load_effect_model
     from symlearn.dataset import load_split
-    from symlearn.transition import encode_crops
+    from symlearn.symbols import encode_codes
 
     model, _ = load_effect_model(run_dir)
     data = load_split(data_dir, "train")
-    out = []
-    for depth, origin in ((data.pre_depth, data.pre_origin), (data.post_depth, data.post_origin)):
-        codes = codes_from_bits(encode_crops(model, depth, origin, data.mask).round())
-        out.append(np.where(data.mask, codes, -1))
-    return out[0], out[1]
+    return (encode_codes(model, data.pre_depth, data.pre_origin, data.mask),
+            encode_codes(model, data.post_depth, data.post_origin, data.mask))
 
 
 def code_counts(*code_arrays: np.ndarray) -> dict[int, int]:

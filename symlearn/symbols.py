@@ -10,31 +10,21 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import torch
 
 from search.symbolic import code_str, codes_from_bits
 from symlearn.checkpoint import load_effect_model
 from symlearn.dataset import InteractionData, load_split
 from symlearn.provenance import atomic_write_json
-from symlearn.training import crops_from_depth
 from symlearn.world import LOCATIONS, N_LOCATIONS, OBJECT_SIZE, ObjectType
 
 MOVED_M = 0.01
 
 
-@torch.no_grad()
-def encode_codes(model, depth: np.ndarray, origin: np.ndarray, mask: np.ndarray, batch: int = 512) -> np.ndarray:
+def encode_codes(model, depth: np.ndarray, origin: np.ndarray, mask: np.ndarray) -> np.ndarray:
     """(N, K, S, S) depth crops -> (N, K) integer codes (eval-mode threshold); padding gets -1."""
-    model.eval()
-    out = np.full(mask.shape, -1, np.int64)
-    for i in range(0, len(depth), batch):
-        d = torch.from_numpy(depth[i:i + batch].astype(np.float32))
-        m = torch.from_numpy(mask[i:i + batch])
-        x = crops_from_depth(d, torch.from_numpy(origin[i:i + batch].astype(np.float32)))
-        codes, _ = model.encode(x, m)
-        c = codes_from_bits(codes.numpy().round())
-        out[i:i + batch] = np.where(mask[i:i + batch], c, -1)
-    return out
+    from symlearn.transition import encode_crops
+
+    return np.where(mask, codes_from_bits(encode_crops(model, depth, origin, mask).round()), -1)
 
 
 def picked_objects(data: InteractionData) -> np.ndarray:

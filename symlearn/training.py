@@ -13,7 +13,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,7 +21,7 @@ import numpy as np
 import torch
 import torch.distributed as dist
 
-from symlearn.checkpoint import CheckpointError, load_checkpoint, save_checkpoint
+from symlearn.checkpoint import load_checkpoint, save_checkpoint
 from symlearn.dataset import InteractionData, load_manifest, load_split
 from symlearn.models import AttentiveDeepSym, ModelConfig, masked_mse
 from symlearn.provenance import atomic_write_json, sha256_bytes, versions
