@@ -26,6 +26,7 @@ SequentialSimulator to report the predicted symbolic states (objects `o<i>`, pre
 """
 from __future__ import annotations
 
+import hashlib
 import math
 import multiprocessing as mp
 import re
@@ -34,7 +35,7 @@ import warnings
 from dataclasses import dataclass
 from typing import Any
 
-from pddl_export.pddl_writer import action_id_from_name, code_from_predicate, object_index
+from pddl_export.pddl_writer import OBJECT_TYPE, action_id_from_name, code_from_predicate, object_index
 from search.result import PlanResult, PlanStatus
 
 
@@ -111,7 +112,8 @@ def _predicted_states(problem: Any, plan: Any) -> tuple[tuple[tuple[int, ...], .
     from unified_planning.shortcuts import SequentialSimulator
 
     try:
-        objects = sorted(problem.all_objects, key=lambda o: object_index(o.name))
+        objects = sorted((o for o in problem.all_objects if o.type.name == OBJECT_TYPE),
+                         key=lambda o: object_index(o.name))
         fluents = [(code_from_predicate(f.name), f) for f in problem.fluents]
     except ValueError as e:
         return (), f"no predicted states: {e}"
@@ -128,8 +130,72 @@ def _predicted_states(problem: Any, plan: Any) -> tuple[tuple[tuple[int, ...], .
     return tuple(states), ""
 
 
+_DOMAINS: dict[str, Any] = {}  # sha256 of a domain text -> its unified-planning problem without objects
+
+
+def parsed_domain(domain_text: str) -> Any:
+    """unified-planning's parse of a domain alone, cached by the text's hash.
+
+    Parsing is the slow part of a call on a large learned domain (unified-planning's reader
+    takes about 30 s for a 1,000-rule domain), so repeated calls on one domain parse it once.
+    """
+    key = hashlib.sha256(domain_text.encode()).hexdigest()
+    if key not in _DOMAINS:
+        from unified_planning.io import PDDLReader
+
+        _DOMAINS[key] = PDDLReader().parse_problem_string(domain_text)
+    return _DOMAINS[key]
+
+
+def _instance(domain: Any, problem_text: str) -> Any | None:
+    """The problem on a copy of a parsed domain, or None if it is more than this reads.
+
+    The problem text is read with the `pddl` package: typed objects, positive ground init
+    atoms and a goal that is an atom or a conjunction of atoms and negated atoms (what
+    pddl_export.pddl_writer.problem_pddl writes). Anything else returns None, and the
+    caller parses domain and problem together with unified-planning.
+    """
+    import sys
+
+    from pddl.logic.base import And, Not
+    from pddl.logic.predicates import Predicate
+    from pddl.parser.problem import ProblemParser
+    from unified_planning.model import Object
+
+    old = getattr(sys, "tracebacklimit", None)
+    try:
+        parsed = ProblemParser()(problem_text)
+    except Exception:  # noqa: BLE001 - let unified-planning's reader report the error
+        return None
+    finally:  # the pddl parser leaves sys.tracebacklimit at 0 on errors
+        if old is None and hasattr(sys, "tracebacklimit"):
+            del sys.tracebacklimit
+    problem = domain.clone()
+    problem.name = str(parsed.name).lower()
+    try:
+        for const in sorted(parsed.objects, key=lambda c: c.name):
+            if len(const.type_tags) != 1:
+                return None
+            type_name = str(next(iter(const.type_tags))).lower()
+            problem.add_object(Object(str(const.name).lower(), domain.user_type(type_name)))
+
+        def atom(lit: Any) -> Any:
+            if not isinstance(lit, Predicate):
+                raise ValueError("not an atom")
+            return problem.fluent(str(lit.name).lower())(*[problem.object(str(t.name).lower()) for t in lit.terms])
+
+        for lit in parsed.init:
+            problem.set_initial_value(atom(lit), True)
+        goals = parsed.goal.operands if isinstance(parsed.goal, And) else (parsed.goal,)
+        for g in goals:
+            problem.add_goal(~atom(g.argument) if isinstance(g, Not) else atom(g))
+    except Exception:  # noqa: BLE001 - an unknown name, type or form: fall back to the full parse
+        return None
+    return problem
+
+
 def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: float,
-                compile_conditional_effects: bool) -> PlanResult:
+                compile_conditional_effects: bool, domain: Any = None) -> PlanResult:
     """The whole pipeline in this process; never raises (ERROR instead)."""
     t0 = time.perf_counter()
     deadline = t0 + timeout_s
@@ -146,10 +212,12 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
     if spec.engine not in env.factory.engines:
         return _result(planner, PlanStatus.ERROR, t0, f"engine {spec.engine!r} is not installed")
     engine_cls = env.factory.engine(spec.engine)
-    try:
-        original = PDDLReader(env).parse_problem_string(domain_text, problem_text)
-    except Exception as e:  # noqa: BLE001 - any parser failure is reported, not raised
-        return _result(planner, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}")
+    original = _instance(domain, problem_text) if domain is not None else None
+    if original is None:
+        try:
+            original = PDDLReader(env).parse_problem_string(domain_text, problem_text)
+        except Exception as e:  # noqa: BLE001 - any parser failure is reported, not raised
+            return _result(planner, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}")
     t_parse = time.perf_counter() - t0
 
     problem, chain, names = original, [], []
@@ -263,11 +331,14 @@ def solve_pddl(
     *,
     compile_conditional_effects: bool = False,
     grace_s: float = 3.0,
+    cache_domain: bool = False,
 ) -> PlanResult:
     """Run one classical planner on PDDL text; every failure comes back as a status, never raised.
 
     Planners: "fast-downward" (satisficing), "fast-downward-opt", "symk", "symk-opt",
-    "pyperplan". The call takes at most about timeout_s + grace_s seconds.
+    "pyperplan". The call takes at most about timeout_s + grace_s seconds. With cache_domain, the domain
+    is parsed once in this process (parsed_domain; the first call's time includes it, outside
+    the guard) and each call reads only the problem.
     """
     t0 = time.perf_counter()
     if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
@@ -286,10 +357,17 @@ def solve_pddl(
     except ImportError as e:
         return _result(name, PlanStatus.ERROR, t0, f"unified-planning is not installed: {e}",
                        total_time_s=time.perf_counter() - t0)
+    domain = None
+    if cache_domain:
+        try:
+            domain = parsed_domain(domain_text)
+        except Exception as e:  # noqa: BLE001
+            return _result(name, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}",
+                           total_time_s=time.perf_counter() - t0)
     ctx = _context()
     recv, send = ctx.Pipe(duplex=False)
     proc = ctx.Process(target=_worker, args=(send, domain_text, problem_text, name, float(timeout_s),
-                                             compile_conditional_effects), daemon=True)
+                                             compile_conditional_effects, domain), daemon=True)
     answer: Any = None  # stays None if the child dies (or on an exception here); "late" on the guard
     proc.start()
     send.close()

@@ -72,7 +72,7 @@ def cmd_train(args: argparse.Namespace) -> int:
         over["attention"] = False
     if args.constant_lr:
         over["cosine_lr"] = False
-    cfg = TrainConfig.preset(args.preset, bf16=not args.no_bf16, compile=args.compile, **over)
+    cfg = TrainConfig.from_preset(args.preset, bf16=not args.no_bf16, compile=args.compile, **over)
     if args.threads:
         import torch
 

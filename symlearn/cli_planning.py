@@ -40,7 +40,7 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
     from symlearn.transition import TransitionConfig, train_transition
 
     over = {"epochs": args.epochs} if args.epochs is not None else {}
-    cfg = TransitionConfig.preset(args.preset, **over)
+    cfg = TransitionConfig.from_preset(args.preset, **over)
     print(f"train-transition: preset {cfg.preset}, {cfg.epochs} epochs, seed {args.seed}, run {args.run}, "
           f"data {args.data}", file=sys.stderr)
     m = train_transition(Path(args.run), Path(args.data), cfg, seed=args.seed, show_progress=not args.quiet)

@@ -7,7 +7,7 @@ the objects of a scene attend to each other (padding masked out); the decoder g 
 object's normalized displacement. Batch-norm layers only ever see real objects: padded slots
 are removed before the encoder and decoder and scattered back after.
 
-    >>> cfg = ModelConfig.preset("quick")
+    >>> cfg = ModelConfig.from_preset("quick")
     >>> model = AttentiveDeepSym(cfg)
     >>> x = torch.zeros(2, 3, 3, cfg.crop, cfg.crop); mask = torch.tensor([[1, 1, 0], [1, 0, 0]]).bool()
     >>> out = model(x, mask, torch.tensor([0, 35]))
@@ -54,7 +54,7 @@ class ModelConfig:
             raise ValueError(f"bits={self.bits} must lie in 1..16")
 
     @staticmethod
-    def preset(name: str, **overrides) -> "ModelConfig":
+    def from_preset(name: str, **overrides) -> "ModelConfig":
         if name not in PRESETS:
             raise ValueError(f"unknown preset {name!r}; known: {', '.join(PRESETS)}")
         return dataclasses.replace(PRESETS[name], **overrides)

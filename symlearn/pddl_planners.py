@@ -75,7 +75,7 @@ def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Pat
             if form == "strips":
                 write_text_atomic(Path(write_dir) / f"domain_strips{suffix}.pddl", dom)
         write_s = time.perf_counter() - t0
-        res = solve_pddl(dom, prob, engine, max(timeout_s - write_s, 0.001))
+        res = solve_pddl(dom, prob, engine, max(timeout_s - write_s, 0.001), cache_domain=form == "conditional")
         extra = dict(res.extra, pddl_write_time_s=round(write_s, 5))
         if res.found:
             extra["rules_vs_net"] = not network_agrees(transition, res)

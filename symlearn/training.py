@@ -6,7 +6,7 @@ are normalized per axis with statistics of the real (unpadded) training objects;
 in the checkpoint. Runs under `torchrun` with DistributedDataParallel (gloo on CPU, nccl on a
 GPU): every rank takes its share of each shuffled epoch and rank 0 writes the files.
 
-    >>> train(Path("data/paper"), Path("runs/paper"), TrainConfig.preset("quick"))  # doctest: +SKIP
+    >>> train(Path("data/paper"), Path("runs/paper"), TrainConfig.from_preset("quick"))  # doctest: +SKIP
 """
 from __future__ import annotations
 
@@ -49,13 +49,13 @@ class TrainConfig:
     max_train_samples: int | None = None  # a subset, for quick runs and tests
 
     @staticmethod
-    def preset(name: str, **overrides) -> "TrainConfig":
+    def from_preset(name: str, **overrides) -> "TrainConfig":
         model_over = {k: overrides.pop(k) for k in list(overrides) if k in ModelConfig.__dataclass_fields__}
         base = {"paper": dict(epochs=60, batch_size=128, lr=5e-4),
                 "quick": dict(epochs=40, batch_size=64, lr=1e-3)}
         if name not in base:
             raise ValueError(f"unknown preset {name!r}; known: paper, quick")
-        return TrainConfig(model=ModelConfig.preset(name, **model_over), preset=name, **{**base[name], **overrides})
+        return TrainConfig(model=ModelConfig.from_preset(name, **model_over), preset=name, **{**base[name], **overrides})
 
     def to_json(self) -> dict:
         d = dataclasses.asdict(self)

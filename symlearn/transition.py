@@ -7,7 +7,7 @@ layers, giving per-object next-code logits; training minimizes binary cross-entr
 over the real objects. The training pairs are the trained effect model's own codes of the
 before- and after-crops of every data sample (encoder in eval mode: deterministic threshold).
 
-    >>> train_transition(Path("runs/paper"), Path("data/paper"), TransitionConfig.preset("paper"))  # doctest: +SKIP
+    >>> train_transition(Path("runs/paper"), Path("data/paper"), TransitionConfig.from_preset("paper"))  # doctest: +SKIP
     >>> m = LearnedTransition.from_run(Path("runs/paper"))                                          # doctest: +SKIP
     >>> m(np.array([[3, 17]]), np.array([action_id(3, 4)]))   # (B, K) codes, (B,) actions      # doctest: +SKIP
     array([[ 3, 19]])
@@ -73,7 +73,7 @@ class TransitionConfig:
             raise ValueError(f"lr={self.lr} must be positive")
 
     @staticmethod
-    def preset(name: str, **overrides) -> "TransitionConfig":
+    def from_preset(name: str, **overrides) -> "TransitionConfig":
         """A named preset with optional field overrides."""
         if name not in TRANSITION_PRESETS:
             raise ValueError(f"unknown preset {name!r}; known: {', '.join(TRANSITION_PRESETS)}")

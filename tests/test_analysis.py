@@ -17,8 +17,8 @@ def run(tmp_path_factory):
     root = tmp_path_factory.mktemp("analysis")
     collect(root / "data", CollectConfig(n=48, seed=9, shard_size=4), show_progress=False)
     cfg = dict(epochs=1, batch_size=8, bf16=False)
-    train(root / "data", root / "run", TrainConfig.preset("quick", **cfg), show_progress=False)
-    train(root / "data", root / "base", TrainConfig.preset("quick", attention=False, **cfg), show_progress=False)
+    train(root / "data", root / "run", TrainConfig.from_preset("quick", **cfg), show_progress=False)
+    train(root / "data", root / "base", TrainConfig.from_preset("quick", attention=False, **cfg), show_progress=False)
     return root
 
 

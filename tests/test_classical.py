@@ -80,6 +80,32 @@ def test_conditional_form_satisficing(rules, planner):
     assert result.extra["compilers"] == ""  # taken as written
 
 
+def test_cached_domain_reads_only_the_problem(rules):
+    """cache_domain parses the domain once; each call builds its problem from the problem text."""
+    import search.classical as classical
+    from unified_planning.shortcuts import OneshotPlanner
+
+    _require("fast-downward")
+    domain, problem = _conditional(rules, UNCOVER_TWICE)
+    first = solve_pddl(domain, problem, planner="fast-downward", timeout_s=20, cache_domain=True)
+    _check_plan(first, UNCOVER_TWICE)
+    _, other = _conditional(rules, STICK_CARRIES_RIDER)
+    second = solve_pddl(domain, other, planner="fast-downward", timeout_s=20, cache_domain=True)
+    _check_plan(second, STICK_CARRIES_RIDER)
+    assert sum(1 for p in classical._DOMAINS.values() if p.name == classical.parsed_domain(domain).name) >= 1
+    # the instance built on the cached domain is the problem unified-planning's reader gives
+    built = classical._instance(classical.parsed_domain(domain), other)
+    from unified_planning.io import PDDLReader
+    full = PDDLReader().parse_problem_string(domain, other)
+    assert {o.name for o in built.all_objects} == {o.name for o in full.all_objects}
+    assert {str(g) for g in built.goals} == {str(g) for g in full.goals}
+    assert {str(k): str(v) for k, v in built.explicit_initial_values.items()} == \
+        {str(k): str(v) for k, v in full.explicit_initial_values.items()}
+    with OneshotPlanner(name="fast-downward") as engine:
+        assert engine.solve(built).plan is not None
+    assert classical._instance(classical.parsed_domain(domain), "(define (problem x) (:domain d) (:objects a - nosuchtype) (:init) (:goal (and)))") is None
+
+
 def test_conditional_form_optimal_with_symk(rules):
     _require("symk-opt")
     result = solve_pddl(*_conditional(rules, STICK_CARRIES_RIDER), planner="symk-opt", timeout_s=20)

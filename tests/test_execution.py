@@ -32,7 +32,7 @@ def _seeded(make, seed: int):
 
 @pytest.fixture(scope="module")
 def encoder():
-    return _seeded(lambda: AttentiveDeepSym(ModelConfig.preset("quick")), 0)
+    return _seeded(lambda: AttentiveDeepSym(ModelConfig.from_preset("quick")), 0)
 
 
 @pytest.fixture(scope="module")
@@ -46,7 +46,7 @@ def run_dir(tmp_path_factory, encoder):
     """A run directory holding an (untrained) effect model and a transition model tied to it."""
     d = tmp_path_factory.mktemp("exec_run")
     save_checkpoint(d / "best.pt", model=encoder)
-    net = _seeded(lambda: TransitionNet(TransitionConfig.preset("quick", bits=encoder.cfg.bits)), 1)
+    net = _seeded(lambda: TransitionNet(TransitionConfig.from_preset("quick", bits=encoder.cfg.bits)), 1)
     save_transition(d / TRANSITION_FILE, net, {"effect_model_sha256": _file_sha(d / "best.pt")})
     return d
 

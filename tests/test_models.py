@@ -3,7 +3,7 @@ import torch
 
 from symlearn.models import AttentiveDeepSym, ModelConfig, gumbel_sigmoid, masked_mse
 
-CFG = ModelConfig.preset("quick")
+CFG = ModelConfig.from_preset("quick")
 
 
 def _batch(b=4, k=3, s=64, seed=0):
@@ -17,7 +17,7 @@ def _batch(b=4, k=3, s=64, seed=0):
 
 @pytest.mark.parametrize("attention", [True, False])
 def test_padding_does_not_change_real_objects(attention):
-    model = AttentiveDeepSym(ModelConfig.preset("quick", attention=attention)).eval()
+    model = AttentiveDeepSym(ModelConfig.from_preset("quick", attention=attention)).eval()
     x, mask, a = _batch()
     out1 = model(x, mask, a)
     x2 = x.clone()
@@ -37,7 +37,7 @@ def test_attention_lets_objects_influence_each_other():
     a = torch.tensor([7])
     att = AttentiveDeepSym(CFG).eval()
     assert not torch.allclose(att.decode(codes, mask, a)[0, 0], att.decode(other, mask, a)[0, 0])
-    base = AttentiveDeepSym(ModelConfig.preset("quick", attention=False)).eval()
+    base = AttentiveDeepSym(ModelConfig.from_preset("quick", attention=False)).eval()
     torch.testing.assert_close(base.decode(codes, mask, a)[0, 0], base.decode(other, mask, a)[0, 0])
 
 
@@ -84,7 +84,7 @@ def test_config_validation_and_presets():
     with pytest.raises(ValueError, match="divisible by n_heads"):
         ModelConfig(d_model=100, n_heads=8)
     with pytest.raises(ValueError, match="unknown preset"):
-        ModelConfig.preset("huge")
-    p = ModelConfig.preset("paper")
+        ModelConfig.from_preset("huge")
+    p = ModelConfig.from_preset("paper")
     assert p.conv_channels == (64, 128, 256, 512) and p.n_layers == 4 and p.decoder_hidden == (256, 256, 256)
     assert ModelConfig.from_json(p.to_json()) == p

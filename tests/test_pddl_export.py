@@ -319,22 +319,28 @@ def test_conditional_domain_parses_with_both_parsers(toy, tmp_path):
     assert re.findall(r"\(:action (\S+)", domain) == [action_name(a) for a in rs.actions]
     d, p = _pddl_parse(domain, problem)
     assert d.requirements == {R.STRIPS, R.TYPING, R.CONDITIONAL_EFFECTS, R.EXISTENTIAL_PRECONDITION,
-                              R.NEG_PRECONDITION, R.EQUALITY}
+                              R.UNIVERSAL_PRECONDITION, R.NEG_PRECONDITION, R.EQUALITY}
     assert {a.name for a in d.actions} == {action_name(a) for a in rs.actions} and p.name == "t1"
     dpath = write_text_atomic(tmp_path / "domain.pddl", domain)
     ppath = write_text_atomic(tmp_path / "problem.pddl", problem)
     assert parse_domain(dpath).name == "learned-symbols" and len(parse_problem(ppath).objects) == 3
     up_problem = _up_parse(domain, problem)
     assert {a.name for a in up_problem.actions} == {action_name(a) for a in rs.actions}
-    assert len(up_problem.all_objects) == 3 and len(up_problem.goals) == 1
+    assert sorted(o.name for o in up_problem.all_objects) == ["o0", "o1", "o2", "the-scene"]
+    assert len(up_problem.goals) == 1
 
 
 def test_requirements_follow_what_is_used():
     plain = RuleSet(2, (1, 2), 2, (Rule(0, 1, 2),), 1)
     assert "(:requirements :strips :typing :conditional-effects)" in conditional_domain(plain, "h")
     absent = RuleSet(2, (1, 2, 3), 2, (Rule(0, 1, 2, forbids=(3,)),), 1)
+    text = conditional_domain(absent, "h")
     assert "(:requirements :strips :typing :conditional-effects :existential-preconditions " \
-           ":negative-preconditions)" in conditional_domain(absent, "h")
+           ":universal-preconditions :negative-preconditions :equality)" in text
+    # a context is wrapped in a universal over the one-object type `scene` (see the writer's docstring)
+    assert "(:constants the-scene - scene)" in text and "(when (forall (?s - scene) (and (= ?s the-scene) " \
+           "(code-01 ?o) (not (exists (?z - obj) (code-11 ?z)))))" in text
+    assert "the-scene" not in conditional_domain(plain, "h")
     empty = RuleSet(2, (1, 2), 2, (), 0)
     text = conditional_domain(empty, "h")
     assert "(:requirements :strips :typing)" in text and ":action" not in text

@@ -23,9 +23,9 @@ ROOT = Path(__file__).resolve().parents[1]
 def run(tmp_path_factory):
     root = tmp_path_factory.mktemp("pddl_pipeline")
     collect(root / "data", CollectConfig(n=48, seed=2, shard_size=4), show_progress=False)
-    train(root / "data", root / "run", TrainConfig.preset("quick", epochs=1, batch_size=8, bf16=False),
+    train(root / "data", root / "run", TrainConfig.from_preset("quick", epochs=1, batch_size=8, bf16=False),
           show_progress=False)
-    train_transition(root / "run", root / "data", TransitionConfig.preset("quick", epochs=2))
+    train_transition(root / "run", root / "data", TransitionConfig.from_preset("quick", epochs=2))
     generate_problems(root / "problems", 2, objects=(1, 2), length=(1, 2), seed=0)
     return root
 

@@ -27,7 +27,7 @@ def _weights(run):
 
 def test_quick_training_writes_run_files(data, tmp_path):
     run = tmp_path / "run"
-    out = train(data, run, TrainConfig.preset("quick", **TINY), show_progress=False)
+    out = train(data, run, TrainConfig.from_preset("quick", **TINY), show_progress=False)
     assert len(out["history"]) == 2
     m = json.loads((run / "metrics.json").read_text())
     assert set(m["history"][0]) >= {"train_loss", "val_loss", "val_mae_mm", "crops_per_s"}
@@ -39,18 +39,18 @@ def test_quick_training_writes_run_files(data, tmp_path):
 
 
 def test_resume_equals_uninterrupted(data, tmp_path):
-    cfg2 = TrainConfig.preset("quick", **TINY)
+    cfg2 = TrainConfig.from_preset("quick", **TINY)
     train(data, tmp_path / "a", cfg2, show_progress=False)
-    train(data, tmp_path / "b", TrainConfig.preset("quick", **{**TINY, "epochs": 1}), show_progress=False)
+    train(data, tmp_path / "b", TrainConfig.from_preset("quick", **{**TINY, "epochs": 1}), show_progress=False)
     out = train(data, tmp_path / "b", cfg2, show_progress=False)  # resumes at epoch 2
     assert [h["epoch"] for h in out["history"]] == [1, 2]
     torch.testing.assert_close(_weights(tmp_path / "a"), _weights(tmp_path / "b"))
 
 
 def test_resume_refuses_other_settings(data, tmp_path):
-    train(data, tmp_path / "r", TrainConfig.preset("quick", **{**TINY, "epochs": 1}), show_progress=False)
+    train(data, tmp_path / "r", TrainConfig.from_preset("quick", **{**TINY, "epochs": 1}), show_progress=False)
     with pytest.raises((TrainingError, CheckpointError), match="other"):
-        train(data, tmp_path / "r", TrainConfig.preset("quick", **{**TINY, "lr": 0.5}), show_progress=False)
+        train(data, tmp_path / "r", TrainConfig.from_preset("quick", **{**TINY, "lr": 0.5}), show_progress=False)
 
 
 def test_nan_loss_stops_with_step(data, tmp_path, monkeypatch):
@@ -58,18 +58,18 @@ def test_nan_loss_stops_with_step(data, tmp_path, monkeypatch):
 
     monkeypatch.setattr(tr, "masked_mse", lambda *a: torch.tensor(float("nan")))
     with pytest.raises(TrainingError, match="epoch 1, step 1"):
-        train(data, tmp_path / "nan", TrainConfig.preset("quick", **TINY), show_progress=False)
+        train(data, tmp_path / "nan", TrainConfig.from_preset("quick", **TINY), show_progress=False)
 
 
 def test_checkpoint_round_trip_and_refusals(tmp_path):
-    model = AttentiveDeepSym(ModelConfig.preset("quick"))
+    model = AttentiveDeepSym(ModelConfig.from_preset("quick"))
     save_checkpoint(tmp_path / "c.pt", model=model, epoch=3, effect_std=[1, 2, 3])
     ck = load_checkpoint(tmp_path / "c.pt")
     assert ck.epoch == 3 and ck.config == model.cfg and ck.effect_std.tolist() == [1, 2, 3]
     for k, v in model.state_dict().items():
         torch.testing.assert_close(ck.model_state[k], v)
     with pytest.raises(CheckpointError, match="another model config"):
-        load_checkpoint(tmp_path / "c.pt", expect_config=ModelConfig.preset("paper"))
+        load_checkpoint(tmp_path / "c.pt", expect_config=ModelConfig.from_preset("paper"))
     (tmp_path / "junk.pt").write_bytes(b"not a checkpoint at all")
     with pytest.raises(CheckpointError, match="not a readable checkpoint"):
         load_checkpoint(tmp_path / "junk.pt")

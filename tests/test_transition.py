@@ -25,7 +25,7 @@ BITS = 8
 def _net(seed: int = 0, **over) -> TransitionNet:
     with torch.random.fork_rng(devices=[]):
         torch.manual_seed(seed)
-        return TransitionNet(TransitionConfig.preset("quick", bits=BITS, **over)).eval()
+        return TransitionNet(TransitionConfig.from_preset("quick", bits=BITS, **over)).eval()
 
 
 @pytest.fixture(scope="module")
@@ -33,9 +33,9 @@ def run(tmp_path_factory):
     """A tiny data set, a one-epoch effect model and a quickly trained transition model."""
     root = tmp_path_factory.mktemp("transition")
     collect(root / "d", CollectConfig(n=48, seed=5, shard_size=4), show_progress=False)
-    train(root / "d", root / "run", TrainConfig.preset("quick", epochs=1, batch_size=8, bf16=False),
+    train(root / "d", root / "run", TrainConfig.from_preset("quick", epochs=1, batch_size=8, bf16=False),
           show_progress=False)
-    metrics = train_transition(root / "run", root / "d", TransitionConfig.preset("quick", epochs=3), seed=0)
+    metrics = train_transition(root / "run", root / "d", TransitionConfig.from_preset("quick", epochs=3), seed=0)
     return root / "run", root / "d", metrics
 
 
@@ -84,10 +84,13 @@ def test_config_validation_and_presets():
     with pytest.raises(ValueError, match="divisible"):
         TransitionConfig(hidden=30, n_heads=4)
     with pytest.raises(ValueError, match="unknown preset"):
-        TransitionConfig.preset("huge")
-    assert TransitionConfig.preset("quick").hidden < TransitionConfig.preset("paper").hidden
-    cfg = TransitionConfig.preset("quick", epochs=2)
+        TransitionConfig.from_preset("huge")
+    assert TransitionConfig.from_preset("quick").hidden < TransitionConfig.from_preset("paper").hidden
+    cfg = TransitionConfig.from_preset("quick", epochs=2)
     assert TransitionConfig.from_json(json.loads(json.dumps(cfg.to_json()))) == cfg
+    # the default config names its preset (a method of the same name once shadowed the field)
+    assert TransitionConfig().preset == "paper" == TransitionConfig.from_preset("paper").preset
+    assert TrainConfig().preset == "paper" and json.dumps(TrainConfig().to_json())
 
 
 def test_rollout_chains_follow_episodes():
@@ -163,7 +166,7 @@ def test_refuses_foreign_and_mismatched_files(run, tmp_path):
     with pytest.raises(TransitionError, match="format 99"):
         load_transition(tmp_path / "future.pt")
     with pytest.raises(TransitionError, match="another transition config"):
-        load_transition(run_dir / TRANSITION_FILE, expect_config=TransitionConfig.preset("paper"))
+        load_transition(run_dir / TRANSITION_FILE, expect_config=TransitionConfig.from_preset("paper"))
     with pytest.raises(TransitionError) as info:
         load_transition(tmp_path / "junk.pt")
     assert "\n" not in str(info.value)
