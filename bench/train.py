@@ -57,7 +57,7 @@ def main() -> None:
     ap.add_argument("--compile", action="store_true", help="also measure torch.compile")
     ap.add_argument("--out", default="bench/results/train.json")
     args = ap.parse_args()
-    cfg = ModelConfig.preset(args.preset)
+    cfg = ModelConfig.from_preset(args.preset)
     rows = {"fp32_eager_nchw (baseline)": measure(cfg, args.batch, args.steps, False, False, False),
             "channels_last_fp32": measure(cfg, args.batch, args.steps, True, False, False),
             "channels_last_bf16 (toolkit default)": measure(cfg, args.batch, args.steps, True, True, False)}
