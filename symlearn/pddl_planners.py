@@ -30,6 +30,7 @@ PDDL_PLANNERS = {
     "symk": ("symk", "conditional"),
     "pyperplan": ("pyperplan", "strips"),
     "fast-downward-opt": ("fast-downward-opt", "strips"),
+    "fast-downward-blind": ("fast-downward-blind", "conditional"),
 }
 
 

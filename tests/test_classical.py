@@ -106,6 +106,14 @@ def test_cached_domain_reads_only_the_problem(rules):
     assert classical._instance(classical.parsed_domain(domain), "(define (problem x) (:domain d) (:objects a - nosuchtype) (:init) (:goal (and)))") is None
 
 
+@pytest.mark.parametrize("problem", [STICK_CARRIES_RIDER, UNCOVER_TWICE])
+def test_conditional_form_optimal_with_fast_downward_blind(rules, problem):
+    _require("fast-downward")
+    result = solve_pddl(*_conditional(rules, problem), planner="fast-downward-blind", timeout_s=20)
+    _check_plan(result, problem)
+    assert len(result.plan) == problem.optimal_length and result.extra["compilers"] == ""
+
+
 def test_conditional_form_optimal_with_symk(rules):
     _require("symk-opt")
     result = solve_pddl(*_conditional(rules, STICK_CARRIES_RIDER), planner="symk-opt", timeout_s=20)
