@@ -5,7 +5,9 @@ problem's initial poses. After each action the real scene is rendered and encode
 are compared with the planner's predicted state. Success is geometric (every object within
 2 cm of its goal position); the symbolic match (final codes == goal codes) is reported beside
 it. With `closed_loop=True`, a departure from the prediction triggers replanning from the
-observed codes, at most `max_replans` times.
+observed codes, at most `max_replans` times; the replanning search uses the network corrected
+by every transition seen so far in this execution (ObservedTransitions), so it does not repeat an
+action the scene has just answered differently than predicted.
 
     >>> row = run_problem(sim, encoder, transition, problem, "astar", get_planner("astar"),
     ...                   ExecutionConfig(closed_loop=True))                       # doctest: +SKIP
@@ -64,14 +66,49 @@ class ExecutionResult:
     off_table: bool  # some object fell off the table
 
 
+class ObservedTransitions:
+    """The network, except where execution has shown what an action does in a symbolic state.
+
+    Closed-loop replanning searches with this model: every executed (state, action) ->
+    observed next state is recorded and answered from memory, so a replan does not choose
+    an action again in the state where the network was just proven wrong about it.
+    """
+
+    def __init__(self, inner: TransitionFn) -> None:
+        self.inner, self.bits = inner, inner.bits
+        self.seen: dict[tuple[int, ...], dict[int, tuple[int, ...]]] = {}  # state -> {action: next}
+
+    def record(self, state, action: int, nxt) -> None:
+        self.seen.setdefault(tuple(int(c) for c in state), {})[int(action)] = tuple(int(c) for c in nxt)
+
+    def __call__(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        out = np.array(self.inner(codes, actions), np.int64)
+        if not self.seen or len(codes) == 0:
+            return out
+        codes, actions = np.asarray(codes), np.asarray(actions)
+        states, inverse = np.unique(codes, axis=0, return_inverse=True)  # an A* expansion: one state
+        for j, state in enumerate(states.tolist()):
+            known = self.seen.get(tuple(state))
+            if not known:
+                continue
+            rows = np.flatnonzero((inverse.reshape(-1) == j) & np.isin(actions, list(known)))
+            for i in rows:
+                out[i] = known[int(actions[i])]
+        return out
+
+
 def _codes(sim, encoder) -> tuple[int, ...]:
     return tuple(int(c) for c in encode_observation(encoder, sim.observe()))
 
 
 def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: np.ndarray,
                  config: ExecutionConfig = ExecutionConfig(),
-                 replan: Callable[[np.ndarray], PlanResult] | None = None) -> ExecutionResult:
-    """Run plan.plan from the problem's initial poses; closed loop replans with `replan(observed_codes)`."""
+                 replan: Callable[[np.ndarray], PlanResult] | None = None,
+                 record: Callable[[tuple, int, tuple], None] | None = None) -> ExecutionResult:
+    """Run plan.plan from the problem's initial poses; closed loop replans with `replan(observed_codes)`.
+
+    `record(state, action, observed_next)` hears every executed step (ObservedTransitions.record).
+    """
     if config.closed_loop and replan is None:
         raise ValueError("closed-loop execution needs a replan function")
     goal = tuple(int(c) for c in goal)
@@ -84,8 +121,10 @@ def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: np.ndar
         res = sim.step(decode_action(actions[t]))
         off_table |= res.off_table
         executed.append(actions[t])
-        codes = _codes(sim, encoder)
+        before, codes = codes, _codes(sim, encoder)
         observed.append(codes)
+        if record is not None:
+            record(before, actions[t], codes)
         if predicted and codes != predicted[t + 1]:
             diverged, segment_ok = True, False
             if config.closed_loop and replans < config.max_replans:
@@ -171,9 +210,11 @@ def run_problem(sim, encoder, transition: TransitionFn, problem: Problem, planne
     plan = initial_plan or safe_plan(planner, planner_fn, transition, start, sym_goal, config.timeout_s)
     ex = None
     if plan.found:
+        memory = ObservedTransitions(transition)
         ex = execute_plan(sim, problem, plan, encoder, goal, config,
-                          replan=lambda codes: safe_plan(planner, planner_fn, transition, codes, sym_goal,
-                                                         config.timeout_s))
+                          replan=lambda codes: safe_plan(planner, planner_fn, memory, codes, sym_goal,
+                                                         config.timeout_s),
+                          record=memory.record if config.closed_loop else None)
     return ProblemRun(
         problem=problem.name, planner=planner, found=plan.found, status=plan.status.value,
         plan_length=len(plan.plan) if plan.found else None, planning_time_s=plan.planning_time_s,

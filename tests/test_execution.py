@@ -16,7 +16,7 @@ from search.result import PlanResult, PlanStatus
 from symlearn import benchmark as bench
 from symlearn.checkpoint import save_checkpoint
 from symlearn.cli_planning import add_planning_commands
-from symlearn.execution import ExecutionConfig, ProblemRun, execute_plan, run_problem
+from symlearn.execution import ExecutionConfig, ObservedTransitions, ProblemRun, execute_plan, run_problem
 from symlearn.models import AttentiveDeepSym, ModelConfig
 from symlearn.problems import GOAL_TOLERANCE_M, generate_problems, goal_codes, load_problem, scene_codes
 from symlearn.transition import (TRANSITION_FILE, LearnedTransition, TransitionConfig, TransitionNet, _file_sha,
@@ -113,6 +113,46 @@ def test_closed_loop_replans_are_bounded(sim, encoder, problems, max_replans):
     assert ex.replans == len(calls) == max_replans
     assert len(ex.executed) == max_replans + 1
     assert ex.diverged and not ex.on_prediction and not ex.success
+
+
+class _Shift:
+    """Toy network: action 0 adds 1 to object 0's code, action 1 adds 2, others change nothing."""
+
+    bits = 4
+
+    def __call__(self, codes, actions):
+        out = np.array(codes, np.int64)
+        out[:, 0] = np.where(actions == 0, out[:, 0] + 1, np.where(actions == 1, out[:, 0] + 2, out[:, 0])) % 16
+        return out
+
+
+def test_observed_transitions_override_only_what_was_seen():
+    from search.learned_astar import plan_symbolic
+    from search.symbolic import SymbolicGoal
+
+    memory = ObservedTransitions(_Shift())
+    codes = np.array([[3, 5], [3, 5], [4, 5], [3, 5]])
+    actions = np.array([0, 1, 0, 2])
+    assert memory(codes, actions).tolist() == [[4, 5], [5, 5], [5, 5], [3, 5]]
+    memory.record((3, 5), 0, (3, 5))  # in (3, 5) action 0 was seen to do nothing
+    assert memory(codes, actions).tolist() == [[3, 5], [5, 5], [5, 5], [3, 5]]
+    goal = SymbolicGoal((4, None))
+    assert plan_symbolic(_Shift(), np.array([3, 5]), goal, uniform_cost=True).plan == (0,)
+    replanned = plan_symbolic(memory, np.array([3, 5]), goal, uniform_cost=True)
+    assert replanned.found and replanned.plan[0] != 0 and replanned.predicted_states[-1][0] == 4
+
+
+def test_closed_loop_records_every_executed_step(sim, encoder, problems):
+    pr = problems[0]
+    goal = goal_codes(sim, encoder, pr)
+    start = scene_codes(sim, encoder, pr.initial)
+    a = _empty_pick(pr)
+    seen = []
+    cfg = ExecutionConfig(closed_loop=True, max_replans=1)
+    ex = execute_plan(sim, pr, _plan([a], [start, _wrong(start)]), encoder, goal, cfg,
+                      replan=lambda codes: _plan([a], [codes, _wrong(codes)]), record=lambda *step: seen.append(step))
+    assert [(s, act, n) for s, act, n in seen] == [(ex.observed_states[i], ex.executed[i], ex.observed_states[i + 1])
+                                                   for i in range(len(ex.executed))]
 
 
 def test_closed_loop_stops_when_replanning_fails(sim, encoder, problems):
