@@ -40,6 +40,8 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
     from symlearn.transition import TransitionConfig, train_transition
 
     over = {"epochs": args.epochs} if args.epochs is not None else {}
+    if getattr(args, "copy_prior", None) is not None:
+        over["copy_prior"] = args.copy_prior
     cfg = TransitionConfig.from_preset(args.preset, **over)
     print(f"train-transition: preset {cfg.preset}, {cfg.epochs} epochs, seed {args.seed}, run {args.run}, "
           f"data {args.data}", file=sys.stderr)
@@ -111,6 +113,7 @@ def add_planning_commands(sub) -> None:
     t.add_argument("--data", required=True, help="the data set to encode")
     t.add_argument("--preset", default="paper", choices=["paper", "quick"])
     t.add_argument("--epochs", type=int)
+    t.add_argument("--copy-prior", type=float, help="logit bias toward keeping each input bit (preset's if unset)")
     t.add_argument("--seed", type=int, default=0)
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=cmd_train_transition)

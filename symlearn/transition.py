@@ -61,6 +61,7 @@ class TransitionConfig:
     lr: float = 1e-3
     weight_decay: float = 0.0
     encode_batch_size: int = 256  # scenes per encoder forward pass while building the data set
+    copy_prior: float = 0.0  # added to each logit toward the input bit, so "no change" is the default
 
     def __post_init__(self) -> None:
         if self.hidden % self.n_heads:
@@ -88,7 +89,7 @@ class TransitionConfig:
         unknown = set(d) - names
         if unknown:
             raise ValueError(f"unknown transition config fields {sorted(unknown)}")
-        return TransitionConfig(**d)
+        return TransitionConfig(**{"copy_prior": 0.0, **d})  # files from before copy_prior had none
 
 
 TRANSITION_PRESETS = {
@@ -129,7 +130,10 @@ class TransitionNet(nn.Module):
         pad[:, 0] &= mask.any(dim=1)
         att, _ = self.attn(h, h, h, key_padding_mask=pad, need_weights=False)  # (B, K, H)
         h = h + att  # residual: an object keeps its own code's features beside the scene context
-        logits = self.post(h) * mask[..., None]  # (B, K, bits)
+        logits = self.post(h)
+        if self.cfg.copy_prior:  # most (object, action) pairs leave the code as it is
+            logits = logits + self.cfg.copy_prior * (2 * codes - 1)
+        logits = logits * mask[..., None]  # (B, K, bits)
         return TransitionOutput(logits, (logits > 0).to(codes.dtype) * mask[..., None])
 
 

@@ -93,6 +93,20 @@ def test_config_validation_and_presets():
     assert TrainConfig().preset == "paper" and json.dumps(TrainConfig().to_json())
 
 
+def test_copy_prior_makes_no_change_the_default():
+    cfg = TransitionConfig.from_preset("quick", copy_prior=3.0)
+    net = TransitionNet(cfg).eval()
+    torch.nn.init.zeros_(net.post[-1].weight)
+    torch.nn.init.zeros_(net.post[-1].bias)
+    codes = torch.randint(0, 2, (4, 3, cfg.bits)).float()
+    mask = torch.tensor([[True, True, False]] * 4)
+    out = net(codes, mask, torch.arange(4))
+    assert torch.equal(out.codes, codes * mask[..., None])
+    assert torch.allclose(out.logits.abs(), 3.0 * mask[..., None].expand_as(codes).float())
+    old = {k: v for k, v in cfg.to_json().items() if k != "copy_prior"}  # a config saved before copy_prior
+    assert TransitionConfig.from_json(old).copy_prior == 0.0
+
+
 def test_rollout_chains_follow_episodes():
     episode = np.array([0, 0, 0, 1, 1, 2])
     step = np.array([0, 1, 2, 0, 1, 0])
