@@ -20,7 +20,15 @@ from symlearn.models import AttentiveDeepSym, ModelConfig, masked_mse
 from symlearn.provenance import versions
 
 
-def measure(cfg: ModelConfig, batch: int, steps: int, channels_last: bool, bf16: bool, compile_: bool) -> float:
+def _onednn_bf16(on: bool) -> None:
+    """Let oneDNN run float32 convolutions and matmuls in bfloat16 (AMX) without autocast."""
+    for backend in (torch.backends.mkldnn.conv, torch.backends.mkldnn.matmul):
+        backend.fp32_precision = "bf16" if on else "none"
+
+
+def measure(cfg: ModelConfig, batch: int, steps: int, channels_last: bool, bf16: bool, compile_: bool,
+            onednn_bf16: bool = False) -> float:
+    _onednn_bf16(onednn_bf16)
     torch.manual_seed(0)
     model = AttentiveDeepSym(cfg)
     model.encoder.channels_last = channels_last
@@ -46,7 +54,9 @@ def measure(cfg: ModelConfig, batch: int, steps: int, channels_last: bool, bf16:
     t = time.perf_counter()
     for _ in range(steps):
         step()
-    return steps * int(mask.sum()) / (time.perf_counter() - t)
+    rate = steps * int(mask.sum()) / (time.perf_counter() - t)
+    _onednn_bf16(False)
+    return rate
 
 
 def main() -> None:
@@ -55,12 +65,15 @@ def main() -> None:
     ap.add_argument("--batch", type=int, default=128)
     ap.add_argument("--steps", type=int, default=5)
     ap.add_argument("--compile", action="store_true", help="also measure torch.compile")
+    ap.add_argument("--onednn-bf16", action="store_true", help="also measure oneDNN's implicit bf16 for fp32")
     ap.add_argument("--out", default="bench/results/train.json")
     args = ap.parse_args()
     cfg = ModelConfig.from_preset(args.preset)
     rows = {"fp32_eager_nchw (baseline)": measure(cfg, args.batch, args.steps, False, False, False),
             "channels_last_fp32": measure(cfg, args.batch, args.steps, True, False, False),
             "channels_last_bf16 (toolkit default)": measure(cfg, args.batch, args.steps, True, True, False)}
+    if args.onednn_bf16:
+        rows["channels_last_fp32_onednn_bf16"] = measure(cfg, args.batch, args.steps, True, False, False, True)
     if args.compile:
         rows["channels_last_bf16_compiled"] = measure(cfg, args.batch, args.steps, True, True, True)
     base = rows["fp32_eager_nchw (baseline)"]
