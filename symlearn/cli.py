@@ -131,8 +131,9 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
     print(f"vocabulary {rep['vocabulary_size']} codes; {rep['n_enumerated_cases']} enumerated cases at "
           f"{rep['enumeration_queries_per_s']:.0f} queries/s; rules {rep['n_rules_before_generalization']} -> "
           f"{rep['n_rules']} after generalization over {rep['n_actions_with_rules']} actions")
-    print(f"fidelity (rules, every case) {rep['fidelity']:.4f}; through the PDDL "
-          f"({rep['pddl_fidelity_cases']} sampled cases) {rep['pddl_fidelity']}")
+    through = (f"({rep['pddl_fidelity_cases']} sampled cases) {rep['pddl_fidelity']}"
+               if rep["pddl_fidelity"] is not None else "not measured (--pddl-fidelity-cases 0)")
+    print(f"fidelity (rules, every case) {rep['fidelity']:.4f}; through the PDDL {through}")
     for d in rep["disagreements"][:5]:
         print(f"  disagreement: {d}")
     print(f"wrote {where / 'domain.pddl'}, rules.json, report.json")
