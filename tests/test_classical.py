@@ -80,19 +80,32 @@ def test_conditional_form_satisficing(rules, planner):
     assert result.extra["compilers"] == ""  # taken as written
 
 
-def test_cached_domain_reads_only_the_problem(rules):
+def test_cached_domain_reads_only_the_problem(rules, monkeypatch, tmp_path):
     """cache_domain parses the domain once; each call builds its problem from the problem text."""
+    import hashlib
+
     import search.classical as classical
+    from unified_planning.io import PDDLReader
     from unified_planning.shortcuts import OneshotPlanner
 
     _require("fast-downward")
     domain, problem = _conditional(rules, UNCOVER_TWICE)
+    classical._DOMAINS.pop(hashlib.sha256(domain.encode()).hexdigest(), None)
+    log, real = tmp_path / "parses.txt", PDDLReader.parse_problem_string
+
+    def counted(self, domain_str, problem_str=None):  # the forked planner processes inherit it
+        with open(log, "a") as f:
+            f.write("domain-only\n" if problem_str is None else "domain+problem\n")
+        return real(self, domain_str, problem_str)
+
+    monkeypatch.setattr(PDDLReader, "parse_problem_string", counted)
     first = solve_pddl(domain, problem, planner="fast-downward", timeout_s=20, cache_domain=True)
     _check_plan(first, UNCOVER_TWICE)
     _, other = _conditional(rules, STICK_CARRIES_RIDER)
     second = solve_pddl(domain, other, planner="fast-downward", timeout_s=20, cache_domain=True)
     _check_plan(second, STICK_CARRIES_RIDER)
-    assert sum(1 for p in classical._DOMAINS.values() if p.name == classical.parsed_domain(domain).name) >= 1
+    assert log.read_text().split() == ["domain-only"]  # one parse of the domain, none of a problem
+    monkeypatch.undo()
     # the instance built on the cached domain is the problem unified-planning's reader gives
     built = classical._instance(classical.parsed_domain(domain), other)
     from unified_planning.io import PDDLReader
