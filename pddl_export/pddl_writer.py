@@ -20,9 +20,10 @@ Two encodings of the same rules (see /work/shared/PDDL_NOTES.md for what each pl
   `scene`, whose only object is the domain constant `the-scene`; a universal over one
   object is the formula itself (the equality keeps unified-planning from dropping the
   unused quantifier when it rewrites the domain). It is there for Fast Downward's
-  translator, which compiles a universal condition into one derived atom. Written plainly, the translator negates the disjunction of all add
-  conditions of each code atom, a product over their literals: on a 1,000-rule domain it
-  did not finish in 120 s, with the wrapper it translates a 3-object task in about 10 s.
+  translator, which compiles a universal condition into one derived atom. Written plainly,
+  the translator negates the disjunction of all add conditions of each code atom, a
+  product over their literals: on a 1,000-rule domain it did not finish in 120 s; with the
+  wrapper it translates a 3-object task in about 10 s.
 * STRIPS form (`strips_pddl`): for ONE problem, the joint states reachable from its initial
   state under the rules are enumerated (breadth first, bounded by max_states); each
   (state, real action) that changes something becomes the ground action

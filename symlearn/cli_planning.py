@@ -39,9 +39,7 @@ def _planner_list(text: str) -> list[str]:
 def cmd_train_transition(args: argparse.Namespace) -> int:
     from symlearn.transition import TransitionConfig, train_transition
 
-    over = {"epochs": args.epochs} if args.epochs is not None else {}
-    if getattr(args, "copy_prior", None) is not None:
-        over["copy_prior"] = args.copy_prior
+    over = {k: v for k, v in (("epochs", args.epochs), ("copy_prior", args.copy_prior)) if v is not None}
     cfg = TransitionConfig.from_preset(args.preset, **over)
     print(f"train-transition: preset {cfg.preset}, {cfg.epochs} epochs, seed {args.seed}, run {args.run}, "
           f"data {args.data}", file=sys.stderr)
