@@ -50,6 +50,7 @@ objects, a consistent generalization above.
 """
 from __future__ import annotations
 
+import functools
 from collections import Counter
 from dataclasses import dataclass, field
 from typing import Mapping, Sequence
@@ -194,9 +195,9 @@ class RuleSet:
     def n_rules(self) -> int:
         return len(self.rules)
 
-    @property
+    @functools.cached_property
     def codes(self) -> tuple[int, ...]:
-        """Every code the vocabulary or a rule mentions, sorted (the PDDL predicates)."""
+        """Every code the vocabulary or a rule mentions, sorted (the PDDL predicates); computed once."""
         out = set(self.vocabulary)
         for r in self.rules:
             out |= {r.code_from, r.code_to, *r.bounds()}
