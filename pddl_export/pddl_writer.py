@@ -215,7 +215,8 @@ def conditional_domain(rules: RuleSet, model_hash: str, name: str = "symlearn") 
     return "\n".join(lines)
 
 
-def _checked_task(rules: RuleSet, init: Sequence[int], goal: SymbolicGoal | Sequence[int | None]) -> tuple[tuple[int, ...], SymbolicGoal]:
+def checked_task(rules: RuleSet, init: Sequence[int], goal: SymbolicGoal | Sequence[int | None]) -> tuple[tuple[int, ...], SymbolicGoal]:
+    """(init codes, goal) checked against the rules' vocabulary; ValueError names the problem."""
     init_t = tuple(int(c) for c in init)
     goal_g = goal if isinstance(goal, SymbolicGoal) else SymbolicGoal(tuple(goal))
     if not init_t:
@@ -244,7 +245,7 @@ def problem_pddl(
     domain_name: str = "symlearn",
 ) -> str:
     """Problem text for the conditional form: objects o0.., their codes, the fixed goal codes."""
-    init_t, goal_g = _checked_task(rules, init, goal)
+    init_t, goal_g = checked_task(rules, init, goal)
     bits = rules.bits
     objs = " ".join(object_name(i) for i in range(len(init_t)))
     facts = " ".join(f"({code_predicate(c, bits)} {object_name(i)})" for i, c in enumerate(init_t))
@@ -318,7 +319,7 @@ def strips_pddl(
     max_states: int = 100_000,
 ) -> StripsTask:
     """Grounded STRIPS domain + problem over the states reachable from `init` (see module doc)."""
-    init_t, goal_g = _checked_task(rules, init, goal)
+    init_t, goal_g = checked_task(rules, init, goal)
     bits = rules.bits
     states, edges = reachable_transitions(rules, init_t, max_states)
     objs = [object_name(i) for i in range(len(init_t))]

@@ -1,0 +1,166 @@
+"""Fast Downward and SymK search components on a directly written SAS+ task, as a PlanResult.
+
+`solve_sas` writes the task of pddl_export.sas_writer to a temporary folder and runs the
+`downward` search binary shipped in the up-fast-downward or up-symk wheel (the planners that
+unified-planning calls, minus their translator, which takes seconds to minutes on the
+learned domain) with an argument list, a wall-clock limit and an address-space limit.
+SymK is a fork of Fast Downward with symbolic (BDD) search and reads the same format.
+The plan is read back, replayed with the rules (it must reach the goal, else the encoding
+is wrong and the result is an ERROR) and reported with the planner's own times: `fd_search_time_s` (search only) and `fd_total_time_s` (reading the
+task + search), next to `planner_time_s` (the process, wall clock) and `sas_write_time_s`.
+
+    >>> r = solve_sas(SASEncoder(rules), [3, 7], [5, None], "fast-downward-sas", 10)  # doctest: +SKIP
+    >>> r.status, r.plan, r.extra["fd_search_time_s"]                                 # doctest: +SKIP
+    (<PlanStatus.SOLVED: 'solved'>, (4, 30), 0.00021)
+"""
+from __future__ import annotations
+
+import importlib.util
+import math
+import re
+import subprocess
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from pddl_export.pddl_writer import action_id_from_name, write_text_atomic
+from pddl_export.rules import apply_rules
+from pddl_export.sas_writer import SASEncoder, TaskTooLargeError
+from search.result import PlanResult, PlanStatus
+from search.symbolic import SymbolicGoal
+
+
+
+@dataclass(frozen=True)
+class SASPlanner:
+    """A search configuration of one Fast Downward-family binary."""
+
+    package: str  # the Python package that ships the binary
+    search: str  # the --search argument
+    optimal: bool  # guarantees a shortest plan (unit costs)
+
+
+SAS_PLANNERS = {
+    "fast-downward-sas": SASPlanner("up_fast_downward", "let(hff, ff(), lazy_greedy([hff], preferred=[hff]))", False),
+    "fast-downward-sas-opt": SASPlanner("up_fast_downward", "astar(blind())", True),
+    "symk-sas": SASPlanner("up_symk", "sym_bd()", True),  # symbolic bidirectional uniform-cost search
+}
+_BINARY_DIRS = {"up_fast_downward": "downward", "up_symk": "symk"}
+MEMORY_LIMIT_MB = 4096
+
+_TIME_RE = {k: re.compile(rf"\] {k}: ([0-9.eE+-]+)s") for k in ("Search time", "Total time")}
+_EXPANDED_RE = re.compile(r"Expanded (\d+) state")
+_EXIT = {11: (PlanStatus.UNSOLVABLE, "no plan exists (search space exhausted)"),  # Fast Downward's exit codes
+         12: (PlanStatus.UNSOLVABLE, "search space exhausted by an incomplete search (no proof)"),
+         22: (PlanStatus.ERROR, "ran out of memory"),
+         23: (PlanStatus.TIMEOUT, "ran out of time"),
+         33: (PlanStatus.ERROR, "rejected the SAS+ input"),
+         34: (PlanStatus.ERROR, "does not support this search on the task")}
+
+
+def search_binary(package: str = "up_fast_downward") -> Path | None:
+    """The `downward` search binary shipped in `package` (up_fast_downward or up_symk), or None."""
+    spec = importlib.util.find_spec(package)
+    if spec is None or not spec.submodule_search_locations or package not in _BINARY_DIRS:
+        return None
+    root = Path(list(spec.submodule_search_locations)[0]) / _BINARY_DIRS[package]
+    path = root / "builds" / "release" / "bin" / "downward"
+    return path if path.is_file() else None
+
+
+def _limit_memory(pid: int, mb: int) -> None:
+    """Cap the address space of a started process (after the start, so Python can vfork)."""
+    try:
+        import resource
+
+        resource.prlimit(pid, resource.RLIMIT_AS, (mb << 20, mb << 20))
+    except (ImportError, AttributeError, OSError, ProcessLookupError):  # not Linux, or it already ended
+        pass
+
+
+def _error(planner: str, status: PlanStatus, t0: float, message: str, **extra) -> PlanResult:
+    return PlanResult(planner=planner, status=status, plan=(), predicted_states=(), expansions=None,
+                      planning_time_s=time.perf_counter() - t0, message=" ".join(message.split())[:300], extra=extra)
+
+
+def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Sequence[int | None], planner: str,
+              timeout_s: float, *, memory_mb: int = MEMORY_LIMIT_MB, write_to: Path | None = None) -> PlanResult:
+    """Plan from init to goal codes with a SAS+ planner (SAS_PLANNERS); failures come back as a status.
+
+    ValueError for a bad timeout; unknown codes, an unknown planner, a missing binary, a crash,
+    a time-out or a task too large are PlanResult statuses with a one-line message. With
+    write_to, the task is also saved there (e.g. RUN/plans/task.sas).
+    """
+    t0 = time.perf_counter()
+    if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
+        raise ValueError(f"timeout_s must be a positive number, got {timeout_s!r}")
+    if planner not in SAS_PLANNERS:
+        return _error(planner or "unknown", PlanStatus.ERROR, t0,
+                      f"unknown planner {planner!r}; known: {', '.join(SAS_PLANNERS)}")
+    spec = SAS_PLANNERS[planner]
+    binary = search_binary(spec.package)
+    if binary is None:
+        return _error(planner, PlanStatus.ERROR, t0, f"the search binary of {spec.package} was not found "
+                      f"(pip install {spec.package.replace('_', '-')})")
+    try:
+        task = encoder.task(init, goal)
+    except (ValueError, TaskTooLargeError) as e:
+        return _error(planner, PlanStatus.ERROR, t0, str(e))
+    goal_g = goal if isinstance(goal, SymbolicGoal) else SymbolicGoal(tuple(goal))
+    write_s = time.perf_counter() - t0
+    extra = {"sas_write_time_s": round(write_s, 6), "sas_variables": task.n_variables,
+             "sas_operators": task.n_operators, "sas_effects": task.n_effects, "sas_axioms": task.n_axioms}
+    if write_to is not None:
+        write_text_atomic(Path(write_to), task.text)
+    with tempfile.TemporaryDirectory(prefix="symlearn-fd-") as tmp:
+        sas_path, plan_path = Path(tmp) / "task.sas", Path(tmp) / "plan"
+        sas_path.write_text(task.text)
+        args = [str(binary), "--search", spec.search, "--internal-plan-file", str(plan_path)]
+        t1 = time.perf_counter()
+        try:
+            with open(sas_path) as stdin:
+                proc = subprocess.Popen(args, stdin=stdin, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                        text=True, cwd=tmp, start_new_session=True)
+        except OSError as e:
+            return _error(planner, PlanStatus.ERROR, t0, f"could not run {planner}: {e}", **extra)
+        if memory_mb:
+            _limit_memory(proc.pid, memory_mb)
+        try:
+            log, err = proc.communicate(timeout=max(timeout_s - write_s, 1e-3))
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.communicate()
+            return _error(planner, PlanStatus.TIMEOUT, t0, f"{planner} hit the {timeout_s:g} s time limit "
+                          "(process killed)", planner_time_s=time.perf_counter() - t1, **extra)
+        extra["planner_time_s"] = time.perf_counter() - t1
+        for key, name in (("Search time", "fd_search_time_s"), ("Total time", "fd_total_time_s")):
+            found = _TIME_RE[key].findall(log)
+            if found:
+                extra[name] = float(found[-1])
+        expanded = _EXPANDED_RE.findall(log)
+        expansions = int(expanded[-1]) if expanded else None
+        if proc.returncode != 0 or not plan_path.is_file():
+            status, why = _EXIT.get(proc.returncode, (PlanStatus.ERROR, f"exited with code {proc.returncode}"))
+            why = why if status is PlanStatus.UNSOLVABLE else f"{planner} {why}"
+            tail = (err.strip().splitlines() or [""])[-1]
+            return _error(planner, status, t0, f"{why}{': ' + tail if status is PlanStatus.ERROR and tail else ''}",
+                          **extra)
+        names = [ln.strip()[1:-1] for ln in plan_path.read_text().splitlines() if ln.strip().startswith("(")]
+    try:
+        plan = tuple(action_id_from_name(n) for n in names)
+    except ValueError as e:
+        return _error(planner, PlanStatus.ERROR, t0, f"{planner} returned an unknown operator: {e}", **extra)
+    states = [np.asarray([int(c) for c in init], np.int64)]
+    for a in plan:
+        states.append(apply_rules(encoder.rules, states[-1], a))
+    if not goal_g.satisfied(states[-1])[0]:
+        return _error(planner, PlanStatus.ERROR, t0, f"the plan does not reach the goal under the rules "
+                      f"(the SAS+ encoding disagrees with apply_rules)", **extra)
+    return PlanResult(planner=planner, status=PlanStatus.SOLVED, plan=plan,
+                      predicted_states=tuple(tuple(int(c) for c in s) for s in states), expansions=expansions,
+                      planning_time_s=time.perf_counter() - t0,
+                      extra=dict(extra, optimal=spec.optimal))
