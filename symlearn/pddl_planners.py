@@ -2,7 +2,9 @@
 
 Each planner writes the problem for the start and goal codes (and, for STRIPS-only planners,
 the grounded STRIPS form of the domain for this problem), calls the planner through
-unified-planning (search.classical), and checks the plan against the network: if rolling the
+unified-planning (search.classical), or, for the `-sas` planners, writes the rules for this
+problem as a SAS+ task and runs Fast Downward's or SymK's search on it without a translator
+(search.sas_planners), and checks the plan against the network: if rolling the
 transition network along the plan gives other states than the PDDL predicted, the result is
 marked `rules_vs_net`. PDDL writing time and the planner's own time are reported separately.
 
@@ -18,7 +20,9 @@ import numpy as np
 
 from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl, write_text_atomic
 from pddl_export.rules import RuleSet
+from pddl_export.sas_writer import SASEncoder
 from search.classical import solve_pddl
+from search.sas_planners import solve_sas
 from search.result import PlanResult, PlanStatus
 from search.symbolic import SymbolicGoal, TransitionFn
 from symlearn.benchmark import PLANNERS, register_planner
@@ -31,6 +35,9 @@ PDDL_PLANNERS = {
     "pyperplan": ("pyperplan", "strips"),
     "fast-downward-opt": ("fast-downward-opt", "strips"),
     "fast-downward-blind": ("fast-downward-blind", "conditional"),
+    "fast-downward-sas": ("fast-downward-sas", "sas"),  # Fast Downward's search on a direct SAS+ task
+    "fast-downward-sas-opt": ("fast-downward-sas-opt", "sas"),
+    "symk-sas": ("symk-sas", "sas"),  # SymK's symbolic search on the same SAS+ task
 }
 
 
@@ -50,15 +57,27 @@ def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Pat
     """A benchmark planner function for registry name `name` over the exported rules.
 
     With `write_dir`, every problem it writes is also saved there (problem.pddl, then
-    problem_2.pddl for a replan, ...; STRIPS planners save their grounded domain beside it).
+    problem_2.pddl for a replan, ...; STRIPS planners save their grounded domain beside it,
+    SAS+ planners the task.sas they ran).
     """
     engine, form = PDDL_PLANNERS[name]
     domain = conditional_domain(rules, model_hash) if form == "conditional" else None
+    encoder = SASEncoder(rules) if form == "sas" else None
     calls = [0]
 
     def plan(transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
         t0 = time.perf_counter()
         init = [int(c) for c in start]
+        if encoder is not None:  # the SAS+ task is saved next to the same problem in PDDL, for reading
+            prob_path = _next_path("problem", ".pddl")
+            if prob_path is not None:
+                try:
+                    write_text_atomic(prob_path, problem_pddl(rules, init, goal, model_hash))
+                except ValueError:
+                    pass  # unknown codes: solve_sas reports them
+            sas_path = None if prob_path is None else prob_path.with_name(prob_path.name.replace("problem", "task")
+                                                                          .replace(".pddl", ".sas"))
+            return _checked(transition, solve_sas(encoder, init, goal, engine, timeout_s, write_to=sas_path))
         try:
             if form == "strips":
                 task = strips_pddl(rules, init, goal, model_hash)
@@ -68,19 +87,30 @@ def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Pat
         except (ValueError, RuntimeError) as e:  # codes outside the vocabulary, too many states
             return PlanResult(planner=name, status=PlanStatus.ERROR, plan=(), predicted_states=(), expansions=None,
                               planning_time_s=time.perf_counter() - t0, message=" ".join(str(e).split())[:300])
-        if write_dir is not None:
-            calls[0] += 1
-            suffix = "" if calls[0] == 1 else f"_{calls[0]}"
-            Path(write_dir).mkdir(parents=True, exist_ok=True)
-            write_text_atomic(Path(write_dir) / f"problem{suffix}.pddl", prob)
+        prob_path = _next_path("problem", ".pddl")
+        if prob_path is not None:
+            write_text_atomic(prob_path, prob)
             if form == "strips":
-                write_text_atomic(Path(write_dir) / f"domain_strips{suffix}.pddl", dom)
+                write_text_atomic(prob_path.with_name(prob_path.name.replace("problem", "domain_strips")), dom)
         write_s = time.perf_counter() - t0
         res = solve_pddl(dom, prob, engine, max(timeout_s - write_s, 0.001), cache_domain=form == "conditional")
-        extra = dict(res.extra, pddl_write_time_s=round(write_s, 5))
+        res = dataclasses.replace(res, planning_time_s=write_s + res.planning_time_s,
+                                  extra=dict(res.extra, pddl_write_time_s=round(write_s, 5)))
+        return _checked(transition, res)
+
+    def _next_path(stem: str, suffix: str) -> Path | None:
+        """RUN's write_dir/problem.pddl, then problem_2.pddl for a replan, ... (None without write_dir)."""
+        if write_dir is None:
+            return None
+        calls[0] += 1
+        Path(write_dir).mkdir(parents=True, exist_ok=True)
+        return Path(write_dir) / (f"{stem}{suffix}" if calls[0] == 1 else f"{stem}_{calls[0]}{suffix}")
+
+    def _checked(transition: TransitionFn, res: PlanResult) -> PlanResult:
+        extra = dict(res.extra)
         if res.found:
             extra["rules_vs_net"] = not network_agrees(transition, res)
-        return dataclasses.replace(res, planner=name, planning_time_s=write_s + res.planning_time_s, extra=extra)
+        return dataclasses.replace(res, planner=name, extra=extra)
 
     return plan
 

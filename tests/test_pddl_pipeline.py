@@ -64,10 +64,11 @@ def test_pddl_planner_plans_on_exported_rules_and_agrees_with_net(run):
     from search.symbolic import SymbolicGoal
 
     goal = SymbolicGoal((goal_code,))
-    for name in ("fast-downward", "pyperplan"):
+    for name in ("fast-downward", "pyperplan", "fast-downward-sas"):
         res = make_pddl_planner(rules, model_hash, name)(tr, start, goal, 30.0)
         assert res.status is PlanStatus.SOLVED, res.message
-        assert "pddl_write_time_s" in res.extra and res.extra["rules_vs_net"] is False
+        write_key = "sas_write_time_s" if name.endswith("-sas") else "pddl_write_time_s"
+        assert write_key in res.extra and res.extra["rules_vs_net"] is False
         assert network_agrees(tr, res)
 
 
