@@ -30,7 +30,9 @@ Two encodings of the same rules (see /work/shared/PDDL_NOTES.md for what each pl
   `pick-P-release-R-sN` (N = the state's index) whose precondition is the full joint
   assignment and whose effect changes exactly the objects that change. Objects are domain
   constants; only :strips and :typing are needed, so every planner (pyperplan,
-  fast-downward-opt) takes it. Its size grows with the reachable state space.
+  fast-downward-opt) takes it. Its size grows with the reachable state space. The task also
+  carries its states and edges, from which search.classical.strips_problem builds the same
+  problem for unified-planning without its PDDL reader.
 
 Names: codes are predicates `code-<bits, MSB first>` (`code-00011011`), objects `o0, o1, ...`.
 Every function returns a string; write_text_atomic puts one on disk.
@@ -265,12 +267,18 @@ class StateLimitError(RuntimeError):
 
 @dataclass(frozen=True)
 class StripsTask:
-    """A grounded STRIPS domain and problem for one initial state."""
+    """A grounded STRIPS domain and problem for one initial state, as text and as the data behind it."""
 
     domain: str
     problem: str
     n_states: int  # reachable joint states
     n_actions: int  # ground actions (state, real action) that change something
+    states: tuple[tuple[int, ...], ...] = ()  # the reachable joint states, states[0] the initial one
+    edges: tuple[tuple[int, int, int], ...] = ()  # ground actions: (state index, action id, next state index)
+    goal: tuple[int | None, ...] = ()
+    bits: int = 0
+    codes: tuple[int, ...] = ()  # the code predicates the domain declares
+    name: str = "task"  # the problem's PDDL name
 
     def __post_init__(self) -> None:
         if self.n_states < 1 or self.n_actions < 0:
@@ -347,7 +355,8 @@ def strips_pddl(
     prob += [f"(define (problem {pddl_name(name)})", f"  (:domain {pddl_name(domain_name)})",
              f"  (:init {' '.join(atom(c, k) for k, c in enumerate(init_t))})",
              f"  {_goal_text(goal_g, bits)})", ""]
-    return StripsTask("\n".join(dom), "\n".join(prob), len(states), len(actions))
+    return StripsTask("\n".join(dom), "\n".join(prob), len(states), len(actions), states=tuple(states),
+                      edges=tuple(edges), goal=goal_g.codes, bits=bits, codes=tuple(codes), name=pddl_name(name))
 
 
 # ----------------------------------------------------------------------------- files

@@ -35,7 +35,8 @@ import warnings
 from dataclasses import dataclass
 from typing import Any
 
-from pddl_export.pddl_writer import OBJECT_TYPE, action_id_from_name, code_from_predicate, object_index
+from pddl_export.pddl_writer import (OBJECT_TYPE, StripsTask, action_id_from_name, action_name, code_from_predicate,
+                                     code_predicate, object_index, object_name)
 from search.result import PlanResult, PlanStatus
 
 
@@ -134,6 +135,82 @@ def _predicted_states(problem: Any, plan: Any) -> tuple[tuple[tuple[int, ...], .
     return tuple(states), ""
 
 
+def strips_problem(task: StripsTask) -> Any:
+    """unified-planning's Problem for a grounded STRIPS task, built from its data without the PDDL reader.
+
+    The same problem as reading task.domain and task.problem (tests compare the two); the reader
+    does not finish within a minute on the ~12 MB of a 2-object task of the learned rules.
+    """
+    from unified_planning.shortcuts import BoolType, Fluent, InstantaneousAction, Object, Problem, UserType
+
+    if not task.states or not task.bits:
+        raise ValueError("the STRIPS task carries no states; make it with pddl_export.pddl_writer.strips_pddl")
+    obj_type = UserType(OBJECT_TYPE)
+    n = len(task.states[0])
+    objects = [Object(object_name(i), obj_type) for i in range(n)]
+    problem = Problem(task.name)
+    fluents = {}
+    for c in sorted(set(task.codes) | {c for c in task.goal if c is not None}):
+        fluents[c] = Fluent(code_predicate(c, task.bits), BoolType(), o=obj_type)
+        problem.add_fluent(fluents[c], default_initial_value=False)
+    problem.add_objects(objects)
+    atoms: dict[tuple[int, int], Any] = {}
+
+    def atom(code: int, i: int) -> Any:
+        if (code, i) not in atoms:
+            atoms[code, i] = fluents[code](objects[i])
+        return atoms[code, i]
+
+    actions = []
+    for i, a, j in task.edges:
+        act = InstantaneousAction(f"{action_name(a)}-s{i}")
+        pre, post = task.states[i], task.states[j]
+        for k, c in enumerate(pre):
+            act.add_precondition(atom(c, k))
+        for k, (c, d) in enumerate(zip(pre, post)):
+            if c != d:
+                act.add_effect(atom(c, k), False)
+                act.add_effect(atom(d, k), True)
+        actions.append(act)
+    if len({a.name for a in actions}) != len(actions):
+        raise ValueError("the STRIPS task has two ground actions with one name")
+    listed = getattr(problem, "_actions", None)
+    if isinstance(listed, list) and not listed:
+        # Problem.add_action compares each new name with every action's (quadratic: hours for the
+        # 64,000 actions of a 2-object task); the names are checked unique above.
+        listed.extend(actions)
+    else:
+        problem.add_actions(actions)
+    for k, c in enumerate(task.states[0]):
+        problem.set_initial_value(atom(c, k), True)
+    for k, c in enumerate(task.goal):
+        if c is not None:
+            problem.add_goal(atom(c, k))
+    return problem
+
+
+_FEW_ACTIONS = 1000  # above this many actions, plans are validated on the problem cut to the plan's actions
+
+
+def _with_only_actions(problem: Any, plan: Any) -> Any:
+    """The problem with the same fluents, objects, initial state and goals, and only the plan's actions."""
+    from unified_planning.model import Problem
+
+    sub = Problem(problem.name, problem.environment)
+    for f in problem.fluents:
+        sub.add_fluent(f, default_initial_value=problem.fluents_defaults.get(f))
+    sub.add_objects(problem.all_objects)
+    used = {ai.action.name for ai in plan.actions}
+    for a in problem.actions:
+        if a.name in used:
+            sub.add_action(a)
+    for fluent, value in problem.explicit_initial_values.items():
+        sub.set_initial_value(fluent, value)
+    for g in problem.goals:
+        sub.add_goal(g)
+    return sub
+
+
 _DOMAINS: dict[str, Any] = {}  # sha256 of a domain text -> its unified-planning problem without objects
 
 
@@ -199,7 +276,7 @@ def _instance(domain: Any, problem_text: str) -> Any | None:
 
 
 def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: float,
-                compile_conditional_effects: bool, domain: Any = None) -> PlanResult:
+                compile_conditional_effects: bool, domain: Any = None, prebuilt: Any = None) -> PlanResult:
     """The whole pipeline in this process; never raises (ERROR instead)."""
     t0 = time.perf_counter()
     deadline = t0 + timeout_s
@@ -216,7 +293,7 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
     if spec.engine not in env.factory.engines:
         return _result(planner, PlanStatus.ERROR, t0, f"engine {spec.engine!r} is not installed")
     engine_cls = env.factory.engine(spec.engine)
-    original = _instance(domain, problem_text) if domain is not None else None
+    original = prebuilt if prebuilt is not None else _instance(domain, problem_text) if domain is not None else None
     if original is None:
         try:
             original = PDDLReader(env).parse_problem_string(domain_text, problem_text)
@@ -225,7 +302,8 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
     t_parse = time.perf_counter() - t0
 
     problem, chain, names = original, [], []
-    if (original.kind.has_conditional_effects() and not compile_conditional_effects
+    pkind = original.kind  # computed once per problem: it walks every action (11 s for 64,000 of them)
+    if (pkind.has_conditional_effects() and not compile_conditional_effects
             and not engine_cls.supported_kind().has_conditional_effects()):
         return _result(planner, PlanStatus.ERROR, t0, f"{planner} does not support CONDITIONAL_EFFECTS; use the "
                        "grounded STRIPS form (pddl_export.pddl_writer.strips_pddl) or compile_conditional_effects=True",
@@ -234,19 +312,21 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
         if spec.optimal:  # ask for a shortest plan explicitly, so the status says SOLVED_OPTIMALLY
             with_metric = original.clone()
             with_metric.add_quality_metric(MinimizeSequentialPlanLength())
-            if engine_cls.supports(with_metric.kind):
-                problem = with_metric
+            metric_kind = with_metric.kind
+            if engine_cls.supports(metric_kind):
+                problem, pkind = with_metric, metric_kind
         for kind_name, needed in _compile_steps(compile_conditional_effects):
-            if engine_cls.supports(problem.kind):
+            if engine_cls.supports(pkind):
                 break
-            if not needed(problem, problem.kind):
+            if not needed(problem, pkind):
                 continue
             kind = CompilationKind[kind_name]
-            with Compiler(problem_kind=problem.kind, compilation_kind=kind) as compiler:
+            with Compiler(problem_kind=pkind, compilation_kind=kind) as compiler:
                 compiled = compiler.compile(problem, kind)
             chain.append(compiled)
             names.append(kind_name.lower())
             problem = compiled.problem
+            pkind = problem.kind
             if time.perf_counter() > deadline:
                 return _result(planner, PlanStatus.TIMEOUT, t0, f"time limit reached while compiling ({kind_name.lower()})")
     except Exception as e:  # noqa: BLE001
@@ -255,8 +335,8 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
     extra: dict[str, Any] = {
         "engine": spec.engine, "parse_time_s": t_parse, "compile_time_s": t_compile,
         "compilers": ",".join(names), "n_actions": len(problem.actions)}
-    if not engine_cls.supports(problem.kind):
-        missing = sorted(set(problem.kind.features) - set(engine_cls.supported_kind().features))
+    if not engine_cls.supports(pkind):
+        missing = sorted(set(pkind.features) - set(engine_cls.supported_kind().features))
         hint = ("; use the grounded STRIPS form (pddl_export.pddl_writer.strips_pddl)"
                 if "CONDITIONAL_EFFECTS" in missing else "")
         return _result(planner, PlanStatus.ERROR, t0, f"{planner} does not support {', '.join(missing)}{hint}", **extra)
@@ -295,14 +375,18 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
         plan = res.plan
         for compiled in reversed(chain):
             plan = plan.replace_action_instances(compiled.map_back_action_instance)
-        with PlanValidator(problem_kind=original.kind, plan_kind=plan.kind) as validator:
-            check = validator.validate(original, plan)
+        # A sequential plan's validity depends on the initial state, the goal and the actions it uses,
+        # so a large grounded problem is validated with only those (the validator and the simulator
+        # recompute the problem kind, a walk over every action, several times).
+        checked = original if len(original.actions) <= _FEW_ACTIONS else _with_only_actions(original, plan)
+        with PlanValidator(problem_kind=checked.kind, plan_kind=plan.kind) as validator:
+            check = validator.validate(checked, plan)
         extra["validate_time_s"] = time.perf_counter() - t2
         if check.status != ValidationResultStatus.VALID:
             reason = getattr(check, "reason", None) or getattr(check, "inapplicable_action", None) or ""
             return _result(planner, PlanStatus.ERROR, t0, f"plan failed validation on the original problem {reason}", **extra)
         ids = tuple(action_id_from_name(ai.action.name) for ai in plan.actions)
-        states, note = _predicted_states(original, plan)
+        states, note = _predicted_states(checked, plan)
     except Exception as e:  # noqa: BLE001
         return _result(planner, PlanStatus.ERROR, t0, f"plan mapping/validation failed: {type(e).__name__}: {e}", **extra)
     if note:
@@ -336,6 +420,7 @@ def solve_pddl(
     compile_conditional_effects: bool = False,
     grace_s: float = 3.0,
     cache_domain: bool = False,
+    problem: Any = None,
 ) -> PlanResult:
     """Run one classical planner on PDDL text; every failure comes back as a status, never raised.
 
@@ -343,7 +428,8 @@ def solve_pddl(
     effects), "fast-downward-blind" (blind A*, optimal, takes conditional effects), "symk", "symk-opt",
     "pyperplan". The call takes at most about timeout_s + grace_s seconds. With cache_domain, the domain
     is parsed once in this process (parsed_domain; the first call's time includes it, outside
-    the guard) and each call reads only the problem.
+    the guard) and each call reads only the problem. With `problem` (a unified-planning Problem
+    equal to the texts, e.g. strips_problem), nothing is parsed.
     """
     t0 = time.perf_counter()
     if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
@@ -372,7 +458,7 @@ def solve_pddl(
     ctx = _context()
     recv, send = ctx.Pipe(duplex=False)
     proc = ctx.Process(target=_worker, args=(send, domain_text, problem_text, name, float(timeout_s),
-                                             compile_conditional_effects, domain), daemon=True)
+                                             compile_conditional_effects, domain, problem), daemon=True)
     answer: Any = None  # stays None if the child dies (or on an exception here); "late" on the guard
     proc.start()
     send.close()

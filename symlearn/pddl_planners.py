@@ -21,7 +21,7 @@ import numpy as np
 from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl, write_text_atomic
 from pddl_export.rules import RuleSet
 from pddl_export.sas_writer import SASEncoder
-from search.classical import solve_pddl
+from search.classical import solve_pddl, strips_problem
 from search.sas_planners import solve_sas
 from search.result import PlanResult, PlanStatus
 from search.symbolic import SymbolicGoal, TransitionFn
@@ -79,9 +79,10 @@ def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Pat
                                                                           .replace(".pddl", ".sas"))
             return _checked(transition, solve_sas(encoder, init, goal, engine, timeout_s, write_to=sas_path))
         try:
-            if form == "strips":
+            prebuilt = None
+            if form == "strips":  # built directly: unified-planning's reader is too slow for its size
                 task = strips_pddl(rules, init, goal, model_hash)
-                dom, prob = task.domain, task.problem
+                dom, prob, prebuilt = task.domain, task.problem, strips_problem(task)
             else:
                 dom, prob = domain, problem_pddl(rules, init, goal, model_hash)
         except (ValueError, RuntimeError) as e:  # codes outside the vocabulary, too many states
@@ -93,7 +94,8 @@ def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Pat
             if form == "strips":
                 write_text_atomic(prob_path.with_name(prob_path.name.replace("problem", "domain_strips")), dom)
         write_s = time.perf_counter() - t0
-        res = solve_pddl(dom, prob, engine, max(timeout_s - write_s, 0.001), cache_domain=form == "conditional")
+        res = solve_pddl(dom, prob, engine, max(timeout_s - write_s, 0.001), cache_domain=form == "conditional",
+                         problem=prebuilt)
         res = dataclasses.replace(res, planning_time_s=write_s + res.planning_time_s,
                                   extra=dict(res.extra, pddl_write_time_s=round(write_s, 5)))
         return _checked(transition, res)

@@ -5,6 +5,7 @@ Each planner test skips, with the reason, when that engine is not installed.
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass
 
@@ -14,7 +15,7 @@ import pytest
 from pddl_export.enumeration import enumerate_transitions
 from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl
 from pddl_export.rules import distil_rules
-from search.classical import PLANNERS, PlannerSpec, solve_pddl
+from search.classical import PLANNERS, PlannerSpec, solve_pddl, strips_problem
 from search.result import PlanStatus
 from search.symbolic import SymbolicGoal
 from test_pddl_export import FAR, NEAR, RIDER, RIDER_M, STICK, TOY_VOCAB, UNDER, ToyRobot
@@ -143,6 +144,35 @@ def test_strips_form_every_planner(rules, planner):
         assert len(result.plan) == UNCOVER_TWICE.optimal_length and result.extra["optimal"]
     if planner.startswith("fast-downward"):
         assert result.expansions is not None and result.expansions >= 0
+
+
+def _conjuncts(conditions) -> list[str]:
+    """The atoms of a list of conditions, with conjunctions opened, sorted as text."""
+    out = []
+    for c in conditions:
+        out += [str(x) for x in c.args] if c.is_and() else [str(c)]
+    return sorted(out)
+
+
+def test_strips_problem_built_directly_equals_the_parsed_one(rules):
+    from unified_planning.io import PDDLReader
+
+    p = UNCOVER_TWICE
+    task = strips_pddl(rules, p.init, p.goal, "test", name=p.name)
+    built, parsed = strips_problem(task), PDDLReader().parse_problem_string(task.domain, task.problem)
+    assert built.name == parsed.name and len(built.actions) == len(parsed.actions) == task.n_actions
+    for a in built.actions:
+        b = parsed.action(a.name)
+        assert _conjuncts(a.preconditions) == _conjuncts(b.preconditions), a.name
+        assert sorted(map(str, a.effects)) == sorted(map(str, b.effects)), a.name
+    assert {str(k): str(v) for k, v in built.initial_values.items()} == \
+        {str(k): str(v) for k, v in parsed.initial_values.items()}
+    assert _conjuncts(built.goals) == _conjuncts(parsed.goals)
+    if _installed("pyperplan"):
+        result = solve_pddl("", "", planner="pyperplan", timeout_s=20, problem=built)
+        _check_plan(result, p)
+    with pytest.raises(ValueError, match="no states"):
+        strips_problem(dataclasses.replace(task, states=()))
 
 
 def test_conditional_form_refused_by_fd_opt_with_a_reason(rules):
