@@ -175,6 +175,46 @@ def test_strips_problem_built_directly_equals_the_parsed_one(rules):
         strips_problem(dataclasses.replace(task, states=()))
 
 
+def test_validation_on_the_plans_actions_decides_like_the_whole_problem(rules):
+    """_with_only_actions keeps init, goal and the used actions: valid plans stay valid, invalid ones invalid."""
+    from unified_planning.plans import ActionInstance, SequentialPlan
+    from unified_planning.shortcuts import PlanValidator
+
+    from search.classical import _with_only_actions
+
+    p = UNCOVER_TWICE
+    whole = strips_problem(strips_pddl(rules, p.init, p.goal, "test"))
+    result = solve_pddl("", "", planner="fast-downward", timeout_s=20, problem=whole)
+    assert result.status is PlanStatus.SOLVED, result.message
+    names = [a.name for a in whole.actions]
+    good = SequentialPlan([ActionInstance(whole.action(n)) for n in _plan_names(whole, result.plan)])
+    bad = SequentialPlan(list(good.actions[:-1]))
+    shuffled = SequentialPlan(list(reversed(good.actions)))
+    for plan, want in ((good, "VALID"), (bad, "INVALID"), (shuffled, None)):
+        verdicts = []
+        for problem in (whole, _with_only_actions(whole, plan)):
+            with PlanValidator(problem_kind=problem.kind) as validator:
+                verdicts.append(validator.validate(problem, plan).status.name)
+        assert verdicts[0] == verdicts[1] and want in (None, verdicts[0]), verdicts
+    sub = _with_only_actions(whole, good)
+    assert len(sub.actions) == len({ai.action.name for ai in good.actions}) < len(names)
+
+
+def _plan_names(problem, plan_ids: tuple[int, ...]) -> list[str]:
+    """Ground action names of a STRIPS plan, replayed from the initial state through the problem's actions."""
+    from unified_planning.shortcuts import SequentialSimulator
+
+    out = []
+    with SequentialSimulator(problem) as sim:
+        state = sim.get_initial_state()
+        for a in plan_ids:
+            prefix = f"pick-{a // 6}-release-{a % 6}-s"
+            act = next(x for x in problem.actions if x.name.startswith(prefix) and sim.is_applicable(state, x))
+            out.append(act.name)
+            state = sim.apply(state, act)
+    return out
+
+
 def test_conditional_form_refused_by_fd_opt_with_a_reason(rules):
     _require("fast-downward-opt")
     result = solve_pddl(*_conditional(rules, STICK_CARRIES_RIDER), planner="fast-downward-opt", timeout_s=20)
