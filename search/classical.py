@@ -37,7 +37,7 @@ from typing import Any
 
 from pddl_export.pddl_writer import (OBJECT_TYPE, StripsTask, action_id_from_name, action_name, code_from_predicate,
                                      code_predicate, object_index, object_name)
-from search.result import PlanResult, PlanStatus
+from search.result import PlanResult, PlanStatus, failed, one_line
 
 
 @dataclass(frozen=True)
@@ -66,16 +66,6 @@ PLANNERS: dict[str, PlannerSpec] = {
 }
 
 _EXPANDED_RE = re.compile(r"Expanded (\d+) state", re.IGNORECASE)
-
-
-def _one_line(text: Any, limit: int = 300) -> str:
-    s = " ".join(str(text).split())
-    return s if len(s) <= limit else s[: limit - 3] + "..."
-
-
-def _result(planner: str, status: PlanStatus, t0: float, message: str = "", **extra: Any) -> PlanResult:
-    return PlanResult(planner=planner, status=status, plan=(), predicted_states=(), expansions=None,
-                      planning_time_s=time.perf_counter() - t0, message=_one_line(message), extra=extra)
 
 
 def _status_from_up(status: Any) -> PlanStatus:
@@ -287,25 +277,25 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
         from unified_planning.shortcuts import Compiler, MinimizeSequentialPlanLength, OneshotPlanner, PlanValidator
         from unified_planning.shortcuts import get_environment
     except ImportError as e:
-        return _result(planner, PlanStatus.ERROR, t0, f"unified-planning is not installed: {e}")
+        return failed(planner, PlanStatus.ERROR, t0, f"unified-planning is not installed: {e}")
     env = get_environment()
     env.credits_stream = None
     if spec.engine not in env.factory.engines:
-        return _result(planner, PlanStatus.ERROR, t0, f"engine {spec.engine!r} is not installed")
+        return failed(planner, PlanStatus.ERROR, t0, f"engine {spec.engine!r} is not installed")
     engine_cls = env.factory.engine(spec.engine)
     original = prebuilt if prebuilt is not None else _instance(domain, problem_text) if domain is not None else None
     if original is None:
         try:
             original = PDDLReader(env).parse_problem_string(domain_text, problem_text)
         except Exception as e:  # noqa: BLE001 - any parser failure is reported, not raised
-            return _result(planner, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}")
+            return failed(planner, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}")
     t_parse = time.perf_counter() - t0
 
     problem, chain, names = original, [], []
     pkind = original.kind  # computed once per problem: it walks every action (11 s for 64,000 of them)
     if (pkind.has_conditional_effects() and not compile_conditional_effects
             and not engine_cls.supported_kind().has_conditional_effects()):
-        return _result(planner, PlanStatus.ERROR, t0, f"{planner} does not support CONDITIONAL_EFFECTS; use the "
+        return failed(planner, PlanStatus.ERROR, t0, f"{planner} does not support CONDITIONAL_EFFECTS; use the "
                        "grounded STRIPS form (pddl_export.pddl_writer.strips_pddl) or compile_conditional_effects=True",
                        engine=spec.engine, parse_time_s=t_parse)
     try:
@@ -328,9 +318,9 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
             problem = compiled.problem
             pkind = problem.kind
             if time.perf_counter() > deadline:
-                return _result(planner, PlanStatus.TIMEOUT, t0, f"time limit reached while compiling ({kind_name.lower()})")
+                return failed(planner, PlanStatus.TIMEOUT, t0, f"time limit reached while compiling ({kind_name.lower()})")
     except Exception as e:  # noqa: BLE001
-        return _result(planner, PlanStatus.ERROR, t0, f"compilation failed: {type(e).__name__}: {e}")
+        return failed(planner, PlanStatus.ERROR, t0, f"compilation failed: {type(e).__name__}: {e}")
     t_compile = time.perf_counter() - t0 - t_parse
     extra: dict[str, Any] = {
         "engine": spec.engine, "parse_time_s": t_parse, "compile_time_s": t_compile,
@@ -339,11 +329,11 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
         missing = sorted(set(pkind.features) - set(engine_cls.supported_kind().features))
         hint = ("; use the grounded STRIPS form (pddl_export.pddl_writer.strips_pddl)"
                 if "CONDITIONAL_EFFECTS" in missing else "")
-        return _result(planner, PlanStatus.ERROR, t0, f"{planner} does not support {', '.join(missing)}{hint}", **extra)
+        return failed(planner, PlanStatus.ERROR, t0, f"{planner} does not support {', '.join(missing)}{hint}", **extra)
 
     remaining = deadline - time.perf_counter()
     if remaining <= 0:
-        return _result(planner, PlanStatus.TIMEOUT, t0, "time limit reached before planning", **extra)
+        return failed(planner, PlanStatus.TIMEOUT, t0, "time limit reached before planning", **extra)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -352,7 +342,7 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
                 res = engine.solve(problem, timeout=remaining if spec.native_timeout else None)
                 planner_time = time.perf_counter() - t1
     except Exception as e:  # noqa: BLE001
-        return _result(planner, PlanStatus.ERROR, t0, f"{planner} failed: {type(e).__name__}: {e}", **extra)
+        return failed(planner, PlanStatus.ERROR, t0, f"{planner} failed: {type(e).__name__}: {e}", **extra)
     extra.update(planner_time_s=planner_time, up_status=res.status.name,
                  optimal=res.status == PlanGenerationResultStatus.SOLVED_OPTIMALLY)
     logs = " ".join(m.message for m in (res.log_messages or []))
@@ -360,16 +350,16 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
     expansions = int(found[-1]) if found else None
     status = _status_from_up(res.status)
     if not spec.native_timeout and time.perf_counter() > deadline:
-        return _result(planner, PlanStatus.TIMEOUT, t0, f"{planner} ran past the {timeout_s:g} s limit "
+        return failed(planner, PlanStatus.TIMEOUT, t0, f"{planner} ran past the {timeout_s:g} s limit "
                        f"({planner_time:.3f} s; it has no time limit of its own)", **extra)
     if status is not PlanStatus.SOLVED:
         why = {PlanStatus.UNSOLVABLE: "no plan exists" if res.status == PlanGenerationResultStatus.UNSOLVABLE_PROVEN
                else "search space exhausted (no proof of unsolvability)",
                PlanStatus.TIMEOUT: f"{planner} hit the {timeout_s:g} s time limit"}.get(
                    status, f"{planner} ended with {res.status.name}")
-        return _result(planner, status, t0, why, **extra)
+        return failed(planner, status, t0, why, **extra)
     if res.plan is None:
-        return _result(planner, PlanStatus.ERROR, t0, f"{planner} reported {res.status.name} without a plan", **extra)
+        return failed(planner, PlanStatus.ERROR, t0, f"{planner} reported {res.status.name} without a plan", **extra)
     try:
         t2 = time.perf_counter()
         plan = res.plan
@@ -384,11 +374,11 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
         extra["validate_time_s"] = time.perf_counter() - t2
         if check.status != ValidationResultStatus.VALID:
             reason = getattr(check, "reason", None) or getattr(check, "inapplicable_action", None) or ""
-            return _result(planner, PlanStatus.ERROR, t0, f"plan failed validation on the original problem {reason}", **extra)
+            return failed(planner, PlanStatus.ERROR, t0, f"plan failed validation on the original problem {reason}", **extra)
         ids = tuple(action_id_from_name(ai.action.name) for ai in plan.actions)
         states, note = _predicted_states(checked, plan)
     except Exception as e:  # noqa: BLE001
-        return _result(planner, PlanStatus.ERROR, t0, f"plan mapping/validation failed: {type(e).__name__}: {e}", **extra)
+        return failed(planner, PlanStatus.ERROR, t0, f"plan mapping/validation failed: {type(e).__name__}: {e}", **extra)
     if note:
         extra["note"] = note
     return PlanResult(planner=planner, status=PlanStatus.SOLVED, plan=ids, predicted_states=states,
@@ -399,7 +389,7 @@ def _worker(conn: Any, *args: Any) -> None:
     try:
         result = _solve_here(*args).to_json()
     except BaseException as e:  # noqa: BLE001 - the parent must hear about anything
-        result = {"error": _one_line(f"{type(e).__name__}: {e}")}
+        result = {"error": one_line(f"{type(e).__name__}: {e}")}
     try:
         conn.send(result)
     finally:
@@ -438,7 +428,7 @@ def solve_pddl(
         raise ValueError(f"grace_s must be >= 0, got {grace_s!r}")
     name = str(planner)
     if name not in PLANNERS:
-        return _result(name or "unknown", PlanStatus.ERROR, t0, f"unknown planner {name!r}; known: {', '.join(PLANNERS)}",
+        return failed(name or "unknown", PlanStatus.ERROR, t0, f"unknown planner {name!r}; known: {', '.join(PLANNERS)}",
                        total_time_s=time.perf_counter() - t0)
     try:  # import here so a forked child starts with unified-planning loaded
         import unified_planning.shortcuts  # noqa: F401
@@ -446,14 +436,14 @@ def solve_pddl(
 
         get_environment().credits_stream = None
     except ImportError as e:
-        return _result(name, PlanStatus.ERROR, t0, f"unified-planning is not installed: {e}",
+        return failed(name, PlanStatus.ERROR, t0, f"unified-planning is not installed: {e}",
                        total_time_s=time.perf_counter() - t0)
     domain = None
     if cache_domain:
         try:
             domain = parsed_domain(domain_text)
         except Exception as e:  # noqa: BLE001
-            return _result(name, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}",
+            return failed(name, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}",
                            total_time_s=time.perf_counter() - t0)
     ctx = _context()
     recv, send = ctx.Pipe(duplex=False)
@@ -477,12 +467,12 @@ def solve_pddl(
         proc.join(5.0)
     total = time.perf_counter() - t0
     if answer == "late":
-        return _result(name, PlanStatus.TIMEOUT, t0, f"no answer within {timeout_s:g} s + {grace_s:g} s grace; "
+        return failed(name, PlanStatus.TIMEOUT, t0, f"no answer within {timeout_s:g} s + {grace_s:g} s grace; "
                        "planner process killed", total_time_s=total)
     if answer is None:
-        return _result(name, PlanStatus.ERROR, t0, f"planner process died (exit code {proc.exitcode})", total_time_s=total)
+        return failed(name, PlanStatus.ERROR, t0, f"planner process died (exit code {proc.exitcode})", total_time_s=total)
     if "error" in answer:
-        return _result(name, PlanStatus.ERROR, t0, answer["error"], total_time_s=total)
+        return failed(name, PlanStatus.ERROR, t0, answer["error"], total_time_s=total)
     inner = PlanResult.from_json(answer)
     extra = dict(inner.extra)
     extra["total_time_s"] = total

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import operator
+import time
 from dataclasses import dataclass, field
 from enum import Enum
 from types import MappingProxyType
@@ -148,3 +149,15 @@ class PlanResult:
     def __reduce__(self):
         """Pickle through the JSON form (a MappingProxyType field cannot be pickled directly)."""
         return (PlanResult.from_json, (self.to_json(),))
+
+
+def one_line(text: Any, limit: int = 300) -> str:
+    """Text on one line (whitespace runs become one space), cut to limit characters."""
+    s = " ".join(str(text).split())
+    return s if len(s) <= limit else s[: limit - 3] + "..."
+
+
+def failed(planner: str, status: PlanStatus, t0: float, message: str = "", **extra: Any) -> PlanResult:
+    """A result without a plan: its status, the time since t0 (time.perf_counter) and a one-line message."""
+    return PlanResult(planner=planner, status=status, plan=(), predicted_states=(), expansions=None,
+                      planning_time_s=time.perf_counter() - t0, message=one_line(message), extra=extra)

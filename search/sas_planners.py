@@ -30,7 +30,7 @@ import numpy as np
 from pddl_export.pddl_writer import action_id_from_name, write_text_atomic
 from pddl_export.rules import apply_rules
 from pddl_export.sas_writer import SASEncoder, TaskTooLargeError
-from search.result import PlanResult, PlanStatus
+from search.result import PlanResult, PlanStatus, failed
 from search.symbolic import SymbolicGoal
 
 
@@ -84,11 +84,6 @@ def _limit_memory(pid: int, mb: int) -> None:
         pass
 
 
-def _error(planner: str, status: PlanStatus, t0: float, message: str, **extra) -> PlanResult:
-    return PlanResult(planner=planner, status=status, plan=(), predicted_states=(), expansions=None,
-                      planning_time_s=time.perf_counter() - t0, message=" ".join(message.split())[:300], extra=extra)
-
-
 def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Sequence[int | None], planner: str,
               timeout_s: float, *, memory_mb: int = MEMORY_LIMIT_MB, write_to: Path | None = None) -> PlanResult:
     """Plan from init to goal codes with a SAS+ planner (SAS_PLANNERS); failures come back as a status.
@@ -101,17 +96,17 @@ def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Seq
     if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
         raise ValueError(f"timeout_s must be a positive number, got {timeout_s!r}")
     if planner not in SAS_PLANNERS:
-        return _error(planner or "unknown", PlanStatus.ERROR, t0,
+        return failed(planner or "unknown", PlanStatus.ERROR, t0,
                       f"unknown planner {planner!r}; known: {', '.join(SAS_PLANNERS)}")
     spec = SAS_PLANNERS[planner]
     binary = search_binary(spec.package)
     if binary is None:
-        return _error(planner, PlanStatus.ERROR, t0, f"the search binary of {spec.package} was not found "
+        return failed(planner, PlanStatus.ERROR, t0, f"the search binary of {spec.package} was not found "
                       f"(pip install {spec.package.replace('_', '-')})")
     try:
         task = encoder.task(init, goal)
     except (ValueError, TaskTooLargeError) as e:
-        return _error(planner, PlanStatus.ERROR, t0, str(e))
+        return failed(planner, PlanStatus.ERROR, t0, str(e))
     goal_g = goal if isinstance(goal, SymbolicGoal) else SymbolicGoal(tuple(goal))
     write_s = time.perf_counter() - t0
     extra = {"sas_write_time_s": round(write_s, 6), "sas_variables": task.n_variables,
@@ -128,7 +123,7 @@ def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Seq
                 proc = subprocess.Popen(args, stdin=stdin, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                         text=True, cwd=tmp, start_new_session=True)
         except OSError as e:
-            return _error(planner, PlanStatus.ERROR, t0, f"could not run {planner}: {e}", **extra)
+            return failed(planner, PlanStatus.ERROR, t0, f"could not run {planner}: {e}", **extra)
         if memory_mb:
             _limit_memory(proc.pid, memory_mb)
         try:
@@ -136,7 +131,7 @@ def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Seq
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.communicate()
-            return _error(planner, PlanStatus.TIMEOUT, t0, f"{planner} hit the {timeout_s:g} s time limit "
+            return failed(planner, PlanStatus.TIMEOUT, t0, f"{planner} hit the {timeout_s:g} s time limit "
                           "(process killed)", planner_time_s=time.perf_counter() - t1, **extra)
         extra["planner_time_s"] = time.perf_counter() - t1
         for key, name in (("Search time", "fd_search_time_s"), ("Total time", "fd_total_time_s")):
@@ -149,18 +144,18 @@ def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Seq
             status, why = _EXIT.get(proc.returncode, (PlanStatus.ERROR, f"exited with code {proc.returncode}"))
             why = why if status is PlanStatus.UNSOLVABLE else f"{planner} {why}"
             tail = (err.strip().splitlines() or [""])[-1]
-            return _error(planner, status, t0, f"{why}{': ' + tail if status is PlanStatus.ERROR and tail else ''}",
+            return failed(planner, status, t0, f"{why}{': ' + tail if status is PlanStatus.ERROR and tail else ''}",
                           **extra)
         names = [ln.strip()[1:-1] for ln in plan_path.read_text().splitlines() if ln.strip().startswith("(")]
     try:
         plan = tuple(action_id_from_name(n) for n in names)
     except ValueError as e:
-        return _error(planner, PlanStatus.ERROR, t0, f"{planner} returned an unknown operator: {e}", **extra)
+        return failed(planner, PlanStatus.ERROR, t0, f"{planner} returned an unknown operator: {e}", **extra)
     states = [np.asarray([int(c) for c in init], np.int64)]
     for a in plan:
         states.append(apply_rules(encoder.rules, states[-1], a))
     if not goal_g.satisfied(states[-1])[0]:
-        return _error(planner, PlanStatus.ERROR, t0, f"the plan does not reach the goal under the rules "
+        return failed(planner, PlanStatus.ERROR, t0, f"the plan does not reach the goal under the rules "
                       f"(the SAS+ encoding disagrees with apply_rules)", **extra)
     return PlanResult(planner=planner, status=PlanStatus.SOLVED, plan=plan,
                       predicted_states=tuple(tuple(int(c) for c in s) for s in states), expansions=expansions,

@@ -22,7 +22,7 @@ from typing import Callable
 
 import numpy as np
 
-from search.result import PlanResult, PlanStatus
+from search.result import PlanResult, PlanStatus, failed
 from search.symbolic import SymbolicGoal, TransitionFn
 from symlearn.problems import GOAL_TOLERANCE_M, Problem, goal_codes, max_goal_distance, place_scene
 from symlearn.transition import encode_observation
@@ -195,9 +195,7 @@ def safe_plan(planner: str, planner_fn: PlannerFn, transition: TransitionFn, sta
     try:
         return planner_fn(transition, np.asarray(start, np.int64), goal, timeout_s)
     except (ValueError, RuntimeError, OSError) as e:
-        msg = " ".join(f"{type(e).__name__}: {e}".split())[:300]
-        return PlanResult(planner=planner, status=PlanStatus.ERROR, plan=(), predicted_states=(), expansions=None,
-                          planning_time_s=time.perf_counter() - t0, message=msg)
+        return failed(planner, PlanStatus.ERROR, t0, f"{type(e).__name__}: {e}")
 
 
 def run_problem(sim, encoder, transition: TransitionFn, problem: Problem, planner: str, planner_fn: PlannerFn,

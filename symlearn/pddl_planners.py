@@ -23,7 +23,7 @@ from pddl_export.rules import RuleSet
 from pddl_export.sas_writer import SASEncoder
 from search.classical import solve_pddl, strips_problem
 from search.sas_planners import solve_sas
-from search.result import PlanResult, PlanStatus
+from search.result import PlanResult, PlanStatus, failed
 from search.symbolic import SymbolicGoal, TransitionFn
 from symlearn.benchmark import PLANNERS, register_planner
 from symlearn.export_pddl import load_rules
@@ -86,8 +86,7 @@ def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Pat
             else:
                 dom, prob = domain, problem_pddl(rules, init, goal, model_hash)
         except (ValueError, RuntimeError) as e:  # codes outside the vocabulary, too many states
-            return PlanResult(planner=name, status=PlanStatus.ERROR, plan=(), predicted_states=(), expansions=None,
-                              planning_time_s=time.perf_counter() - t0, message=" ".join(str(e).split())[:300])
+            return failed(name, PlanStatus.ERROR, t0, str(e))
         prob_path = _next_path("problem", ".pddl")
         if prob_path is not None:
             write_text_atomic(prob_path, prob)
