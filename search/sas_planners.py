@@ -1,13 +1,14 @@
 """Fast Downward and SymK search components on a directly written SAS+ task, as a PlanResult.
 
-`solve_sas` writes the task of pddl_export.sas_writer to a temporary folder and runs the
+`solve_sas` feeds the task of pddl_export.sas_writer on standard input to the
 `downward` search binary shipped in the up-fast-downward or up-symk wheel (the planners that
 unified-planning calls, minus their translator, which takes seconds to minutes on the
 learned domain) with an argument list, a wall-clock limit and an address-space limit.
 SymK is a fork of Fast Downward with symbolic (BDD) search and reads the same format.
 The plan is read back, replayed with the rules (it must reach the goal, else the encoding
-is wrong and the result is an ERROR) and reported with the planner's own times: `fd_search_time_s` (search only) and `fd_total_time_s` (reading the
-task + search), next to `planner_time_s` (the process, wall clock) and `sas_write_time_s`.
+is wrong and the result is an ERROR) and reported with the planner's own times:
+`fd_search_time_s` (search only) and `fd_total_time_s` (reading the task + search), next to
+`planner_time_s` (the process, wall clock) and `sas_write_time_s`.
 
     >>> r = solve_sas(SASEncoder(rules), [3, 7], [5, None], "fast-downward-sas", 10)  # doctest: +SKIP
     >>> r.status, r.plan, r.extra["fd_search_time_s"]                                 # doctest: +SKIP
@@ -32,7 +33,6 @@ from pddl_export.rules import apply_rules
 from pddl_export.sas_writer import SASEncoder, TaskTooLargeError
 from search.result import PlanResult, PlanStatus, failed
 from search.symbolic import SymbolicGoal
-
 
 
 @dataclass(frozen=True)
@@ -113,21 +113,19 @@ def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Seq
              "sas_operators": task.n_operators, "sas_effects": task.n_effects, "sas_axioms": task.n_axioms}
     if write_to is not None:
         write_text_atomic(Path(write_to), task.text)
-    with tempfile.TemporaryDirectory(prefix="symlearn-fd-") as tmp:
-        sas_path, plan_path = Path(tmp) / "task.sas", Path(tmp) / "plan"
-        sas_path.write_text(task.text)
+    with tempfile.TemporaryDirectory(prefix="symlearn-fd-") as tmp:  # for the plan file
+        plan_path = Path(tmp) / "plan"
         args = [str(binary), "--search", spec.search, "--internal-plan-file", str(plan_path)]
         t1 = time.perf_counter()
         try:
-            with open(sas_path) as stdin:
-                proc = subprocess.Popen(args, stdin=stdin, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                        text=True, cwd=tmp, start_new_session=True)
+            proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                    text=True, cwd=tmp, start_new_session=True)
         except OSError as e:
             return failed(planner, PlanStatus.ERROR, t0, f"could not run {planner}: {e}", **extra)
         if memory_mb:
             _limit_memory(proc.pid, memory_mb)
         try:
-            log, err = proc.communicate(timeout=max(timeout_s - write_s, 1e-3))
+            log, err = proc.communicate(task.text, timeout=max(timeout_s - write_s, 1e-3))
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.communicate()
