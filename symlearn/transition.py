@@ -89,7 +89,7 @@ class TransitionConfig:
         unknown = set(d) - names
         if unknown:
             raise ValueError(f"unknown transition config fields {sorted(unknown)}")
-        return TransitionConfig(**{"copy_prior": 0.0, **d})  # files from before copy_prior had none
+        return TransitionConfig(**d)  # a file from before copy_prior gets its default, 0
 
 
 TRANSITION_PRESETS = {
