@@ -20,11 +20,11 @@ import numpy as np
 import torch
 
 from search.learned_astar import plan_symbolic
-from search.symbolic import N_ACTIONS, SymbolicGoal, codes_from_bits
-from symlearn.checkpoint import load_effect_model
-from symlearn.dataset import load_split
+from pddl_export.symbolic import N_ACTIONS, SymbolicGoal, codes_from_bits
+from symlearn.learning.checkpoint import load_effect_model
+from symlearn.data.dataset import load_split
 from symlearn.provenance import atomic_write_json, versions
-from symlearn.transition import LearnedTransition, encode_crops
+from symlearn.symbolic.transition import LearnedTransition, encode_crops
 
 
 class OneActionPerCall:

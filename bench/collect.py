@@ -17,10 +17,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from symlearn.collect import CollectConfig, collect, collect_shard
-from symlearn.dataset import effect_statistics, load_split
+from symlearn.sim.collect import CollectConfig, collect, collect_shard
+from symlearn.data.dataset import effect_statistics, load_split
 from symlearn.provenance import versions
-from symlearn.simulator import SimConfig
+from symlearn.sim.simulator import SimConfig
 
 ORIGINAL_TIMING = SimConfig(time_step=1 / 240, solver_iterations=50, accel_free=0.5, accel_loaded=0.5,
                             accel_loaded_vertical=0.5)

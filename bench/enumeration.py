@@ -18,10 +18,10 @@ import numpy as np
 import torch
 
 from pddl_export.enumeration import enumerate_transitions, multiset_indices
-from search.symbolic import N_ACTIONS
-from symlearn.export_pddl import load_rules
+from pddl_export.symbolic import N_ACTIONS
+from symlearn.planning.export import load_rules
 from symlearn.provenance import atomic_write_json, versions
-from symlearn.transition import LearnedTransition
+from symlearn.symbolic.transition import LearnedTransition
 
 
 def per_scene_baseline(transition: LearnedTransition, vocab: tuple[int, ...], k: int, n_scenes: int) -> float:

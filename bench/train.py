@@ -16,7 +16,7 @@ from pathlib import Path
 
 import torch
 
-from symlearn.models import AttentiveDeepSym, ModelConfig, masked_mse
+from symlearn.learning.models import AttentiveDeepSym, ModelConfig, masked_mse
 from symlearn.provenance import versions
 
 

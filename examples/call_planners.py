@@ -8,14 +8,14 @@ A* and the classical planners on RUN/pddl (run examples/generate_domain.py first
 import argparse
 from pathlib import Path
 
-from search.symbolic import SymbolicGoal, code_str
-from symlearn.benchmark import PLANNERS
-from symlearn.checkpoint import load_effect_model
-from symlearn.execution import safe_plan
-from symlearn.pddl_planners import register_pddl_planners
-from symlearn.problems import goal_codes, load_problem, place_scene
-from symlearn.simulator import TabletopSimulator
-from symlearn.transition import LearnedTransition, encode_observation
+from pddl_export.symbolic import SymbolicGoal, code_str
+from symlearn.planning.benchmark import PLANNERS
+from symlearn.learning.checkpoint import load_effect_model
+from symlearn.planning.execution import safe_plan
+from symlearn.planning.planners import register_pddl_planners
+from symlearn.planning.problems import goal_codes, load_problem, place_scene
+from symlearn.sim.simulator import TabletopSimulator
+from symlearn.symbolic.transition import LearnedTransition, encode_observation
 from symlearn.world import decode_action
 
 

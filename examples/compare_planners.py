@@ -5,8 +5,8 @@
 import argparse
 from pathlib import Path
 
-from symlearn.benchmark import benchmark, format_table
-from symlearn.pddl_planners import PDDL_PLANNERS, register_pddl_planners
+from symlearn.planning.benchmark import benchmark, format_table
+from symlearn.planning.planners import PDDL_PLANNERS, register_pddl_planners
 
 
 def main() -> None:

@@ -7,7 +7,7 @@ Needs a run with best.pt (symlearn train) and transition.pt (symlearn train-tran
 import argparse
 from pathlib import Path
 
-from symlearn.export_pddl import ExportConfig, export_pddl
+from symlearn.planning.export import ExportConfig, export_pddl
 
 
 def main() -> None:

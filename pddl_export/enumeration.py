@@ -1,6 +1,6 @@
 """Query a transition function on every scene of up to `max_objects` objects over a vocabulary.
 
-The transition function is permutation-equivariant (search.symbolic), so a scene is a
+The transition function is permutation-equivariant (pddl_export.symbolic), so a scene is a
 MULTISET of codes: one sorted ordering per multiset is enough, C(V + k - 1, k) scenes of k
 objects over a vocabulary of V codes, each paired with all 36 actions. Scenes are built with
 numpy (no per-scene Python loop) and sent to the transition function in large batches: one
@@ -28,7 +28,7 @@ from typing import Sequence
 
 import numpy as np
 
-from search.symbolic import N_ACTIONS, TransitionFn
+from pddl_export.symbolic import N_ACTIONS, TransitionFn
 
 
 def multiset_indices(n_symbols: int, k: int) -> np.ndarray:

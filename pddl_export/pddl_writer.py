@@ -35,7 +35,7 @@ Two encodings of the same rules (see /work/shared/PDDL_NOTES.md for what each pl
   problem for unified-planning without its PDDL reader.
 
 Names: codes are predicates `code-<bits, MSB first>` (`code-00011011`), objects `o0, o1, ...`.
-Every function returns a string; write_text_atomic puts one on disk.
+Every function returns a string; `pddl_export.files.atomic_write_text` puts one on disk.
 
     >>> from pddl_export.rules import Rule, RuleSet
     >>> rs = RuleSet(bits=2, vocabulary=(1, 2), max_objects=2, n_rules_before_generalization=1,
@@ -63,9 +63,8 @@ from typing import Sequence
 import numpy as np
 
 from pddl_export.rules import INF, Rule, RuleSet, apply_rules_batch
-from search.symbolic import N_ACTIONS, SymbolicGoal, code_str
+from pddl_export.symbolic import N_ACTIONS, N_LOCATIONS, SymbolicGoal, code_str
 
-N_LOCATIONS = 6  # action id = pick * 6 + release
 OBJECT_TYPE = "obj"
 SCENE_TYPE, SCENE_CONSTANT, SCENE_VAR = "scene", "the-scene", "?s"  # the one-object wrapper type
 _ACTION_RE = re.compile(r"^pick-([0-5])-release-([0-5])(?:-s[0-9]+)?$", re.IGNORECASE)
@@ -357,25 +356,3 @@ def strips_pddl(
              f"  {_goal_text(goal_g, bits)})", ""]
     return StripsTask("\n".join(dom), "\n".join(prob), len(states), len(actions), states=tuple(states),
                       edges=tuple(edges), goal=goal_g.codes, bits=bits, codes=tuple(codes), name=pddl_name(name))
-
-
-# ----------------------------------------------------------------------------- files
-
-
-def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
-    """Write text to path via a temporary file in the same folder and os.replace."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a written domain is meant to be read by others
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path

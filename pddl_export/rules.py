@@ -59,7 +59,7 @@ import numpy as np
 from sklearn.tree import DecisionTreeClassifier
 
 from pddl_export.enumeration import Enumeration
-from search.symbolic import N_ACTIONS
+from pddl_export.symbolic import N_ACTIONS
 
 INF = 1 << 62  # open upper end of a count interval
 Bounds = dict[int, tuple[int, int]]  # code -> [lo, hi) on the number of OTHER objects with it

@@ -49,7 +49,7 @@ from typing import Sequence
 
 from pddl_export.pddl_writer import action_name, checked_task, code_predicate, object_name
 from pddl_export.rules import RuleSet
-from search.symbolic import SymbolicGoal
+from pddl_export.symbolic import SymbolicGoal
 
 SAS_FILE_VERSION = 3
 MAX_EFFECTS = 2_000_000  # refuse tasks whose conditional effects would exceed this

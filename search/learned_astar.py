@@ -27,7 +27,7 @@ import numpy as np
 
 from search.astar import astar
 from search.result import PlanResult, PlanStatus
-from search.symbolic import N_ACTIONS, SymbolicGoal, TransitionFn
+from pddl_export.symbolic import N_ACTIONS, SymbolicGoal, TransitionFn
 
 State = tuple[int, ...]
 

@@ -22,7 +22,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from search.symbolic import N_ACTIONS
+from pddl_export.symbolic import N_ACTIONS
 
 
 class PlanStatus(str, Enum):

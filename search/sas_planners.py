@@ -28,11 +28,12 @@ from typing import Sequence
 
 import numpy as np
 
-from pddl_export.pddl_writer import action_id_from_name, write_text_atomic
+from pddl_export.files import atomic_write_text
+from pddl_export.pddl_writer import action_id_from_name
 from pddl_export.rules import apply_rules
 from pddl_export.sas_writer import SASEncoder, TaskTooLargeError
 from search.result import PlanResult, PlanStatus, failed
-from search.symbolic import SymbolicGoal
+from pddl_export.symbolic import SymbolicGoal
 
 
 @dataclass(frozen=True)
@@ -112,7 +113,7 @@ def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Seq
     extra = {"sas_write_time_s": round(write_s, 6), "sas_variables": task.n_variables,
              "sas_operators": task.n_operators, "sas_effects": task.n_effects, "sas_axioms": task.n_axioms}
     if write_to is not None:
-        write_text_atomic(Path(write_to), task.text)
+        atomic_write_text(Path(write_to), task.text)
     with tempfile.TemporaryDirectory(prefix="symlearn-fd-") as tmp:  # for the plan file
         plan_path = Path(tmp) / "plan"
         args = [str(binary), "--search", spec.search, "--internal-plan-file", str(plan_path)]

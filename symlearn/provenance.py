@@ -1,12 +1,12 @@
 """What every output records beside itself: versions, hashes, and atomic writes of JSON."""
 from __future__ import annotations
 
-import hashlib
-import json
-import os
 import platform
 from importlib import metadata
 from pathlib import Path
+
+from pddl_export.files import (atomic_write_bytes, atomic_write_json, atomic_write_text,  # noqa: F401 (re-exported)
+                                sha256_bytes, sha256_file)
 
 _PACKAGES = ("symlearn", "numpy", "pybullet", "torch", "unified-planning")
 
@@ -21,21 +21,3 @@ def versions() -> dict[str, str]:
             out[name] = "not installed"
     return out
 
-
-def sha256_bytes(data: bytes) -> str:
-    return hashlib.sha256(data).hexdigest()
-
-
-def atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write to a temp file beside `path`, then rename: readers never see half a file."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    with open(tmp, "wb") as f:
-        f.write(data)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
-
-
-def atomic_write_json(path: Path, obj) -> None:
-    atomic_write_bytes(Path(path), (json.dumps(obj, indent=2, sort_keys=False) + "\n").encode())

@@ -14,14 +14,16 @@ from enum import IntEnum
 
 import numpy as np
 
+from pddl_export.symbolic import N_ACTIONS, N_LOCATIONS  # noqa: F401 (the action space, defined once)
+
 TABLE_TOP_Z = 0.40
-# Index order: far row (x = 0.80) left to right, then near row (x = 0.50); see REFERENCE_NOTES.md.
+# Index order: far row (x = 0.80) left to right, then near row (x = 0.50); see docs/DESIGN.md.
 LOCATIONS: tuple[tuple[float, float], ...] = (
     (0.80, -0.18), (0.80, 0.00), (0.80, 0.18),
     (0.50, -0.30), (0.50, 0.00), (0.50, 0.30),
 )
-N_LOCATIONS = len(LOCATIONS)
-N_ACTIONS = N_LOCATIONS * N_LOCATIONS
+if len(LOCATIONS) != N_LOCATIONS:
+    raise ImportError("LOCATIONS must list one position per symbolic location")
 NEAR_ROW = (3, 4, 5)
 FAR_ROW = (0, 1, 2)
 

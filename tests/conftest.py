@@ -1,6 +1,6 @@
 import pytest
 
-from symlearn.simulator import TabletopSimulator
+from symlearn.sim.simulator import TabletopSimulator
 
 
 @pytest.fixture(scope="session")

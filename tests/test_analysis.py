@@ -4,12 +4,12 @@ import json
 import numpy as np
 import pytest
 
-from symlearn.collect import CollectConfig, collect
-from symlearn.evaluation import evaluate, format_table
-from symlearn.symbols import analyse_symbols, picked_objects
-from symlearn.dataset import load_split
-from symlearn.table1 import CASES, format_table1, table1
-from symlearn.training import TrainConfig, train
+from symlearn.sim.collect import CollectConfig, collect
+from symlearn.learning.evaluation import evaluate, format_table
+from symlearn.symbolic.symbols import analyse_symbols, picked_objects
+from symlearn.data.dataset import load_split
+from symlearn.learning.table1 import CASES, format_table1, table1
+from symlearn.learning.training import TrainConfig, train
 
 
 @pytest.fixture(scope="module")

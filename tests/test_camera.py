@@ -1,6 +1,6 @@
 import numpy as np
 
-from symlearn.camera import CameraConfig, crop_origins, cut_crops, metric_depth, position_channels
+from symlearn.sim.camera import CameraConfig, crop_origins, cut_crops, metric_depth, position_channels
 
 
 def test_metric_depth_endpoints_and_monotone():

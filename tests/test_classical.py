@@ -17,7 +17,7 @@ from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pdd
 from pddl_export.rules import distil_rules
 from search.classical import PLANNERS, PlannerSpec, solve_pddl, strips_problem
 from search.result import PlanStatus
-from search.symbolic import SymbolicGoal
+from pddl_export.symbolic import SymbolicGoal
 from test_pddl_export import FAR, NEAR, RIDER, RIDER_M, STICK, TOY_VOCAB, UNDER, ToyRobot
 
 

@@ -5,9 +5,9 @@ import sys
 import numpy as np
 import pytest
 
-from symlearn.collect import CollectConfig, CollectError, collect, shard_name
-from symlearn.dataset import ARRAY_NAMES, DataError, load_manifest, load_split, model_inputs, summarize
-from symlearn.exploration import ExplorationConfig
+from symlearn.sim.collect import CollectConfig, CollectError, collect, shard_name
+from symlearn.data.dataset import ARRAY_NAMES, DataError, load_manifest, load_split, model_inputs, summarize
+from symlearn.sim.exploration import ExplorationConfig
 
 CFG = CollectConfig(n=24, seed=3, shard_size=2)
 
@@ -123,7 +123,7 @@ def test_bad_exploration_settings_refused(kw, msg):
 
 def test_cli_collect_and_refusals(tmp_path):
     out = tmp_path / "cli"
-    run = [sys.executable, "-m", "symlearn.cli", "collect", "--out", str(out), "--n", "12",
+    run = [sys.executable, "-m", "symlearn.cli.main", "collect", "--out", str(out), "--n", "12",
            "--shard-size", "1", "--objects", "4-5", "--quiet"]
     r = subprocess.run(run, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr

@@ -13,13 +13,14 @@ import pytest
 import torch
 
 from search.result import PlanResult, PlanStatus
-from symlearn import benchmark as bench
-from symlearn.checkpoint import save_checkpoint
-from symlearn.cli_planning import add_planning_commands
-from symlearn.execution import ExecutionConfig, ObservedTransitions, ProblemRun, execute_plan, run_problem
-from symlearn.models import AttentiveDeepSym, ModelConfig
-from symlearn.problems import GOAL_TOLERANCE_M, generate_problems, goal_codes, load_problem, scene_codes
-from symlearn.transition import (TRANSITION_FILE, LearnedTransition, TransitionConfig, TransitionNet, _file_sha,
+from symlearn.planning import benchmark as bench
+from symlearn.learning.checkpoint import save_checkpoint
+from symlearn.cli.planning import add_planning_commands
+from symlearn.planning.execution import ExecutionConfig, ObservedTransitions, ProblemRun, execute_plan, run_problem
+from symlearn.learning.models import AttentiveDeepSym, ModelConfig
+from symlearn.planning.problems import GOAL_TOLERANCE_M, generate_problems, goal_codes, load_problem, scene_codes
+from pddl_export.files import sha256_file
+from symlearn.symbolic.transition import (TRANSITION_FILE, LearnedTransition, TransitionConfig, TransitionNet, 
                                  save_transition)
 from symlearn.world import action_id
 
@@ -47,7 +48,7 @@ def run_dir(tmp_path_factory, encoder):
     d = tmp_path_factory.mktemp("exec_run")
     save_checkpoint(d / "best.pt", model=encoder)
     net = _seeded(lambda: TransitionNet(TransitionConfig.from_preset("quick", bits=encoder.cfg.bits)), 1)
-    save_transition(d / TRANSITION_FILE, net, {"effect_model_sha256": _file_sha(d / "best.pt")})
+    save_transition(d / TRANSITION_FILE, net, {"effect_model_sha256": sha256_file(d / "best.pt")[:16]})
     return d
 
 
@@ -128,7 +129,7 @@ class _Shift:
 
 def test_observed_transitions_override_only_what_was_seen():
     from search.learned_astar import plan_symbolic
-    from search.symbolic import SymbolicGoal
+    from pddl_export.symbolic import SymbolicGoal
 
     memory = ObservedTransitions(_Shift())
     codes = np.array([[3, 5], [3, 5], [4, 5], [3, 5]])

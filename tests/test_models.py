@@ -1,7 +1,7 @@
 import pytest
 import torch
 
-from symlearn.models import AttentiveDeepSym, ModelConfig, gumbel_sigmoid, masked_mse
+from symlearn.learning.models import AttentiveDeepSym, ModelConfig, gumbel_sigmoid, masked_mse
 
 CFG = ModelConfig.from_preset("quick")
 

@@ -29,8 +29,8 @@ from pddl_export.pddl_writer import (
     problem_pddl,
     reachable_transitions,
     strips_pddl,
-    write_text_atomic,
 )
+from pddl_export.files import atomic_write_text
 from pddl_export.rules import (
     AmbiguousRulesError,
     NotEquivariantError,
@@ -41,7 +41,7 @@ from pddl_export.rules import (
     distil_rules,
     rule_fidelity,
 )
-from search.symbolic import N_ACTIONS
+from pddl_export.symbolic import N_ACTIONS
 
 NEAR, FAR, STICK, RIDER, UNDER, STICK_M, RIDER_M = 1, 2, 3, 4, 5, 6, 7
 A_PLACE, A_STACK, A_STICK, A_UNCOVER, A_BACK, A_NOOP = 3, 10, 22, 24, 27, 35
@@ -321,8 +321,8 @@ def test_conditional_domain_parses_with_both_parsers(toy, tmp_path):
     assert d.requirements == {R.STRIPS, R.TYPING, R.CONDITIONAL_EFFECTS, R.EXISTENTIAL_PRECONDITION,
                               R.UNIVERSAL_PRECONDITION, R.NEG_PRECONDITION, R.EQUALITY}
     assert {a.name for a in d.actions} == {action_name(a) for a in rs.actions} and p.name == "t1"
-    dpath = write_text_atomic(tmp_path / "domain.pddl", domain)
-    ppath = write_text_atomic(tmp_path / "problem.pddl", problem)
+    dpath = atomic_write_text(tmp_path / "domain.pddl", domain)
+    ppath = atomic_write_text(tmp_path / "problem.pddl", problem)
     assert parse_domain(dpath).name == "learned-symbols" and len(parse_problem(ppath).objects) == 3
     up_problem = _up_parse(domain, problem)
     assert {a.name for a in up_problem.actions} == {action_name(a) for a in rs.actions}
@@ -434,10 +434,10 @@ def test_strips_state_limit(toy):
         strips_pddl(rs, [NEAR, STICK, NEAR, UNDER], [FAR, None, None, None], model_hash="h", max_states=2)
 
 
-def test_write_text_atomic(tmp_path):
+def test_atomic_write_text(tmp_path):
     path = tmp_path / "sub" / "d.pddl"
-    write_text_atomic(path, "one")
-    write_text_atomic(path, "two")
+    atomic_write_text(path, "one")
+    atomic_write_text(path, "two")
     assert path.read_text() == "two" and sorted(p.name for p in path.parent.iterdir()) == ["d.pddl"]
 
 

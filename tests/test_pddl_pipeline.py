@@ -9,12 +9,12 @@ import pytest
 
 from pddl_export.pddl_writer import action_name
 from search.result import PlanResult, PlanStatus
-from symlearn.collect import CollectConfig, collect
-from symlearn.export_pddl import ExportConfig, export_pddl, load_rules, rules_from_json, rules_to_json
-from symlearn.pddl_planners import make_pddl_planner, network_agrees
-from symlearn.problems import generate_problems
-from symlearn.training import TrainConfig, train
-from symlearn.transition import LearnedTransition, TransitionConfig, train_transition
+from symlearn.sim.collect import CollectConfig, collect
+from symlearn.planning.export import ExportConfig, export_pddl, load_rules, rules_from_json, rules_to_json
+from symlearn.planning.planners import make_pddl_planner, network_agrees
+from symlearn.planning.problems import generate_problems
+from symlearn.learning.training import TrainConfig, train
+from symlearn.symbolic.transition import LearnedTransition, TransitionConfig, train_transition
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -61,7 +61,7 @@ def test_pddl_planner_plans_on_exported_rules_and_agrees_with_net(run):
     r = changing[0]
     start = np.array([r.code_from])
     goal_code = int(tr(start[None], np.array([r.action]))[0, 0])
-    from search.symbolic import SymbolicGoal
+    from pddl_export.symbolic import SymbolicGoal
 
     goal = SymbolicGoal((goal_code,))
     for name in ("fast-downward", "pyperplan", "fast-downward-sas"):

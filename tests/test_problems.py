@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from symlearn.problems import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, ProblemConfig, generate_problems,
+from symlearn.planning.problems import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, ProblemConfig, generate_problems,
                                load_problem, load_problems, max_goal_distance, save_problem)
 from symlearn.world import ObjectType, Scene, decode_action
 

@@ -19,7 +19,7 @@ from pddl_export.rules import INF
 from pddl_export.sas_writer import SASEncoder, context_terms
 from search.sas_planners import SAS_PLANNERS, search_binary, solve_sas
 from search.result import PlanStatus
-from search.symbolic import N_ACTIONS, SymbolicGoal
+from pddl_export.symbolic import N_ACTIONS, SymbolicGoal
 from test_classical import NEVER, STICK_CARRIES_RIDER, UNCOVER_TWICE, rules  # noqa: F401 - fixture
 from test_pddl_export import ToyRobot, random_nets  # noqa: F401 - fixture
 

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from symlearn.scenarios import SCENARIO_BY_NAME, SCENARIOS, run_scenario
+from symlearn.sim.scenarios import SCENARIO_BY_NAME, SCENARIOS, run_scenario
 from symlearn.world import LOCATIONS, ObjectType
 
 CM = 0.01

@@ -18,7 +18,7 @@ import pytest
 from search.astar import astar
 from search.learned_astar import plan_symbolic, symbolic_successors
 from search.result import PlanResult, PlanStatus
-from search.symbolic import N_ACTIONS, SymbolicGoal, TransitionFn
+from pddl_export.symbolic import N_ACTIONS, SymbolicGoal, TransitionFn
 
 
 # ---------------------------------------------------------------------------------------------

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from symlearn.simulator import SimConfig, TabletopSimulator
+from symlearn.sim.simulator import SimConfig, TabletopSimulator
 from symlearn.world import Action, ObjectType, TABLE_TOP_Z
 
 

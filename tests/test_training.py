@@ -5,10 +5,10 @@ import sys
 import pytest
 import torch
 
-from symlearn.checkpoint import CheckpointError, load_checkpoint, load_effect_model, save_checkpoint
-from symlearn.collect import CollectConfig, collect
-from symlearn.models import AttentiveDeepSym, ModelConfig
-from symlearn.training import TrainConfig, TrainingError, train
+from symlearn.learning.checkpoint import CheckpointError, load_checkpoint, load_effect_model, save_checkpoint
+from symlearn.sim.collect import CollectConfig, collect
+from symlearn.learning.models import AttentiveDeepSym, ModelConfig
+from symlearn.learning.training import TrainConfig, TrainingError, train
 
 TINY = dict(epochs=2, batch_size=8, bf16=False)
 
@@ -54,7 +54,7 @@ def test_resume_refuses_other_settings(data, tmp_path):
 
 
 def test_nan_loss_stops_with_step(data, tmp_path, monkeypatch):
-    import symlearn.training as tr
+    import symlearn.learning.training as tr
 
     monkeypatch.setattr(tr, "masked_mse", lambda *a: torch.tensor(float("nan")))
     with pytest.raises(TrainingError, match="epoch 1, step 1"):
@@ -87,7 +87,7 @@ def test_checkpoint_round_trip_and_refusals(tmp_path):
 
 def test_two_process_ddp_ends_with_identical_weights(data, tmp_path):
     run = tmp_path / "ddp"
-    cmd = [sys.executable, "-m", "torch.distributed.run", "--standalone", "--nproc_per_node=2", "-m", "symlearn.cli",
+    cmd = [sys.executable, "-m", "torch.distributed.run", "--standalone", "--nproc_per_node=2", "-m", "symlearn.cli.main",
            "train", "--data", str(data), "--out", str(run), "--preset", "quick", "--epochs", "1", "--batch-size", "4",
            "--no-bf16", "--quiet"]
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)

@@ -8,12 +8,12 @@ import pytest
 import torch
 
 from search.learned_astar import plan_symbolic
-from search.symbolic import SymbolicGoal
-from symlearn.checkpoint import load_effect_model
-from symlearn.collect import CollectConfig, collect
-from symlearn.dataset import load_split
-from symlearn.training import TrainConfig, train
-from symlearn.transition import (METRICS_FILE, ROLLOUT_STEPS, TRANSITION_FILE, LearnedTransition, TransitionConfig,
+from pddl_export.symbolic import SymbolicGoal
+from symlearn.learning.checkpoint import load_effect_model
+from symlearn.sim.collect import CollectConfig, collect
+from symlearn.data.dataset import load_split
+from symlearn.learning.training import TrainConfig, train
+from symlearn.symbolic.transition import (METRICS_FILE, ROLLOUT_STEPS, TRANSITION_FILE, LearnedTransition, TransitionConfig,
                                  TransitionData, TransitionError, TransitionNet, build_transition_data,
                                  encode_observation, load_transition, masked_bce, rollout_chains, save_transition,
                                  train_transition)

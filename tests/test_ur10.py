@@ -1,7 +1,7 @@
 import numpy as np
 import pybullet as pb
 
-from symlearn.ur10_urdf import forward_kinematics
+from symlearn.sim.ur10_urdf import forward_kinematics
 
 
 def test_generated_urdf_matches_dh_forward_kinematics(sim):

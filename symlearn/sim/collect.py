@@ -5,7 +5,7 @@ a fresh simulator, so the arrays do not depend on how many worker processes ran.
 written atomically (temp file, then rename); `manifest.json` records the settings, each
 finished shard's checksum, and the train / val / test split by shards. Re-running with the same
 settings resumes: finished shards whose checksum matches are skipped. The format is described
-in docs/DATA_FORMAT.md and read back by `symlearn.dataset`.
+in docs/DATA_FORMAT.md and read back by `symlearn.data.dataset`.
 
     >>> cfg = CollectConfig(n=40, seed=1)          # doctest: +SKIP
     >>> collect(Path("data/tiny"), cfg, workers=2)  # doctest: +SKIP
@@ -13,7 +13,6 @@ in docs/DATA_FORMAT.md and read back by `symlearn.dataset`.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
 import math
 import multiprocessing as mp
@@ -25,13 +24,11 @@ from typing import Callable
 
 import numpy as np
 
-from symlearn.exploration import ExplorationConfig, sample_action, sample_scene_spec
-from symlearn.provenance import atomic_write_json, versions
-from symlearn.simulator import SimConfig, TabletopSimulator
+from symlearn.sim.exploration import ExplorationConfig, sample_action, sample_scene_spec
+from symlearn.data.dataset import DATA_KIND, FORMAT_VERSION, SPLITS
+from symlearn.provenance import atomic_write_json, sha256_file, versions
+from symlearn.sim.simulator import SimConfig, TabletopSimulator
 
-FORMAT_VERSION = 1
-DATA_KIND = "symlearn-interaction-data"
-SPLITS = ("train", "val", "test")
 
 
 class CollectError(RuntimeError):
@@ -136,14 +133,6 @@ def collect_shard(cfg: CollectConfig, index: int, size: int,
             episode += 1
     a["dropped"] = np.array(dropped, np.int32)
     return a
-
-
-def sha256_file(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for chunk in iter(lambda: f.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
 
 
 def shard_name(index: int) -> str:

@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
-from search.symbolic import code_str, codes_from_bits
-from symlearn.checkpoint import load_effect_model
-from symlearn.dataset import InteractionData, load_split
+from pddl_export.symbolic import code_str, codes_from_bits
+from symlearn.learning.checkpoint import load_effect_model
+from symlearn.data.dataset import InteractionData, load_split
 from symlearn.provenance import atomic_write_json
 from symlearn.world import LOCATIONS, N_LOCATIONS, OBJECT_SIZE, ObjectType
 
@@ -22,7 +22,7 @@ MOVED_M = 0.01
 
 def encode_codes(model, depth: np.ndarray, origin: np.ndarray, mask: np.ndarray) -> np.ndarray:
     """(N, K, S, S) depth crops -> (N, K) integer codes (eval-mode threshold); padding gets -1."""
-    from symlearn.transition import encode_crops
+    from symlearn.symbolic.transition import encode_crops
 
     return np.where(mask, codes_from_bits(encode_crops(model, depth, origin, mask).round()), -1)
 

@@ -21,9 +21,9 @@ import numpy as np
 import torch
 import torch.distributed as dist
 
-from symlearn.checkpoint import load_checkpoint, save_checkpoint
-from symlearn.dataset import InteractionData, load_manifest, load_split
-from symlearn.models import AttentiveDeepSym, ModelConfig, masked_mse
+from symlearn.learning.checkpoint import load_checkpoint, save_checkpoint
+from symlearn.data.dataset import InteractionData, load_manifest, load_split
+from symlearn.learning.models import AttentiveDeepSym, ModelConfig, masked_mse
 from symlearn.provenance import atomic_write_json, sha256_bytes, versions
 
 

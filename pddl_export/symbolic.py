@@ -17,7 +17,8 @@ from typing import Protocol
 
 import numpy as np
 
-N_ACTIONS = 36
+N_LOCATIONS = 6  # table locations: far row 0-2, near row 3-5 (geometry in symlearn.world)
+N_ACTIONS = N_LOCATIONS * N_LOCATIONS  # action id = pick * N_LOCATIONS + release
 
 
 class TransitionFn(Protocol):

@@ -45,8 +45,8 @@ def _quiet_import_pybullet():
 
 pb = _quiet_import_pybullet()
 
-from symlearn.camera import CameraConfig, crop_origins, cut_crops, metric_depth
-from symlearn.ur10_urdf import forward_kinematics, ur10_urdf
+from symlearn.sim.camera import CameraConfig, crop_origins, cut_crops, metric_depth
+from symlearn.sim.ur10_urdf import forward_kinematics, ur10_urdf
 from symlearn.world import (LOCATIONS, OBJECT_MASS, OBJECT_SIZE, TABLE_TOP_Z, Action, ObjectState,
                             ObjectType, Scene)
 

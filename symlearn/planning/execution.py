@@ -23,9 +23,9 @@ from typing import Callable
 import numpy as np
 
 from search.result import PlanResult, PlanStatus, failed
-from search.symbolic import SymbolicGoal, TransitionFn
-from symlearn.problems import GOAL_TOLERANCE_M, Problem, goal_codes, max_goal_distance, place_scene
-from symlearn.transition import encode_observation
+from pddl_export.symbolic import SymbolicGoal, TransitionFn
+from symlearn.planning.problems import GOAL_TOLERANCE_M, Problem, goal_codes, max_goal_distance, place_scene
+from symlearn.symbolic.transition import encode_observation
 from symlearn.world import decode_action
 
 PlannerFn = Callable[[TransitionFn, np.ndarray, SymbolicGoal, float], PlanResult]

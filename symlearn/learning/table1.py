@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from symlearn.checkpoint import load_effect_model
+from symlearn.learning.checkpoint import load_effect_model
 from symlearn.provenance import atomic_write_json
-from symlearn.scenarios import SCENARIO_BY_NAME
-from symlearn.training import crops_from_depth
+from symlearn.sim.scenarios import SCENARIO_BY_NAME
+from symlearn.learning.training import crops_from_depth
 
 CASES = ("table1_case1", "table1_case2", "table1_case3")
 
@@ -31,7 +31,7 @@ def predict_scene_effects(model, ck, crops: np.ndarray, origins: np.ndarray, act
 
 def table1(run_dir: Path) -> dict:
     """Run the three cases, write RUN/table1.json and return it."""
-    from symlearn.simulator import TabletopSimulator
+    from symlearn.sim.simulator import TabletopSimulator
 
     model, ck = load_effect_model(Path(run_dir))
     rows = []

@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from symlearn.checkpoint import load_effect_model
-from symlearn.dataset import load_split
+from symlearn.learning.checkpoint import load_effect_model
+from symlearn.data.dataset import load_split
 from symlearn.provenance import atomic_write_json
-from symlearn.training import data_fingerprint, predict_effects, to_tensors
+from symlearn.learning.training import data_fingerprint, predict_effects, to_tensors
 
 
 def _mae_rows(pred_m: np.ndarray, true_m: np.ndarray, mask: np.ndarray, n_objects: np.ndarray) -> dict:

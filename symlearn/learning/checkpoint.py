@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from symlearn.models import AttentiveDeepSym, ModelConfig
+from symlearn.learning.models import AttentiveDeepSym, ModelConfig
 from symlearn.provenance import atomic_write_bytes
 
 CHECKPOINT_FORMAT = 1

@@ -11,13 +11,13 @@ import sys
 import time
 from pathlib import Path
 
-from symlearn.cli_planning import _int_range
+from symlearn.cli.planning import _int_range
 
 
 def cmd_collect(args: argparse.Namespace) -> int:
-    from symlearn.collect import CollectConfig, collect
-    from symlearn.dataset import summarize
-    from symlearn.exploration import ExplorationConfig
+    from symlearn.sim.collect import CollectConfig, collect
+    from symlearn.data.dataset import summarize
+    from symlearn.sim.exploration import ExplorationConfig
 
     expl = ExplorationConfig() if args.objects is None else ExplorationConfig.with_k_range(*args.objects)
     cfg = CollectConfig(n=args.n, seed=args.seed, shard_size=args.shard_size, exploration=expl)
@@ -32,8 +32,8 @@ def cmd_collect(args: argparse.Namespace) -> int:
 
 
 def cmd_scenarios(args: argparse.Namespace) -> int:
-    from symlearn.scenarios import SCENARIO_BY_NAME, SCENARIOS, run_scenario
-    from symlearn.simulator import TabletopSimulator
+    from symlearn.sim.scenarios import SCENARIO_BY_NAME, SCENARIOS, run_scenario
+    from symlearn.sim.simulator import TabletopSimulator
 
     names = args.names or [s.name for s in SCENARIOS]
     unknown = [n for n in names if n not in SCENARIO_BY_NAME]
@@ -64,7 +64,7 @@ def _init_distributed() -> None:
 
 
 def cmd_train(args: argparse.Namespace) -> int:
-    from symlearn.training import TrainConfig, train
+    from symlearn.learning.training import TrainConfig, train
 
     over = {k: v for k, v in dict(epochs=args.epochs, batch_size=args.batch_size, lr=args.lr, seed=args.seed,
                                    max_train_samples=args.max_train_samples).items() if v is not None}
@@ -87,7 +87,7 @@ def cmd_train(args: argparse.Namespace) -> int:
 
 
 def cmd_evaluate(args: argparse.Namespace) -> int:
-    from symlearn.evaluation import evaluate, format_table
+    from symlearn.learning.evaluation import evaluate, format_table
 
     res = evaluate(Path(args.run), Path(args.data), Path(args.baseline_run) if args.baseline_run else None)
     print(format_table(res))
@@ -96,7 +96,7 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
 
 
 def cmd_table1(args: argparse.Namespace) -> int:
-    from symlearn.table1 import format_table1, table1
+    from symlearn.learning.table1 import format_table1, table1
 
     res = table1(Path(args.run))
     print(format_table1(res))
@@ -105,7 +105,7 @@ def cmd_table1(args: argparse.Namespace) -> int:
 
 
 def cmd_symbols(args: argparse.Namespace) -> int:
-    from symlearn.symbols import analyse_symbols
+    from symlearn.symbolic.symbols import analyse_symbols
 
     res = analyse_symbols(Path(args.run), Path(args.data), symbol=args.symbol, min_count=args.min_count)
     print(f"{res['n_objects']} training objects, {res['n_distinct']} distinct symbols, "
@@ -121,7 +121,7 @@ def cmd_symbols(args: argparse.Namespace) -> int:
 
 
 def cmd_export_pddl(args: argparse.Namespace) -> int:
-    from symlearn.export_pddl import ExportConfig, export_pddl
+    from symlearn.planning.export import ExportConfig, export_pddl
 
     cfg = ExportConfig(max_objects=args.max_objects, min_count=args.min_count, closure=args.closure,
                        pddl_fidelity_cases=args.pddl_fidelity_cases, scenes=args.scenes, seed=args.seed)
@@ -211,7 +211,7 @@ def build_parser() -> argparse.ArgumentParser:
     x.add_argument("--seed", type=int, default=0)
     x.set_defaults(func=cmd_export_pddl)
 
-    from symlearn.cli_planning import add_planning_commands
+    from symlearn.cli.planning import add_planning_commands
 
     add_planning_commands(sub)
     return p

@@ -14,9 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
-from symlearn.camera import position_channels
-from symlearn.collect import DATA_KIND, FORMAT_VERSION, SPLITS, sha256_file
+from symlearn.sim.camera import position_channels
+from symlearn.provenance import sha256_file
 
+FORMAT_VERSION = 1
+DATA_KIND = "symlearn-interaction-data"
+SPLITS = ("train", "val", "test")
 ARRAY_NAMES = ("pre_depth", "post_depth", "pre_origin", "post_origin", "pre_pixels", "post_pixels",
                "action", "effect", "n_objects", "obj_type", "pre_pose", "post_pose", "grasped",
                "episode", "step")

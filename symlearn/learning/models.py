@@ -24,7 +24,8 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
-N_ACTIONS = 36
+from symlearn.world import N_ACTIONS
+
 
 
 @dataclass(frozen=True)

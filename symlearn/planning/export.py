@@ -12,7 +12,6 @@ Writes RUN/pddl/domain.pddl, rules.json, report.json.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
 import time
 from dataclasses import dataclass
@@ -22,9 +21,10 @@ import numpy as np
 
 from pddl_export.enumeration import enumerate_scenes, enumerate_transitions, vocabulary_closure
 from pddl_export.fidelity import pddl_fidelity
-from pddl_export.pddl_writer import conditional_domain, write_text_atomic
+from pddl_export.files import atomic_write_text, sha256_file
+from pddl_export.pddl_writer import conditional_domain
 from pddl_export.rules import Rule, RuleSet, distil_rules, rule_fidelity
-from search.symbolic import code_str
+from pddl_export.symbolic import code_str
 from symlearn.provenance import atomic_write_json, versions
 
 PDDL_DIR = "pddl"
@@ -51,15 +51,12 @@ class ExportConfig:
             raise ValueError(f"scenes={self.scenes!r}: expected observed or all")
 
 
-def file_sha256(path: Path) -> str:
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-
 
 def training_codes(run_dir: Path, data_dir: Path) -> tuple[np.ndarray, np.ndarray]:
     """The encoder's integer codes of every training sample's objects before and after: two (N, K), -1 padding."""
-    from symlearn.checkpoint import load_effect_model
-    from symlearn.dataset import load_split
-    from symlearn.symbols import encode_codes
+    from symlearn.learning.checkpoint import load_effect_model
+    from symlearn.data.dataset import load_split
+    from symlearn.symbolic.symbols import encode_codes
 
     model, _ = load_effect_model(run_dir)
     data = load_split(data_dir, "train")
@@ -123,12 +120,12 @@ def load_rules(run_dir: Path) -> tuple[RuleSet, str]:
 
 def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path | None = None) -> dict:
     """Enumerate, distil, write and check; returns the report (also written as report.json)."""
-    from symlearn.transition import TRANSITION_FILE, LearnedTransition
+    from symlearn.symbolic.transition import TRANSITION_FILE, LearnedTransition
 
     run_dir = Path(run_dir)
     out = Path(out_dir) if out_dir else run_dir / PDDL_DIR
     transition = LearnedTransition.from_run(run_dir)
-    model_hash = file_sha256(run_dir / TRANSITION_FILE)[:16]
+    model_hash = sha256_file(run_dir / TRANSITION_FILE)[:16]
     t0 = time.perf_counter()
     pre, post = training_codes(run_dir, data_dir)
     counts = code_counts(pre, post)
@@ -149,7 +146,7 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     fid = rule_fidelity(rules, enum)
     domain = conditional_domain(rules, model_hash)
     out.mkdir(parents=True, exist_ok=True)
-    write_text_atomic(out / "domain.pddl", domain)
+    atomic_write_text(out / "domain.pddl", domain)
     atomic_write_json(out / "rules.json", {"model_hash": model_hash, **rules_to_json(rules)})
     t2 = time.perf_counter()
     n_pddl = None if cfg.pddl_fidelity_cases < 0 else cfg.pddl_fidelity_cases

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from symlearn.exploration import MAX_OBJECTS, ExplorationConfig, sample_action, sample_scene_spec
+from symlearn.sim.exploration import MAX_OBJECTS, ExplorationConfig, sample_action, sample_scene_spec
 from symlearn.provenance import atomic_write_json
 from symlearn.world import N_ACTIONS, N_LOCATIONS, Action, ObjectType, Scene, decode_action
 
@@ -249,7 +249,7 @@ def generate_problem(sim, rng: np.random.Generator, cfg: ProblemConfig, name: st
 def generate_problems(out_dir: Path, n: int, objects: tuple[int, int] = (1, 3), length: tuple[int, int] = (1, 4),
                       seed: int = 0, sim=None) -> list[Path]:
     """Write n problems to out_dir/problem_NNNN.json (problem i drawn from seed (seed, i))."""
-    from symlearn.simulator import TabletopSimulator
+    from symlearn.sim.simulator import TabletopSimulator
 
     if n < 1:
         raise ValueError(f"n={n} must be at least 1")
@@ -282,7 +282,7 @@ def place_scene(sim, scene: Scene) -> None:
 
 def scene_codes(sim, encoder, scene: Scene) -> np.ndarray:
     """(k,) int64 codes of a scene: place it, render, encode with the effect model."""
-    from symlearn.transition import encode_observation
+    from symlearn.symbolic.transition import encode_observation
 
     place_scene(sim, scene)
     return encode_observation(encoder, sim.observe())

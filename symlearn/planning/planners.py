@@ -18,15 +18,16 @@ from pathlib import Path
 
 import numpy as np
 
-from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl, write_text_atomic
+from pddl_export.files import atomic_write_text
+from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl
 from pddl_export.rules import RuleSet
 from pddl_export.sas_writer import SASEncoder
 from search.classical import solve_pddl, strips_problem
 from search.sas_planners import solve_sas
 from search.result import PlanResult, PlanStatus, failed
-from search.symbolic import SymbolicGoal, TransitionFn
-from symlearn.benchmark import PLANNERS, register_planner
-from symlearn.export_pddl import load_rules
+from pddl_export.symbolic import SymbolicGoal, TransitionFn
+from symlearn.planning.benchmark import PLANNERS, register_planner
+from symlearn.planning.export import load_rules
 
 # registry name -> (unified-planning engine name in search.classical, PDDL form)
 PDDL_PLANNERS = {
@@ -72,7 +73,7 @@ def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Pat
             prob_path = _next_path("problem", ".pddl")
             if prob_path is not None:
                 try:
-                    write_text_atomic(prob_path, problem_pddl(rules, init, goal, model_hash))
+                    atomic_write_text(prob_path, problem_pddl(rules, init, goal, model_hash))
                 except ValueError:
                     pass  # unknown codes: solve_sas reports them
             sas_path = None if prob_path is None else prob_path.with_name(prob_path.name.replace("problem", "task")
@@ -89,9 +90,9 @@ def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Pat
             return failed(name, PlanStatus.ERROR, t0, str(e))
         prob_path = _next_path("problem", ".pddl")
         if prob_path is not None:
-            write_text_atomic(prob_path, prob)
+            atomic_write_text(prob_path, prob)
             if form == "strips":
-                write_text_atomic(prob_path.with_name(prob_path.name.replace("problem", "domain_strips")), dom)
+                atomic_write_text(prob_path.with_name(prob_path.name.replace("problem", "domain_strips")), dom)
         write_s = time.perf_counter() - t0
         res = solve_pddl(dom, prob, engine, max(timeout_s - write_s, 0.001), cache_domain=form == "conditional",
                          problem=prebuilt)

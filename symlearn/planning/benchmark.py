@@ -21,8 +21,8 @@ import numpy as np
 
 from search.learned_astar import plan_symbolic
 from search.result import PlanResult
-from search.symbolic import SymbolicGoal, TransitionFn
-from symlearn.execution import ExecutionConfig, PlannerFn, ProblemRun, run_problem
+from pddl_export.symbolic import SymbolicGoal, TransitionFn
+from symlearn.planning.execution import ExecutionConfig, PlannerFn, ProblemRun, run_problem
 from symlearn.provenance import atomic_write_json, sha256_bytes, versions
 
 
@@ -99,10 +99,10 @@ def benchmark(run_dir: Path, problems_dir: Path, planners: list[str], out_file: 
               closed_loop: bool = False, timeout_s: float = 30.0, max_replans: int = 3,
               show_progress: bool = True) -> dict:
     """Plan and execute every problem with every planner (closed loop too if asked); write out_file."""
-    from symlearn.checkpoint import load_effect_model
-    from symlearn.problems import load_problems
-    from symlearn.simulator import TabletopSimulator
-    from symlearn.transition import TRANSITION_FILE, LearnedTransition
+    from symlearn.learning.checkpoint import load_effect_model
+    from symlearn.planning.problems import load_problems
+    from symlearn.sim.simulator import TabletopSimulator
+    from symlearn.symbolic.transition import TRANSITION_FILE, LearnedTransition
 
     if not planners:
         raise ValueError("no planners given")

@@ -12,7 +12,7 @@ before- and after-crops of every data sample (encoder in eval mode: deterministi
     >>> m(np.array([[3, 17]]), np.array([action_id(3, 4)]))   # (B, K) codes, (B,) actions      # doctest: +SKIP
     array([[ 3, 19]])
 
-`LearnedTransition` implements search.symbolic.TransitionFn; A* and the PDDL export call it.
+`LearnedTransition` implements pddl_export.symbolic.TransitionFn; A* and the PDDL export call it.
 """
 from __future__ import annotations
 
@@ -30,12 +30,12 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
-from search.symbolic import bits_from_codes, codes_from_bits
-from symlearn.checkpoint import load_effect_model
-from symlearn.dataset import InteractionData, load_split
-from symlearn.models import N_ACTIONS, AttentiveDeepSym
-from symlearn.provenance import atomic_write_bytes, atomic_write_json, sha256_bytes, versions
-from symlearn.training import crops_from_depth, data_fingerprint
+from pddl_export.symbolic import bits_from_codes, codes_from_bits
+from symlearn.learning.checkpoint import load_effect_model
+from symlearn.data.dataset import InteractionData, load_split
+from symlearn.learning.models import N_ACTIONS, AttentiveDeepSym
+from symlearn.provenance import atomic_write_bytes, atomic_write_json, sha256_bytes, sha256_file, versions
+from symlearn.learning.training import crops_from_depth, data_fingerprint
 
 TRANSITION_KIND = "symlearn-transition-model"
 TRANSITION_FORMAT = 1
@@ -280,10 +280,6 @@ def evaluate_transition(net: TransitionNet, data: TransitionData) -> dict:
 # ------------------------------------------------------------------------------- checkpoint
 
 
-def _file_sha(path: Path) -> str:
-    return sha256_bytes(Path(path).read_bytes())[:16]
-
-
 def save_transition(path: Path, net: TransitionNet, meta: dict) -> None:
     """Write the transition checkpoint atomically: tensors plus JSON strings (weights_only loadable)."""
     blob = {"kind": TRANSITION_KIND, "format_version": TRANSITION_FORMAT,
@@ -374,7 +370,7 @@ def train_transition(run_dir: Path, data_dir: Path, cfg: TransitionConfig, seed:
     net.eval()
     meta = {"transition_config": cfg.to_json(), "seed": seed, "data": str(data_dir),
             "data_fingerprint": fingerprint, "effect_model": "best.pt",
-            "effect_model_sha256": _file_sha(run_dir / "best.pt"), "effect_model_bits": ck.config.bits,
+            "effect_model_sha256": sha256_file(run_dir / "best.pt")[:16], "effect_model_bits": ck.config.bits,
             "best_val_loss": best, "versions": versions()}
     save_transition(run_dir / TRANSITION_FILE, net, meta)
     metrics = {**meta, "history": history, "n_samples": {s: len(d) for s, d in splits.items()},
@@ -400,7 +396,7 @@ def _json_safe(obj):
 
 
 class LearnedTransition:
-    """m(z) as a search.symbolic.TransitionFn: integer codes in, thresholded integer codes out."""
+    """m(z) as a pddl_export.symbolic.TransitionFn: integer codes in, thresholded integer codes out."""
 
     def __init__(self, net: TransitionNet, batch_size: int = 4096) -> None:
         self.net = net.eval()
@@ -414,7 +410,7 @@ class LearnedTransition:
         net, meta = load_transition(run_dir / TRANSITION_FILE)
         if check_encoder:
             best = run_dir / "best.pt"
-            if best.exists() and meta.get("effect_model_sha256") != _file_sha(best):
+            if best.exists() and meta.get("effect_model_sha256") != sha256_file(best)[:16]:
                 raise TransitionError(f"{run_dir / TRANSITION_FILE} was trained on another effect model than "
                                       f"{best}; re-run 'symlearn train-transition'")
         return cls(net)

@@ -1,6 +1,6 @@
 """Planning sub-commands of the `symlearn` CLI: train-transition, problems, plan, benchmark.
 
-symlearn.cli's build_parser calls `add_planning_commands(sub)`; each command maps its flags onto
+symlearn.cli.main's build_parser calls `add_planning_commands(sub)`; each command maps its flags onto
 a config and calls one library function, returning an exit code. Errors are raised as
 ValueError / RuntimeError with one-line messages, which the main CLI prints.
 
@@ -37,7 +37,7 @@ def _planner_list(text: str) -> list[str]:
 
 
 def cmd_train_transition(args: argparse.Namespace) -> int:
-    from symlearn.transition import TransitionConfig, train_transition
+    from symlearn.symbolic.transition import TransitionConfig, train_transition
 
     over = {k: v for k, v in (("epochs", args.epochs), ("copy_prior", args.copy_prior)) if v is not None}
     cfg = TransitionConfig.from_preset(args.preset, **over)
@@ -53,7 +53,7 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
 
 
 def cmd_problems(args: argparse.Namespace) -> int:
-    from symlearn.problems import generate_problems
+    from symlearn.planning.problems import generate_problems
 
     print(f"problems: {args.n} problems, objects {args.objects[0]}-{args.objects[1]}, length "
           f"{args.length[0]}-{args.length[1]}, seed {args.seed} -> {args.out}", file=sys.stderr)
@@ -63,14 +63,14 @@ def cmd_problems(args: argparse.Namespace) -> int:
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
-    from symlearn.benchmark import get_planner
-    from symlearn.checkpoint import load_effect_model
-    from symlearn.execution import ExecutionConfig, run_problem
-    from symlearn.problems import load_problem
-    from symlearn.simulator import TabletopSimulator
-    from symlearn.transition import LearnedTransition
+    from symlearn.planning.benchmark import get_planner
+    from symlearn.learning.checkpoint import load_effect_model
+    from symlearn.planning.execution import ExecutionConfig, run_problem
+    from symlearn.planning.problems import load_problem
+    from symlearn.sim.simulator import TabletopSimulator
+    from symlearn.symbolic.transition import LearnedTransition
 
-    from symlearn.pddl_planners import register_pddl_planners
+    from symlearn.planning.planners import register_pddl_planners
 
     problem = load_problem(Path(args.problem))
     register_pddl_planners(Path(args.run), [args.planner], write_dir=Path(args.run) / "pddl" / "problems" / problem.name)
@@ -91,8 +91,8 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 
 def cmd_benchmark(args: argparse.Namespace) -> int:
-    from symlearn.benchmark import benchmark, format_table, get_planner
-    from symlearn.pddl_planners import register_pddl_planners
+    from symlearn.planning.benchmark import benchmark, format_table, get_planner
+    from symlearn.planning.planners import register_pddl_planners
 
     register_pddl_planners(Path(args.run), args.planners)
     for name in args.planners:
