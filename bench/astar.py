@@ -24,7 +24,8 @@ from pddl_export.symbolic import N_ACTIONS, SymbolicGoal, codes_from_bits
 from symlearn.learning.checkpoint import load_effect_model
 from symlearn.data.dataset import load_split
 from symlearn.provenance import atomic_write_json, versions
-from symlearn.symbolic.transition import LearnedTransition, encode_crops
+from symlearn.symbolic.learned_transition import LearnedTransition
+from symlearn.symbolic.transition_data import encode_crops
 
 
 class OneActionPerCall:

@@ -21,7 +21,7 @@ from pddl_export.enumeration import enumerate_transitions, multiset_indices
 from pddl_export.symbolic import N_ACTIONS
 from symlearn.planning.export import load_rules
 from symlearn.provenance import atomic_write_json, versions
-from symlearn.symbolic.transition import LearnedTransition
+from symlearn.symbolic.learned_transition import LearnedTransition
 
 
 def per_scene_baseline(transition: LearnedTransition, vocab: tuple[int, ...], k: int, n_scenes: int) -> float:

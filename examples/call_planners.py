@@ -15,7 +15,8 @@ from symlearn.planning.execution import safe_plan
 from symlearn.planning.planners import register_pddl_planners
 from symlearn.planning.problems import goal_codes, load_problem, place_scene
 from symlearn.sim.simulator import TabletopSimulator
-from symlearn.symbolic.transition import LearnedTransition, encode_observation
+from symlearn.symbolic.learned_transition import LearnedTransition
+from symlearn.symbolic.transition_data import encode_observation
 from symlearn.world import decode_action
 
 

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from symlearn.sim.collect import CollectConfig, CollectError, collect, shard_name
-from symlearn.data.dataset import ARRAY_NAMES, DataError, load_manifest, load_split, model_inputs, summarize
+from symlearn.data.dataset import ARRAY_NAMES, DataError, load_manifest, load_split, summarize
+from symlearn.data.model_input import model_inputs
 from symlearn.sim.exploration import ExplorationConfig
 
 CFG = CollectConfig(n=24, seed=3, shard_size=2)

@@ -20,8 +20,9 @@ from symlearn.planning.execution import ExecutionConfig, ObservedTransitions, Pr
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig
 from symlearn.planning.problems import GOAL_TOLERANCE_M, generate_problems, goal_codes, load_problem, scene_codes
 from pddl_export.files import sha256_file
-from symlearn.symbolic.transition import (TRANSITION_FILE, LearnedTransition, TransitionConfig, TransitionNet, 
-                                 save_transition)
+from symlearn.symbolic.learned_transition import LearnedTransition
+from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, save_transition
+from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet
 from symlearn.world import action_id
 
 

@@ -14,7 +14,9 @@ from symlearn.planning.export import ExportConfig, export_pddl, load_rules, rule
 from symlearn.planning.planners import make_pddl_planner, network_agrees
 from symlearn.planning.problems import generate_problems
 from symlearn.learning.training import TrainConfig, train
-from symlearn.symbolic.transition import LearnedTransition, TransitionConfig, train_transition
+from symlearn.symbolic.learned_transition import LearnedTransition
+from symlearn.symbolic.transition_model import TransitionConfig
+from symlearn.symbolic.transition_training import train_transition
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -13,10 +13,12 @@ from symlearn.learning.checkpoint import load_effect_model
 from symlearn.sim.collect import CollectConfig, collect
 from symlearn.data.dataset import load_split
 from symlearn.learning.training import TrainConfig, train
-from symlearn.symbolic.transition import (METRICS_FILE, ROLLOUT_STEPS, TRANSITION_FILE, LearnedTransition, TransitionConfig,
-                                 TransitionData, TransitionError, TransitionNet, build_transition_data,
-                                 encode_observation, load_transition, masked_bce, rollout_chains, save_transition,
-                                 train_transition)
+from symlearn.symbolic.learned_transition import LearnedTransition
+from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, TransitionError, load_transition, save_transition
+from symlearn.symbolic.transition_data import TransitionData, build_transition_data, encode_observation
+from symlearn.symbolic.transition_metrics import ROLLOUT_STEPS, rollout_chains
+from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet, masked_bce
+from symlearn.symbolic.transition_training import METRICS_FILE, train_transition
 from symlearn.world import ObjectType
 
 BITS = 8

@@ -37,7 +37,8 @@ def _planner_list(text: str) -> list[str]:
 
 
 def cmd_train_transition(args: argparse.Namespace) -> int:
-    from symlearn.symbolic.transition import TransitionConfig, train_transition
+    from symlearn.symbolic.transition_model import TransitionConfig
+    from symlearn.symbolic.transition_training import train_transition
 
     over = {k: v for k, v in (("epochs", args.epochs), ("copy_prior", args.copy_prior)) if v is not None}
     cfg = TransitionConfig.from_preset(args.preset, **over)
@@ -68,7 +69,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from symlearn.planning.execution import ExecutionConfig, run_problem
     from symlearn.planning.problems import load_problem
     from symlearn.sim.simulator import TabletopSimulator
-    from symlearn.symbolic.transition import LearnedTransition
+    from symlearn.symbolic.learned_transition import LearnedTransition
 
     from symlearn.planning.planners import register_pddl_planners
 

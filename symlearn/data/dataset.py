@@ -1,9 +1,9 @@
-"""Reading a collected data set back: manifest checks, checksums, splits, model inputs.
+"""Reading a collected data set back: manifest checks, checksums, splits, fingerprints.
 
 Everything loads with numpy alone (`allow_pickle=False`); see docs/DATA_FORMAT.md.
 
     >>> data = load_split(Path("data/paper"), "train")     # doctest: +SKIP
-    >>> x = model_inputs(data.pre_depth, data.pre_origin)   # (N, K, 3, 64, 64)  # doctest: +SKIP
+    >>> data_fingerprint(Path("data/paper"))                # names the exact shards  # doctest: +SKIP
 """
 from __future__ import annotations
 
@@ -14,8 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from symlearn.sim.camera import position_channels
-from symlearn.provenance import sha256_file
+from symlearn.provenance import sha256_bytes, sha256_file
 
 FORMAT_VERSION = 1
 DATA_KIND = "symlearn-interaction-data"
@@ -114,15 +113,10 @@ def load_split(root: Path, split: str, verify: bool = True) -> InteractionData:
     return InteractionData(**arrays)
 
 
-def model_inputs(depth: np.ndarray, origin: np.ndarray, image_size: int = 256) -> np.ndarray:
-    """(N, K, S, S) depth crops and (N, K, 2) origins -> (N, K, 3, S, S) float32: depth, x, y."""
-    depth = np.asarray(depth, np.float32)
-    if depth.ndim != 4 or depth.shape[-1] != depth.shape[-2]:
-        raise DataError(f"depth crops must have shape (N, K, S, S), got {depth.shape}")
-    if origin.shape != depth.shape[:2] + (2,):
-        raise DataError(f"origins must have shape {depth.shape[:2] + (2,)}, got {origin.shape}")
-    xy = position_channels(origin, depth.shape[-1], image_size)
-    return np.concatenate([depth[:, :, None], xy], axis=2)
+def data_fingerprint(root: Path) -> str:
+    """Hash of the data set's shard checksums: identifies exactly what a run was trained on."""
+    m = load_manifest(root)
+    return sha256_bytes("".join(sorted(s["sha256"] for s in m["shards"])).encode())[:16]
 
 
 def effect_statistics(data: InteractionData) -> dict:

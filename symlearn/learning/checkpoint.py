@@ -14,7 +14,7 @@ import numpy as np
 import torch
 
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig
-from symlearn.provenance import atomic_write_bytes
+from symlearn.provenance import atomic_write_bytes, sha256_file, versions
 
 CHECKPOINT_FORMAT = 1
 CHECKPOINT_KIND = "symlearn-effect-model"
@@ -59,6 +59,7 @@ def save_checkpoint(path: Path, *, model, optimizer=None, epoch: int = 0, best_v
 
 
 def load_checkpoint(path: Path, expect_config: ModelConfig | None = None) -> Checkpoint:
+    """A checkpoint file's record; refuses missing, foreign, other-format or other-config files."""
     path = Path(path)
     if not path.exists():
         raise CheckpointError(f"no checkpoint at {path}; train a model first ('symlearn train')")
@@ -86,3 +87,18 @@ def load_effect_model(run_dir: Path, which: str = "best") -> tuple[AttentiveDeep
     model = AttentiveDeepSym(ck.config)
     model.load_state_dict(ck.model_state)
     return model.eval(), ck
+
+
+def effect_model_sha256(run_dir: Path, which: str = "best") -> str:
+    """First 16 hex digits of RUN/best.pt's SHA-256: names the exact effect model an output derives from."""
+    return sha256_file(Path(run_dir) / f"{which}.pt")[:16]
+
+
+def stage_record(run_dir: Path, ck: Checkpoint, config: dict) -> dict:
+    """What a stage reading RUN's effect model writes beside its results: config, seed, versions, model hash.
+
+    These stages draw no random numbers (eval mode, deterministic physics), so the seed recorded
+    is the one the effect model was trained with: it and the model hash fix every number.
+    """
+    return {"config": config, "seed": ck.meta.get("train_config", {}).get("seed"), "versions": versions(),
+            "effect_model_sha256": effect_model_sha256(run_dir)}

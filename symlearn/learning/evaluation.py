@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from symlearn.learning.checkpoint import load_effect_model
-from symlearn.data.dataset import load_split
+from symlearn.data.dataset import data_fingerprint, load_split
+from symlearn.learning.checkpoint import effect_model_sha256, load_effect_model, stage_record
 from symlearn.provenance import atomic_write_json
-from symlearn.learning.training import data_fingerprint, predict_effects, to_tensors
+from symlearn.learning.training import predict_effects, to_tensors
 
 
 def _mae_rows(pred_m: np.ndarray, true_m: np.ndarray, mask: np.ndarray, n_objects: np.ndarray) -> dict:
@@ -31,7 +31,7 @@ def _mae_rows(pred_m: np.ndarray, true_m: np.ndarray, mask: np.ndarray, n_object
 
 
 def evaluate(run_dir: Path, data_dir: Path, baseline_run: Path | None = None) -> dict:
-    """Write RUN/eval.json and return it."""
+    """Write RUN/eval.json (errors, config, seed, versions, model hash, data fingerprint) and return it."""
     run_dir = Path(run_dir)
     model, ck = load_effect_model(run_dir)
     test = load_split(data_dir, "test")
@@ -43,7 +43,9 @@ def evaluate(run_dir: Path, data_dir: Path, baseline_run: Path | None = None) ->
     def denorm(p: torch.Tensor) -> np.ndarray:
         return p.numpy() * std + mean
 
-    result = {"run": str(run_dir), "data": str(data_dir), "data_fingerprint": data_fingerprint(data_dir),
+    config = {"run": str(run_dir), "data": str(data_dir), "baseline_run": None if baseline_run is None else str(baseline_run)}
+    result = {"run": str(run_dir), "data": str(data_dir), **stage_record(run_dir, ck, config),
+              "data_fingerprint": data_fingerprint(data_dir),
               "trained_on": ck.meta.get("data_fingerprint"), "n_test_samples": len(test),
               "mean_abs_effect_mm": dict(zip("xyz", np.round(np.abs(truth[mask]).mean(0) * 1000, 2).tolist())),
               "mean_abs_effect_by_objects_mm": {
@@ -55,7 +57,8 @@ def evaluate(run_dir: Path, data_dir: Path, baseline_run: Path | None = None) ->
         base, bck = load_effect_model(Path(baseline_run))
         tb = to_tensors(test, bck.effect_mean, bck.effect_std)
         pb_ = predict_effects(base, tb).numpy() * bck.effect_std + bck.effect_mean
-        ablations["no_attention"] = {"run": str(baseline_run), **_mae_rows(pb_, truth, mask, nobj)}
+        ablations["no_attention"] = {"run": str(baseline_run), "effect_model_sha256": effect_model_sha256(baseline_run),
+                                     **_mae_rows(pb_, truth, mask, nobj)}
     ablations["mean_effect"] = _mae_rows(np.broadcast_to(mean, truth.shape), truth, mask, nobj)
     result["ablations"] = ablations
     atomic_write_json(run_dir / "eval.json", result)

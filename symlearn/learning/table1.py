@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from symlearn.learning.checkpoint import load_effect_model
+from symlearn.data.model_input import model_inputs
+from symlearn.learning.checkpoint import load_effect_model, stage_record
 from symlearn.provenance import atomic_write_json
 from symlearn.sim.scenarios import SCENARIO_BY_NAME
-from symlearn.learning.training import crops_from_depth
 
 CASES = ("table1_case1", "table1_case2", "table1_case3")
 
@@ -23,14 +23,14 @@ CASES = ("table1_case1", "table1_case2", "table1_case3")
 def predict_scene_effects(model, ck, crops: np.ndarray, origins: np.ndarray, action_id: int) -> np.ndarray:
     """One observed scene's crops (k, S, S) and origins (k, 2) -> predicted effects (k, 3) in metres."""
     depth = torch.from_numpy(crops.astype(np.float16).astype(np.float32))[None]  # as stored in the data set
-    x = crops_from_depth(depth, torch.from_numpy(origins.astype(np.float32))[None])  # (1, k, 3, S, S)
+    x = model_inputs(depth, torch.from_numpy(origins.astype(np.float32))[None])  # (1, k, 3, S, S)
     mask = torch.ones(1, crops.shape[0], dtype=torch.bool)
     out = model.eval()(x, mask, torch.tensor([action_id]))
     return out.effect[0].numpy() * ck.effect_std + ck.effect_mean
 
 
 def table1(run_dir: Path) -> dict:
-    """Run the three cases, write RUN/table1.json and return it."""
+    """Run the three cases, write RUN/table1.json (with config, seed, versions, model hash) and return it."""
     from symlearn.sim.simulator import TabletopSimulator
 
     model, ck = load_effect_model(Path(run_dir))
@@ -49,7 +49,8 @@ def table1(run_dir: Path) -> dict:
                                       "truth_mm": [round(float(v) * 1000, 1) for v in g]}
                                      for t, p, g in zip(sim.types, pred, res.effect)]})
     errors = np.array([[abs(a - b) for a, b in zip(o["predicted_mm"], o["truth_mm"])] for r in rows for o in r["objects"]])
-    out = {"run": str(run_dir), "cases": rows, "mean_abs_error_mm": dict(zip("xyz", np.round(errors.mean(0), 1).tolist()))}
+    out = {"run": str(run_dir), **stage_record(Path(run_dir), ck, {"run": str(run_dir), "cases": list(CASES)}),
+           "cases": rows, "mean_abs_error_mm": dict(zip("xyz", np.round(errors.mean(0), 1).tolist()))}
     atomic_write_json(Path(run_dir) / "table1.json", out)
     return out
 

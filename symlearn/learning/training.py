@@ -16,15 +16,17 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 import torch
 import torch.distributed as dist
 
 from symlearn.learning.checkpoint import load_checkpoint, save_checkpoint
-from symlearn.data.dataset import InteractionData, load_manifest, load_split
+from symlearn.data.dataset import InteractionData, data_fingerprint, load_split
+from symlearn.data.model_input import model_inputs
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig, masked_mse
-from symlearn.provenance import atomic_write_json, sha256_bytes, versions
+from symlearn.provenance import atomic_write_json, versions
 
 
 class TrainingError(RuntimeError):
@@ -86,19 +88,8 @@ class SplitTensors:
     def batch(self, idx: torch.Tensor, image_size: int = 256):
         """Model inputs for rows idx: crops (B, K, 3, S, S) float32, mask, actions, effects."""
         d = self.depth[idx].float()  # (B, K, S, S)
-        crops = crops_from_depth(d, self.origin[idx], image_size)
+        crops = model_inputs(d, self.origin[idx], image_size)
         return crops, self.mask[idx], self.action[idx], self.effect[idx]
-
-
-def crops_from_depth(depth: torch.Tensor, origin: torch.Tensor, image_size: int = 256) -> torch.Tensor:
-    """(B, K, S, S) depth and (B, K, 2) origins -> (B, K, 3, S, S): depth, column x and row y in [0, 1]."""
-    s = depth.shape[-1]
-    offs = torch.arange(s, dtype=torch.float32, device=depth.device)
-    rows = (origin[..., 0:1].float() + offs) / (image_size - 1)  # (B, K, S)
-    cols = (origin[..., 1:2].float() + offs) / (image_size - 1)
-    x = cols[..., None, :].expand(*depth.shape)
-    y = rows[..., :, None].expand(*depth.shape)
-    return torch.stack([depth, x, y], dim=2)
 
 
 def effect_normalization(data: InteractionData) -> tuple[np.ndarray, np.ndarray]:
@@ -108,6 +99,7 @@ def effect_normalization(data: InteractionData) -> tuple[np.ndarray, np.ndarray]
 
 
 def to_tensors(data: InteractionData, mean: np.ndarray, std: np.ndarray, post: bool = False) -> SplitTensors:
+    """A split's pre-state (or, with post, post-state) crops and its normalized effects as tensors."""
     mask = torch.from_numpy(data.mask)
     eff = torch.from_numpy((data.effect - mean) / std) * mask[..., None]
     return SplitTensors(
@@ -115,12 +107,6 @@ def to_tensors(data: InteractionData, mean: np.ndarray, std: np.ndarray, post: b
         origin=torch.from_numpy((data.post_origin if post else data.pre_origin).astype(np.float32)),
         mask=mask, action=torch.from_numpy(data.action.astype(np.int64)), effect=eff.float(),
         n_objects=torch.from_numpy(data.n_objects.astype(np.int64)))
-
-
-def data_fingerprint(root: Path) -> str:
-    """Hash of the data set's shard checksums: identifies exactly what a run was trained on."""
-    m = load_manifest(root)
-    return sha256_bytes("".join(sorted(s["sha256"] for s in m["shards"])).encode())[:16]
 
 
 def _dist_info() -> tuple[int, int]:
@@ -154,14 +140,62 @@ def mae_mm(pred: torch.Tensor, split: SplitTensors, std: np.ndarray) -> dict[str
     return dict(zip("xyz", [round(float(v), 2) for v in err.mean(0)]))
 
 
+@dataclass(frozen=True)
+class _Loop:
+    """What every epoch of one training run shares: the model, its optimizer, generators and this rank's place."""
+
+    cfg: TrainConfig
+    run_dir: Path
+    model: AttentiveDeepSym
+    step_fn: Callable  # the model, wrapped in DistributedDataParallel and/or compiled
+    opt: torch.optim.Optimizer
+    gen: torch.Generator  # shuffling of the training split
+    noise_gen: torch.Generator  # the encoder's code noise during training
+    device: torch.device
+    rank: int
+    world: int
+    mean: np.ndarray  # effect normalization, saved in every checkpoint
+    std: np.ndarray
+    meta: dict
+    show_progress: bool
+
+
 def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, show_progress: bool = True) -> dict:
     """Train (or resume training) an effect model; returns the metrics written to RUN/metrics.json."""
-    from tqdm import tqdm
-
     rank, world = _dist_info()
     run_dir = Path(run_dir)
     device = torch.device("cuda", rank % torch.cuda.device_count()) if torch.cuda.is_available() else torch.device("cpu")
     fingerprint = data_fingerprint(data_dir)
+    tr, va, mean, std = _load_training_splits(data_dir, cfg)
+    torch.manual_seed(cfg.seed)
+    model = AttentiveDeepSym(cfg.model).to(device)
+    opt = torch.optim.Adam(model.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
+    gen = torch.Generator().manual_seed(cfg.seed)
+    noise_gen = torch.Generator(device=device).manual_seed(cfg.seed + 1 + rank)
+    start_epoch, best, history = 0, math.inf, []
+    meta = {"train_config": cfg.to_json(), "data": str(data_dir), "data_fingerprint": fingerprint}
+    if resume and (run_dir / "last.pt").exists():
+        start_epoch, best, history = _resume(run_dir, cfg, fingerprint, model, opt, gen, noise_gen)
+    if rank == 0:
+        run_dir.mkdir(parents=True, exist_ok=True)
+        atomic_write_json(run_dir / "config.json", {**meta, "seed": cfg.seed, "versions": versions(),
+                                                    "world_size": world})
+    net = model
+    if world > 1:
+        net = torch.nn.parallel.DistributedDataParallel(model, device_ids=[device.index] if device.type == "cuda" else None)
+    loop = _Loop(cfg, run_dir, model, torch.compile(net) if cfg.compile else net, opt, gen, noise_gen, device,
+                 rank, world, mean, std, meta, show_progress)
+    for epoch in range(start_epoch, cfg.epochs):
+        train_loss, seen, train_time = _train_epoch(loop, tr, epoch)
+        row, val_loss = _validate(loop, va, epoch, train_loss, seen, train_time)
+        history.append(row)
+        if rank == 0:
+            best = _save_epoch(loop, epoch, row, val_loss, best, history)
+    return _finish(loop, history, best)
+
+
+def _load_training_splits(data_dir: Path, cfg: TrainConfig) -> tuple[SplitTensors, SplitTensors, np.ndarray, np.ndarray]:
+    """The train and val splits as tensors, effects normalized with the training split's statistics."""
     train_data = load_split(data_dir, "train")
     val_data = load_split(data_dir, "val")
     if cfg.max_train_samples:
@@ -170,90 +204,96 @@ def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, 
     if train_data.pre_depth.shape[-1] % cfg.model.crop:
         raise TrainingError(f"data crops of {train_data.pre_depth.shape[-1]} px do not pool to the model's {cfg.model.crop} px")
     mean, std = effect_normalization(train_data)
-    tr, va = to_tensors(train_data, mean, std), to_tensors(val_data, mean, std)
+    return to_tensors(train_data, mean, std), to_tensors(val_data, mean, std), mean, std
 
-    torch.manual_seed(cfg.seed)
-    model = AttentiveDeepSym(cfg.model).to(device)
-    opt = torch.optim.Adam(model.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
-    gen = torch.Generator().manual_seed(cfg.seed)
-    noise_gen = torch.Generator(device=device).manual_seed(cfg.seed + 1 + rank)
-    start_epoch, best, history = 0, math.inf, []
-    meta = {"train_config": cfg.to_json(), "data": str(data_dir), "data_fingerprint": fingerprint}
-    last = run_dir / "last.pt"
-    if resume and last.exists():
-        ck = load_checkpoint(last, expect_config=cfg.model)
-        if (_resumable(ck.meta.get("train_config", {})) != _resumable(cfg.to_json())
-                or ck.meta.get("data_fingerprint") != fingerprint):
-            raise TrainingError(f"{run_dir} holds a run with other settings or data; use a new --out or --no-resume")
-        model.load_state_dict(ck.model_state)
-        opt.load_state_dict(ck.optimizer_state)
-        gen.set_state(ck.rng_states["shuffle"])
-        noise_gen.set_state(ck.rng_states["noise"])
-        torch.set_rng_state(ck.rng_states["torch"])  # dropout
-        start_epoch, best, history = ck.epoch + 1, ck.best_val, ck.history
-    if rank == 0:
-        run_dir.mkdir(parents=True, exist_ok=True)
-        atomic_write_json(run_dir / "config.json", {**meta, "seed": cfg.seed, "versions": versions(),
-                                                    "world_size": world})
-    net = model
-    if world > 1:
-        net = torch.nn.parallel.DistributedDataParallel(model, device_ids=[device.index] if device.type == "cuda" else None)
-    step_fn = torch.compile(net) if cfg.compile else net
 
-    for epoch in range(start_epoch, cfg.epochs):
-        for group in opt.param_groups:
-            group["lr"] = epoch_lr(cfg, epoch)
-        model.train()
-        perm = torch.randperm(len(tr), generator=gen)
-        per_rank = len(perm) // world
-        perm = perm[rank * per_rank:(rank + 1) * per_rank]
-        n_batches = max(1, len(perm) // cfg.batch_size)
-        t0, seen, total = time.perf_counter(), 0, 0.0
-        bar = tqdm(range(n_batches), desc=f"epoch {epoch + 1}/{cfg.epochs}", disable=not show_progress or rank != 0,
-                   leave=False)
-        for b in bar:
-            idx = perm[b * cfg.batch_size:(b + 1) * cfg.batch_size]
-            crops, mask, act, eff = (t.to(device) for t in tr.batch(idx))
-            with _autocast(cfg, device):
-                out = step_fn(crops, mask, act, generator=noise_gen)
-            loss = masked_mse(out.effect.float(), eff, mask)
-            if not torch.isfinite(loss):
-                raise TrainingError(f"loss became {loss.item()} at epoch {epoch + 1}, step {b + 1}; "
-                                    "lower the learning rate or check the data")
-            opt.zero_grad(set_to_none=True)
-            loss.backward()
-            opt.step()
-            seen += int(mask.sum())
-            total += float(loss.detach())
-            bar.set_postfix(loss=f"{total / (b + 1):.4f}", crops_s=f"{seen * world / (time.perf_counter() - t0):.0f}")
-        train_time = time.perf_counter() - t0
-        pred = predict_effects(model, va, bf16=cfg.bf16)
-        val_loss = float(masked_mse(pred, va.effect, va.mask))
-        row = {"epoch": epoch + 1, "train_loss": round(total / n_batches, 5), "val_loss": round(val_loss, 5),
-               "val_mae_mm": mae_mm(pred, va, std), "lr": round(epoch_lr(cfg, epoch), 7), "crops_per_s": round(seen * world / train_time, 1),
-               "epoch_time_s": round(train_time, 1)}
-        history.append(row)
-        if rank == 0:
-            improved = val_loss < best
-            best = min(best, val_loss)
-            state = dict(model=model, optimizer=opt, epoch=epoch, best_val=best, history=history,
-                         rng_states={"shuffle": gen.get_state(), "noise": noise_gen.get_state(),
-                                     "torch": torch.get_rng_state()},
-                         effect_mean=mean, effect_std=std, meta=meta)
-            save_checkpoint(last, **state)
-            if improved:
-                save_checkpoint(run_dir / "best.pt", **state)
-            atomic_write_json(run_dir / "metrics.json", {"history": history, "best_val_loss": best,
-                                                         "data_fingerprint": fingerprint})
-            if show_progress:
-                print(f"epoch {epoch + 1}: train {row['train_loss']:.4f} val {val_loss:.4f} "
-                      f"mae mm {row['val_mae_mm']} {row['crops_per_s']:.0f} crops/s", flush=True)
+def _resume(run_dir: Path, cfg: TrainConfig, fingerprint: str, model: AttentiveDeepSym, opt: torch.optim.Optimizer,
+            gen: torch.Generator, noise_gen: torch.Generator) -> tuple[int, float, list]:
+    """Load RUN/last.pt into model, optimizer and generators; returns the next epoch, best val loss and history."""
+    ck = load_checkpoint(run_dir / "last.pt", expect_config=cfg.model)
+    if (_resumable(ck.meta.get("train_config", {})) != _resumable(cfg.to_json())
+            or ck.meta.get("data_fingerprint") != fingerprint):
+        raise TrainingError(f"{run_dir} holds a run with other settings or data; use a new --out or --no-resume")
+    model.load_state_dict(ck.model_state)
+    opt.load_state_dict(ck.optimizer_state)
+    gen.set_state(ck.rng_states["shuffle"])
+    noise_gen.set_state(ck.rng_states["noise"])
+    torch.set_rng_state(ck.rng_states["torch"])  # dropout
+    return ck.epoch + 1, ck.best_val, ck.history
+
+
+def _train_epoch(loop: _Loop, tr: SplitTensors, epoch: int) -> tuple[float, int, float]:
+    """One shuffled pass over this rank's share of the training split: mean loss, real crops seen, seconds."""
+    from tqdm import tqdm
+
+    cfg, world = loop.cfg, loop.world
+    for group in loop.opt.param_groups:
+        group["lr"] = epoch_lr(cfg, epoch)
+    loop.model.train()
+    perm = torch.randperm(len(tr), generator=loop.gen)
+    per_rank = len(perm) // world
+    perm = perm[loop.rank * per_rank:(loop.rank + 1) * per_rank]
+    n_batches = max(1, len(perm) // cfg.batch_size)
+    t0, seen, total = time.perf_counter(), 0, 0.0
+    bar = tqdm(range(n_batches), desc=f"epoch {epoch + 1}/{cfg.epochs}",
+               disable=not loop.show_progress or loop.rank != 0, leave=False)
+    for b in bar:
+        idx = perm[b * cfg.batch_size:(b + 1) * cfg.batch_size]
+        crops, mask, act, eff = (t.to(loop.device) for t in tr.batch(idx))
+        with _autocast(cfg, loop.device):
+            out = loop.step_fn(crops, mask, act, generator=loop.noise_gen)
+        loss = masked_mse(out.effect.float(), eff, mask)
+        if not torch.isfinite(loss):
+            raise TrainingError(f"loss became {loss.item()} at epoch {epoch + 1}, step {b + 1}; "
+                                "lower the learning rate or check the data")
+        loop.opt.zero_grad(set_to_none=True)
+        loss.backward()
+        loop.opt.step()
+        seen += int(mask.sum())
+        total += float(loss.detach())
+        bar.set_postfix(loss=f"{total / (b + 1):.4f}", crops_s=f"{seen * world / (time.perf_counter() - t0):.0f}")
+    return total / n_batches, seen, time.perf_counter() - t0
+
+
+def _validate(loop: _Loop, va: SplitTensors, epoch: int, train_loss: float, seen: int,
+              train_time: float) -> tuple[dict, float]:
+    """The epoch's history row (losses, val MAE, lr, throughput) and its unrounded validation loss."""
+    cfg = loop.cfg
+    pred = predict_effects(loop.model, va, bf16=cfg.bf16)
+    val_loss = float(masked_mse(pred, va.effect, va.mask))
+    row = {"epoch": epoch + 1, "train_loss": round(train_loss, 5), "val_loss": round(val_loss, 5),
+           "val_mae_mm": mae_mm(pred, va, loop.std), "lr": round(epoch_lr(cfg, epoch), 7),
+           "crops_per_s": round(seen * loop.world / train_time, 1), "epoch_time_s": round(train_time, 1)}
+    return row, val_loss
+
+
+def _save_epoch(loop: _Loop, epoch: int, row: dict, val_loss: float, best: float, history: list) -> float:
+    """Rank 0 after an epoch: write last.pt, best.pt when improved and metrics.json; returns the new best."""
+    improved = val_loss < best
+    best = min(best, val_loss)
+    state = dict(model=loop.model, optimizer=loop.opt, epoch=epoch, best_val=best, history=history,
+                 rng_states={"shuffle": loop.gen.get_state(), "noise": loop.noise_gen.get_state(),
+                             "torch": torch.get_rng_state()},
+                 effect_mean=loop.mean, effect_std=loop.std, meta=loop.meta)
+    save_checkpoint(loop.run_dir / "last.pt", **state)
+    if improved:
+        save_checkpoint(loop.run_dir / "best.pt", **state)
+    atomic_write_json(loop.run_dir / "metrics.json", {"history": history, "best_val_loss": best,
+                                                      "data_fingerprint": loop.meta["data_fingerprint"]})
+    if loop.show_progress:
+        print(f"epoch {epoch + 1}: train {row['train_loss']:.4f} val {val_loss:.4f} "
+              f"mae mm {row['val_mae_mm']} {row['crops_per_s']:.0f} crops/s", flush=True)
+    return best
+
+
+def _finish(loop: _Loop, history: list, best: float) -> dict:
+    """The run's result; with several ranks, also whether they ended with identical weights."""
     result = {"history": history, "best_val_loss": best}
-    if world > 1:
-        result["ranks_identical"] = _ranks_identical(model)
-        if rank == 0:
-            atomic_write_json(run_dir / "metrics.json", {**result, "data_fingerprint": fingerprint,
-                                                         "world_size": world})
+    if loop.world > 1:
+        result["ranks_identical"] = _ranks_identical(loop.model)
+        if loop.rank == 0:
+            atomic_write_json(loop.run_dir / "metrics.json", {**result, "data_fingerprint": loop.meta["data_fingerprint"],
+                                                              "world_size": loop.world})
     return result
 
 

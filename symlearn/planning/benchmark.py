@@ -102,7 +102,8 @@ def benchmark(run_dir: Path, problems_dir: Path, planners: list[str], out_file: 
     from symlearn.learning.checkpoint import load_effect_model
     from symlearn.planning.problems import load_problems
     from symlearn.sim.simulator import TabletopSimulator
-    from symlearn.symbolic.transition import TRANSITION_FILE, LearnedTransition
+    from symlearn.symbolic.learned_transition import LearnedTransition
+    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
 
     if not planners:
         raise ValueError("no planners given")

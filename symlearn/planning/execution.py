@@ -25,7 +25,7 @@ import numpy as np
 from search.result import PlanResult, PlanStatus, failed
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
 from symlearn.planning.problems import GOAL_TOLERANCE_M, Problem, goal_codes, max_goal_distance, place_scene
-from symlearn.symbolic.transition import encode_observation
+from symlearn.symbolic.transition_data import encode_observation
 from symlearn.world import decode_action
 
 PlannerFn = Callable[[TransitionFn, np.ndarray, SymbolicGoal, float], PlanResult]

@@ -120,7 +120,8 @@ def load_rules(run_dir: Path) -> tuple[RuleSet, str]:
 
 def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path | None = None) -> dict:
     """Enumerate, distil, write and check; returns the report (also written as report.json)."""
-    from symlearn.symbolic.transition import TRANSITION_FILE, LearnedTransition
+    from symlearn.symbolic.learned_transition import LearnedTransition
+    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
 
     run_dir = Path(run_dir)
     out = Path(out_dir) if out_dir else run_dir / PDDL_DIR

@@ -282,7 +282,7 @@ def place_scene(sim, scene: Scene) -> None:
 
 def scene_codes(sim, encoder, scene: Scene) -> np.ndarray:
     """(k,) int64 codes of a scene: place it, render, encode with the effect model."""
-    from symlearn.symbolic.transition import encode_observation
+    from symlearn.symbolic.transition_data import encode_observation
 
     place_scene(sim, scene)
     return encode_observation(encoder, sim.observe())

@@ -12,9 +12,10 @@ from pathlib import Path
 import numpy as np
 
 from pddl_export.symbolic import code_str, codes_from_bits
-from symlearn.learning.checkpoint import load_effect_model
-from symlearn.data.dataset import InteractionData, load_split
+from symlearn.data.dataset import InteractionData, data_fingerprint, load_split
+from symlearn.learning.checkpoint import load_effect_model, stage_record
 from symlearn.provenance import atomic_write_json
+from symlearn.symbolic.transition_data import encode_crops
 from symlearn.world import LOCATIONS, N_LOCATIONS, OBJECT_SIZE, ObjectType
 
 MOVED_M = 0.01
@@ -22,8 +23,6 @@ MOVED_M = 0.01
 
 def encode_codes(model, depth: np.ndarray, origin: np.ndarray, mask: np.ndarray) -> np.ndarray:
     """(N, K, S, S) depth crops -> (N, K) integer codes (eval-mode threshold); padding gets -1."""
-    from symlearn.symbolic.transition import encode_crops
-
     return np.where(mask, codes_from_bits(encode_crops(model, depth, origin, mask).round()), -1)
 
 
@@ -37,7 +36,7 @@ def picked_objects(data: InteractionData) -> np.ndarray:
 
 
 def analyse_symbols(run_dir: Path, data_dir: Path, symbol: str | None = None, min_count: int = 100) -> dict:
-    """Write RUN/symbols.json, RUN/symbols.png and RUN/symbol_examples.png; return the JSON."""
+    """Write RUN/symbols.json (with config, seed, versions, input hashes), symbols.png and symbol_examples.png."""
     run_dir = Path(run_dir)
     model, ck = load_effect_model(run_dir)
     bits = ck.config.bits
@@ -67,7 +66,9 @@ def analyse_symbols(run_dir: Path, data_dir: Path, symbol: str | None = None, mi
                      "moved_when_picked": None if mv is None else round(mv, 3),
                      "moved_purity": None if mv is None else round(max(mv, 1 - mv), 3)})
     w = counts / counts.sum()
-    result = {"run": str(run_dir), "n_objects": int(real.sum()), "n_distinct": int(len(uniq)),
+    config = {"run": str(run_dir), "data": str(data_dir), "symbol": symbol, "min_count": min_count}
+    result = {"run": str(run_dir), **stage_record(run_dir, ck, config), "data_fingerprint": data_fingerprint(Path(data_dir)),
+              "n_objects": int(real.sum()), "n_distinct": int(len(uniq)),
               "n_symbols_for_95pct": cover95, "frequent_min_count": min_count,
               "weighted_type_purity": round(float(sum(r["type_purity"] * wi for r, wi in zip(rows, w))), 3),
               "symbols": rows}

@@ -1,0 +1,59 @@
+"""m(z) for planners: LearnedTransition implements pddl_export.symbolic.TransitionFn on integer codes.
+
+    >>> m = LearnedTransition.from_run(Path("runs/paper"))                                          # doctest: +SKIP
+    >>> m(np.array([[3, 17]]), np.array([action_id(3, 4)]))   # (B, K) codes, (B,) actions      # doctest: +SKIP
+    array([[ 3, 19]])
+
+A* (search.learned_astar) and the PDDL export call it.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from pddl_export.symbolic import bits_from_codes, codes_from_bits
+from symlearn.learning.checkpoint import effect_model_sha256
+from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, TransitionError, load_transition
+from symlearn.symbolic.transition_model import TransitionNet, predict_bits
+from symlearn.world import N_ACTIONS
+
+
+class LearnedTransition:
+    """m(z) as a pddl_export.symbolic.TransitionFn: integer codes in, thresholded integer codes out."""
+
+    def __init__(self, net: TransitionNet, batch_size: int = 4096) -> None:
+        self.net = net.eval()
+        self.bits = int(net.cfg.bits)
+        self.batch_size = batch_size
+
+    @classmethod
+    def from_run(cls, run_dir: Path, check_encoder: bool = True) -> "LearnedTransition":
+        """Load RUN/transition.pt; refuses one trained on another effect model than RUN/best.pt."""
+        run_dir = Path(run_dir)
+        net, meta = load_transition(run_dir / TRANSITION_FILE)
+        if check_encoder:
+            best = run_dir / "best.pt"
+            if best.exists() and meta.get("effect_model_sha256") != effect_model_sha256(run_dir):
+                raise TransitionError(f"{run_dir / TRANSITION_FILE} was trained on another effect model than "
+                                      f"{best}; re-run 'symlearn train-transition'")
+        return cls(net)
+
+    def __call__(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        """(B, K) int codes and (B,) action ids -> (B, K) int64 next codes."""
+        codes = np.asarray(codes)
+        actions = np.asarray(actions)
+        if codes.ndim != 2 or actions.shape != codes.shape[:1]:
+            raise ValueError(f"codes must be (B, K) and actions (B,); got {codes.shape} and {actions.shape}")
+        if not (np.issubdtype(codes.dtype, np.integer) and np.issubdtype(actions.dtype, np.integer)):
+            raise ValueError(f"codes and actions must be integers, got {codes.dtype} and {actions.dtype}")
+        if codes.size and (codes.min() < 0 or codes.max() >= 1 << self.bits):
+            raise ValueError(f"codes must lie in 0..{(1 << self.bits) - 1}")
+        if actions.size and (actions.min() < 0 or actions.max() >= N_ACTIONS):
+            raise ValueError(f"action ids must lie in 0..{N_ACTIONS - 1}")
+        if codes.size == 0:
+            return codes.astype(np.int64)
+        bits = bits_from_codes(codes, self.bits)  # (B, K, bits)
+        mask = np.ones(codes.shape, bool)
+        nxt = predict_bits(self.net, bits, mask, actions.astype(np.int64), self.batch_size)
+        return codes_from_bits(nxt)

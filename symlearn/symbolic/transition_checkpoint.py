@@ -1,0 +1,58 @@
+"""The transition model's file, RUN/transition.pt: tensors plus JSON strings, loadable with weights_only.
+
+A missing, foreign, other-format or damaged file is refused with a one-line TransitionError.
+"""
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+
+import torch
+
+from symlearn.provenance import atomic_write_bytes
+from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet
+
+TRANSITION_KIND = "symlearn-transition-model"
+TRANSITION_FORMAT = 1
+TRANSITION_FILE = "transition.pt"
+
+
+class TransitionError(ValueError):
+    """A transition checkpoint that is missing, foreign, of another format or another effect model."""
+
+
+def save_transition(path: Path, net: TransitionNet, meta: dict) -> None:
+    """Write the transition checkpoint atomically: tensors plus JSON strings (weights_only loadable)."""
+    blob = {"kind": TRANSITION_KIND, "format_version": TRANSITION_FORMAT,
+            "config": json.dumps(net.cfg.to_json()), "model": net.state_dict(), "meta": json.dumps(meta)}
+    buf = io.BytesIO()
+    torch.save(blob, buf)
+    atomic_write_bytes(Path(path), buf.getvalue())
+
+
+def load_transition(path: Path, expect_config: TransitionConfig | None = None) -> tuple[TransitionNet, dict]:
+    """The transition network (eval mode) and its meta record; refuses foreign or mismatched files."""
+    path = Path(path)
+    if not path.exists():
+        raise TransitionError(f"no transition model at {path}; run 'symlearn train-transition' first")
+    try:
+        blob = torch.load(path, map_location="cpu", weights_only=True)
+    except Exception as e:  # torch raises several types for foreign or truncated files
+        raise TransitionError(f"{path} is not a readable checkpoint "
+                              f"({type(e).__name__}: {str(e).splitlines()[0][:120] if str(e) else ''})") from None
+    if not isinstance(blob, dict) or blob.get("kind") != TRANSITION_KIND:
+        raise TransitionError(f"{path} is not a symlearn transition-model checkpoint")
+    if blob.get("format_version") != TRANSITION_FORMAT:
+        raise TransitionError(f"{path} has transition format {blob.get('format_version')!r}, "
+                              f"expected {TRANSITION_FORMAT}")
+    try:
+        cfg = TransitionConfig.from_json(json.loads(blob["config"]))
+        meta = json.loads(blob["meta"])
+        net = TransitionNet(cfg)
+        net.load_state_dict(blob["model"])
+    except (KeyError, TypeError, ValueError, RuntimeError) as e:
+        raise TransitionError(f"{path} is a damaged transition checkpoint ({str(e).splitlines()[0][:120]})") from None
+    if expect_config is not None and cfg != expect_config:
+        raise TransitionError(f"{path} was trained with another transition config")
+    return net.eval(), meta

@@ -1,0 +1,82 @@
+"""The transition model's data: every sample's objects encoded by the trained effect model, before and after.
+
+The training pairs of m(z) are the effect model's own codes of the before- and after-crops of
+every data sample (encoder in eval mode: deterministic threshold). The same encoder turns a
+live simulator observation into codes for planning.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from pddl_export.symbolic import codes_from_bits
+from symlearn.data.dataset import InteractionData
+from symlearn.data.model_input import model_inputs
+from symlearn.learning.models import AttentiveDeepSym
+
+
+@dataclass(frozen=True)
+class TransitionData:
+    """Encoded samples of one split: codes before and after each action, as 0/1 bit arrays."""
+
+    before: np.ndarray  # (N, K, bits) float32 0/1, padded slots zero
+    action: np.ndarray  # (N,) int64 action ids
+    after: np.ndarray  # (N, K, bits) float32 0/1
+    mask: np.ndarray  # (N, K) bool, real objects
+    episode: np.ndarray  # (N,) int32 episode ids (unique within the split)
+    step: np.ndarray  # (N,) int step index within the episode
+
+    def __post_init__(self) -> None:
+        n = self.action.shape[0]
+        for f in dataclasses.fields(self):
+            if getattr(self, f.name).shape[0] != n:
+                raise ValueError(f"{f.name} has {getattr(self, f.name).shape[0]} rows, expected {n}")
+
+    def __len__(self) -> int:
+        return int(self.action.shape[0])
+
+
+@torch.no_grad()
+def encode_crops(model: AttentiveDeepSym, depth: np.ndarray, origin: np.ndarray, mask: np.ndarray,
+                 batch_size: int = 256, image_size: int = 256) -> np.ndarray:
+    """(N, K, S, S) depth crops, (N, K, 2) origins, (N, K) mask -> (N, K, bits) float32 codes (eval mode)."""
+    model.eval()
+    device = next(model.parameters()).device
+    out = []
+    for i in range(0, depth.shape[0], batch_size):
+        d = torch.from_numpy(np.asarray(depth[i:i + batch_size], np.float32))  # (B, K, S, S)
+        o = torch.from_numpy(np.asarray(origin[i:i + batch_size], np.float32))  # (B, K, 2)
+        m = torch.from_numpy(np.asarray(mask[i:i + batch_size], bool))  # (B, K)
+        crops = model_inputs(d, o, image_size)  # (B, K, 3, S, S)
+        codes, _ = model.encode(crops.to(device), m.to(device))  # (B, K, bits)
+        out.append(codes.float().cpu().numpy())
+    bits = model.cfg.bits
+    return np.concatenate(out) if out else np.zeros((0, depth.shape[1], bits), np.float32)
+
+
+def build_transition_data(model: AttentiveDeepSym, data: InteractionData,
+                          batch_size: int = 256) -> TransitionData:
+    """Encode a split's before- and after-crops with the effect model's encoder."""
+    mask = data.mask
+    before = encode_crops(model, data.pre_depth, data.pre_origin, mask, batch_size)
+    after = encode_crops(model, data.post_depth, data.post_origin, mask, batch_size)
+    return TransitionData(before, data.action.astype(np.int64), after, mask,
+                          data.episode.astype(np.int32), data.step.astype(np.int64))
+
+
+def encode_observation(model: AttentiveDeepSym, obs) -> np.ndarray:
+    """A live simulator Observation -> (k,) int64 codes, one per object, MSB first.
+
+    Crops go through float16 first, as they are stored in the data set the encoder was trained on,
+    so a live scene and its recorded twin get the same codes.
+    """
+    crops = np.asarray(obs.crops, np.float16).astype(np.float32)[None]  # (1, k, S, S)
+    origins = np.asarray(obs.origins, np.float32)[None]  # (1, k, 2)
+    if crops.shape[1] == 0:
+        return np.zeros(0, np.int64)
+    mask = np.ones(crops.shape[:2], bool)
+    bits = encode_crops(model, crops, origins, mask, image_size=int(obs.depth.shape[0]))  # (1, k, bits)
+    return codes_from_bits(bits[0])

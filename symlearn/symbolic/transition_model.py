@@ -1,0 +1,132 @@
+"""The symbolic transition network m(z): its config, the network itself and its loss.
+
+As in the paper's "Planning with Discovered Symbols": each object's binary code is
+concatenated with the 36-way one-hot action, passed through two dense layers, one
+self-attention layer over the scene's objects (padding masked out) and two more dense
+layers, giving per-object next-code logits; training minimizes binary cross-entropy per bit
+over the real objects (transition_training.py).
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+import torch
+import torch.nn as nn
+import torch.nn.functional as F
+
+from symlearn.world import N_ACTIONS
+
+
+@dataclass(frozen=True)
+class TransitionConfig:
+    """Architecture and training of m(z); `paper` follows the paper's layer counts, `quick` is small."""
+
+    preset: str = "paper"
+    bits: int = 8  # code length; always taken from the effect model the codes come from
+    hidden: int = 128  # width of every dense layer and of the attention
+    n_heads: int = 4  # attention heads (hidden must be divisible by it)
+    epochs: int = 200  # the network is tiny: 200 epochs of 10,000 samples take about a minute on CPU
+    batch_size: int = 128  # scenes per step
+    lr: float = 1e-3
+    weight_decay: float = 0.0
+    encode_batch_size: int = 256  # scenes per encoder forward pass while building the data set
+    copy_prior: float = 0.0  # added to each logit toward the input bit, so "no change" is the default
+
+    def __post_init__(self) -> None:
+        if self.hidden % self.n_heads:
+            raise ValueError(f"hidden {self.hidden} is not divisible by n_heads {self.n_heads}")
+        if not 1 <= self.bits <= 16:
+            raise ValueError(f"bits={self.bits} must lie in 1..16")
+        if self.epochs < 1 or self.batch_size < 1 or self.encode_batch_size < 1:
+            raise ValueError("epochs, batch_size and encode_batch_size must be positive")
+        if not self.lr > 0:
+            raise ValueError(f"lr={self.lr} must be positive")
+
+    @staticmethod
+    def from_preset(name: str, **overrides) -> "TransitionConfig":
+        """A named preset with optional field overrides."""
+        if name not in TRANSITION_PRESETS:
+            raise ValueError(f"unknown preset {name!r}; known: {', '.join(TRANSITION_PRESETS)}")
+        return dataclasses.replace(TRANSITION_PRESETS[name], **overrides)
+
+    def to_json(self) -> dict:
+        return dataclasses.asdict(self)
+
+    @staticmethod
+    def from_json(d: dict) -> "TransitionConfig":
+        names = {f.name for f in dataclasses.fields(TransitionConfig)}
+        unknown = set(d) - names
+        if unknown:
+            raise ValueError(f"unknown transition config fields {sorted(unknown)}")
+        return TransitionConfig(**d)  # a file from before copy_prior gets its default, 0
+
+
+TRANSITION_PRESETS = {
+    # copy_prior 3: on paper24 it raised closed-loop A* success from 0.81 to 0.91 (docs/BENCHMARKS.md)
+    "paper": TransitionConfig(preset="paper", copy_prior=3.0),
+    "quick": TransitionConfig(preset="quick", hidden=64, n_heads=4, epochs=40, batch_size=64, lr=2e-3),
+}
+
+
+class TransitionOutput(NamedTuple):
+    logits: torch.Tensor  # (B, K, bits) next-code logits, zero for padded slots
+    codes: torch.Tensor  # (B, K, bits) thresholded next codes in {0, 1}, zero for padded slots
+
+
+class TransitionNet(nn.Module):
+    """m(z): (code, action) per object -> 2 dense -> self-attention -> 2 dense -> next-code logits."""
+
+    def __init__(self, cfg: TransitionConfig) -> None:
+        super().__init__()
+        self.cfg = cfg
+        h = cfg.hidden
+        self.pre = nn.Sequential(nn.Linear(cfg.bits + N_ACTIONS, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU())
+        self.attn = nn.MultiheadAttention(h, cfg.n_heads, batch_first=True)
+        self.post = nn.Sequential(nn.Linear(h, h), nn.ReLU(), nn.Linear(h, cfg.bits))
+
+    def forward(self, codes: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor) -> TransitionOutput:
+        """Codes (B, K, bits) in {0, 1}, mask (B, K) bool, action ids (B,) -> next-code logits."""
+        if codes.dim() != 3 or codes.shape[:2] != mask.shape or codes.shape[2] != self.cfg.bits:
+            raise ValueError(f"codes must be (B, K, {self.cfg.bits}) matching mask (B, K); got "
+                             f"{tuple(codes.shape)} and {tuple(mask.shape)}")
+        if actions.shape != mask.shape[:1]:
+            raise ValueError(f"actions must be (B,), got {tuple(actions.shape)}")
+        b, k = mask.shape
+        a = F.one_hot(actions.long(), N_ACTIONS).to(codes.dtype)  # (B, 36)
+        x = torch.cat([codes, a[:, None].expand(b, k, N_ACTIONS)], dim=-1)  # (B, K, bits + 36)
+        h = self.pre(x)  # (B, K, H)
+        # A scene without real objects would attend to nothing (NaN): let its first slot attend to itself.
+        pad = ~mask
+        pad[:, 0] &= mask.any(dim=1)
+        att, _ = self.attn(h, h, h, key_padding_mask=pad, need_weights=False)  # (B, K, H)
+        h = h + att  # residual: an object keeps its own code's features beside the scene context
+        logits = self.post(h)
+        if self.cfg.copy_prior:  # most (object, action) pairs leave the code as it is
+            logits = logits + self.cfg.copy_prior * (2 * codes - 1)
+        logits = logits * mask[..., None]  # (B, K, bits)
+        return TransitionOutput(logits, (logits > 0).to(codes.dtype) * mask[..., None])
+
+
+def masked_bce(logits: torch.Tensor, target: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+    """Binary cross-entropy per bit, averaged over the bits of real objects only."""
+    per_bit = F.binary_cross_entropy_with_logits(logits, target, reduction="none")  # (B, K, bits)
+    m = mask[..., None].to(per_bit.dtype)
+    return (per_bit * m).sum() / (m.sum() * logits.shape[-1]).clamp_min(1.0)
+
+
+@torch.no_grad()
+def predict_bits(net: TransitionNet, before: np.ndarray, mask: np.ndarray, action: np.ndarray,
+                 batch_size: int = 4096) -> np.ndarray:
+    """(N, K, bits) codes, (N, K) mask, (N,) actions -> (N, K, bits) float32 thresholded next codes."""
+    net.eval()
+    out = []
+    for i in range(0, before.shape[0], batch_size):
+        o = net(torch.from_numpy(np.asarray(before[i:i + batch_size], np.float32)),
+                torch.from_numpy(np.asarray(mask[i:i + batch_size], bool)),
+                torch.from_numpy(np.asarray(action[i:i + batch_size], np.int64)))
+        out.append(o.codes.numpy())
+    return np.concatenate(out) if out else np.zeros_like(before, np.float32)
+

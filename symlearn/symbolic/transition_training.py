@@ -1,0 +1,120 @@
+"""Training m(z) on the codes of a run's effect model; writes RUN/transition.pt and RUN/transition_metrics.json.
+
+    >>> train_transition(Path("runs/paper"), Path("data/paper"), TransitionConfig.from_preset("paper"))  # doctest: +SKIP
+
+The metrics file records the transition config, the seed, package versions, the data set's
+fingerprint and the hash of the effect model (best.pt) the codes came from.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from pathlib import Path
+
+import torch
+
+from symlearn.data.dataset import data_fingerprint, load_split
+from symlearn.learning.checkpoint import effect_model_sha256, load_effect_model
+from symlearn.learning.models import AttentiveDeepSym
+from symlearn.provenance import atomic_write_json, versions
+from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, save_transition
+from symlearn.symbolic.transition_data import TransitionData, build_transition_data
+from symlearn.symbolic.transition_metrics import evaluate_transition
+from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet, masked_bce
+
+METRICS_FILE = "transition_metrics.json"
+
+
+def train_transition(run_dir: Path, data_dir: Path, cfg: TransitionConfig, seed: int = 0,
+                     show_progress: bool = False) -> dict:
+    """Train m(z) on the codes of RUN's effect model; writes RUN/transition.pt and RUN/transition_metrics.json."""
+    run_dir, data_dir = Path(run_dir), Path(data_dir)
+    t_start = time.perf_counter()
+    encoder, ck = load_effect_model(run_dir)
+    cfg = dataclasses.replace(cfg, bits=ck.config.bits)
+    fingerprint = data_fingerprint(data_dir)
+    splits = encode_splits(encoder, data_dir, cfg.encode_batch_size)
+    encode_s = time.perf_counter() - t_start
+    net, best, history = fit_transition(cfg, splits["train"], splits["val"], seed, show_progress)
+    meta = {"transition_config": cfg.to_json(), "seed": seed, "data": str(data_dir),
+            "data_fingerprint": fingerprint, "effect_model": "best.pt",
+            "effect_model_sha256": effect_model_sha256(run_dir), "effect_model_bits": ck.config.bits,
+            "best_val_loss": best, "versions": versions()}
+    save_transition(run_dir / TRANSITION_FILE, net, meta)
+    metrics = {**meta, "history": history, "n_samples": {s: len(d) for s, d in splits.items()},
+               "test": evaluate_transition(net, splits["test"]), "val": evaluate_transition(net, splits["val"]),
+               "encode_time_s": round(encode_s, 2), "wall_time_s": round(time.perf_counter() - t_start, 2)}
+    metrics = _json_safe(metrics)
+    atomic_write_json(run_dir / METRICS_FILE, metrics)
+    return metrics
+
+
+def encode_splits(encoder: AttentiveDeepSym, data_dir: Path, batch_size: int) -> dict[str, TransitionData]:
+    """The train, val and test splits encoded by the effect model: m(z)'s training, selection and test pairs."""
+    return {s: build_transition_data(encoder, load_split(data_dir, s), batch_size) for s in ("train", "val", "test")}
+
+
+def fit_transition(cfg: TransitionConfig, tr: TransitionData, va: TransitionData, seed: int,
+                   show_progress: bool = False) -> tuple[TransitionNet, float, list[dict]]:
+    """Adam on masked BCE for cfg.epochs; returns the net with its best-validation weights, that loss and the history."""
+    with torch.random.fork_rng(devices=[]):  # seeded init without touching the caller's global RNG
+        torch.manual_seed(seed)
+        net = TransitionNet(cfg)
+    opt = torch.optim.Adam(net.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
+    gen = torch.Generator().manual_seed(seed)
+    train_t = _tensors(tr)
+    x_va, m_va, a_va, y_va = _tensors(va)
+    best, best_state, history = math.inf, None, []
+    for epoch in range(cfg.epochs):
+        train_loss = _train_epoch(net, opt, gen, train_t, cfg, epoch)
+        net.eval()
+        with torch.no_grad():
+            val_loss = float(masked_bce(net(x_va, m_va, a_va).logits, y_va, m_va))
+        history.append({"epoch": epoch + 1, "train_loss": round(train_loss, 5), "val_loss": round(val_loss, 5)})
+        if val_loss < best:
+            best = val_loss
+            best_state = {k: v.detach().clone() for k, v in net.state_dict().items()}
+        if show_progress:
+            print(f"transition epoch {epoch + 1}/{cfg.epochs}: train {train_loss:.4f} val {val_loss:.4f}", flush=True)
+    net.load_state_dict(best_state)
+    net.eval()
+    return net, best, history
+
+
+def _tensors(data: TransitionData) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+    """A split's codes before, mask, actions and codes after, as tensors sharing the arrays' memory."""
+    return (torch.from_numpy(data.before), torch.from_numpy(data.mask),
+            torch.from_numpy(data.action), torch.from_numpy(data.after))
+
+
+def _train_epoch(net: TransitionNet, opt: torch.optim.Optimizer, gen: torch.Generator,
+                 train_t: tuple[torch.Tensor, ...], cfg: TransitionConfig, epoch: int) -> float:
+    """One shuffled pass over the training pairs; returns the mean batch loss."""
+    x_tr, m_tr, a_tr, y_tr = train_t
+    net.train()
+    perm = torch.randperm(len(a_tr), generator=gen)
+    n_batches = max(1, math.ceil(len(a_tr) / cfg.batch_size))
+    total = 0.0
+    for b in range(n_batches):
+        idx = perm[b * cfg.batch_size:(b + 1) * cfg.batch_size]
+        out = net(x_tr[idx], m_tr[idx], a_tr[idx])
+        loss = masked_bce(out.logits, y_tr[idx], m_tr[idx])
+        if not torch.isfinite(loss):
+            raise RuntimeError(f"transition loss became {loss.item()} at epoch {epoch + 1}; lower the learning rate")
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        opt.step()
+        total += float(loss.detach())
+    return total / n_batches
+
+
+def _json_safe(obj):
+    """NaN (metrics of empty selections) becomes null so the file stays strict JSON."""
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, dict):
+        return {k: _json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_json_safe(v) for v in obj]
+    return obj
