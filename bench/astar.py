@@ -57,6 +57,7 @@ def problems(run: Path, data: Path, n: int, length: int, seed: int, transition: 
 
 
 def measure(transition, tasks, uniform_cost: bool, timeout_s: float) -> dict:
+    """Expansions, seconds and solved count of one search mode over the tasks."""
     expansions, seconds, solved = 0, 0.0, 0
     for start, goal in tasks:
         r = plan_symbolic(transition, start, goal, uniform_cost=uniform_cost, timeout_s=timeout_s)
@@ -68,6 +69,7 @@ def measure(transition, tasks, uniform_cost: bool, timeout_s: float) -> dict:
 
 
 def main() -> None:
+    """Build the problems, time batched and unbatched search, write the JSON report."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--run", type=Path, default=Path("runs/quick32"))
     ap.add_argument("--data", type=Path, default=Path("data/paper"))

@@ -56,15 +56,18 @@ class ModelConfig:
 
     @staticmethod
     def from_preset(name: str, **overrides) -> "ModelConfig":
+        """A named preset (paper, quick) with optional field overrides."""
         if name not in PRESETS:
             raise ValueError(f"unknown preset {name!r}; known: {', '.join(PRESETS)}")
         return dataclasses.replace(PRESETS[name], **overrides)
 
     def to_json(self) -> dict:
+        """The config as plain JSON, as stored in checkpoints."""
         return dataclasses.asdict(self)
 
     @staticmethod
     def from_json(d: dict) -> "ModelConfig":
+        """The config back from to_json's form."""
         fields = {f.name for f in dataclasses.fields(ModelConfig)}
         unknown = set(d) - fields
         if unknown:
@@ -127,6 +130,7 @@ class Encoder(nn.Module):
 
 
 def mlp(sizes: list[int], batch_norm: bool = True) -> nn.Sequential:
+    """Dense layers of the given sizes with ReLU (and optional batch norm) between them."""
     layers: list[nn.Module] = []
     for a, b in zip(sizes[:-2], sizes[1:-1]):
         layers += [nn.Linear(a, b), *( [nn.BatchNorm1d(b)] if batch_norm else []), nn.ReLU(inplace=True)]

@@ -52,6 +52,7 @@ class TrainConfig:
 
     @staticmethod
     def from_preset(name: str, **overrides) -> "TrainConfig":
+        """A named preset (paper, quick); model fields among the overrides go to the model config."""
         model_over = {k: overrides.pop(k) for k in list(overrides) if k in ModelConfig.__dataclass_fields__}
         base = {"paper": dict(epochs=60, batch_size=128, lr=5e-4),
                 "quick": dict(epochs=40, batch_size=64, lr=1e-3)}
@@ -60,12 +61,14 @@ class TrainConfig:
         return TrainConfig(model=ModelConfig.from_preset(name, **model_over), preset=name, **{**base[name], **overrides})
 
     def to_json(self) -> dict:
+        """The config as plain JSON, as stored in checkpoints and config.json."""
         d = dataclasses.asdict(self)
         d["model"] = self.model.to_json()
         return json.loads(json.dumps(d))  # tuples as lists, as read back from disk
 
     @staticmethod
     def from_json(d: dict) -> "TrainConfig":
+        """The config back from to_json's form."""
         d = dict(d)
         d["model"] = ModelConfig.from_json(d["model"])
         return TrainConfig(**d)

@@ -53,10 +53,12 @@ class TransitionConfig:
         return dataclasses.replace(TRANSITION_PRESETS[name], **overrides)
 
     def to_json(self) -> dict:
+        """The config as plain JSON, as stored in the checkpoint and the metrics."""
         return dataclasses.asdict(self)
 
     @staticmethod
     def from_json(d: dict) -> "TransitionConfig":
+        """The config back from to_json's form; unknown fields are refused."""
         names = {f.name for f in dataclasses.fields(TransitionConfig)}
         unknown = set(d) - names
         if unknown:
