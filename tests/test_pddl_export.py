@@ -31,16 +31,9 @@ from pddl_export.pddl_writer import (
     strips_pddl,
 )
 from pddl_export.files import atomic_write_text
-from pddl_export.rules import (
-    AmbiguousRulesError,
-    NotEquivariantError,
-    Rule,
-    RuleSet,
-    apply_rules,
-    apply_rules_batch,
-    distil_rules,
-    rule_fidelity,
-)
+from pddl_export.distil import NotEquivariantError, distil_rules
+from pddl_export.fidelity import rule_fidelity
+from pddl_export.rules import AmbiguousRulesError, Rule, RuleSet, apply_rules, apply_rules_batch
 from pddl_export.symbolic import N_ACTIONS
 
 NEAR, FAR, STICK, RIDER, UNDER, STICK_M, RIDER_M = 1, 2, 3, 4, 5, 6, 7

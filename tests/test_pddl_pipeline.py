@@ -10,7 +10,8 @@ import pytest
 from pddl_export.pddl_writer import action_name
 from search.result import PlanResult, PlanStatus
 from symlearn.sim.collect import CollectConfig, collect
-from symlearn.planning.export import ExportConfig, export_pddl, load_rules, rules_from_json, rules_to_json
+from pddl_export.rules_io import load_rules, rules_from_json, rules_to_json
+from symlearn.planning.export import ExportConfig, export_pddl
 from symlearn.planning.planners import make_pddl_planner, network_agrees
 from symlearn.planning.problems import generate_problems
 from symlearn.learning.training import TrainConfig, train

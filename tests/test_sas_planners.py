@@ -14,8 +14,7 @@ import numpy as np
 import pytest
 
 from pddl_export.pddl_writer import action_name, conditional_domain, problem_pddl
-from pddl_export.rules import apply_rules_batch
-from pddl_export.rules import INF
+from pddl_export.rules import INF, apply_rules_batch
 from pddl_export.sas_writer import SASEncoder, context_terms
 from search.sas_planners import SAS_PLANNERS, search_binary, solve_sas
 from search.result import PlanStatus
