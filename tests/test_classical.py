@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from pddl_export.enumeration import enumerate_transitions
-from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl
+from pddl_export.pddl_writer import PddlForm, conditional_domain, problem_pddl, strips_pddl
 from pddl_export.distil import distil_rules
 from search.classical import PLANNERS, PlannerSpec, solve_pddl
 from search.up_problem import strips_problem
@@ -222,10 +222,10 @@ def test_conditional_form_refused_by_fd_opt_with_a_reason(rules):
     assert result.status is PlanStatus.ERROR and "STRIPS" in result.message and result.plan == ()
 
 
-@pytest.mark.parametrize("planner,form", [("fast-downward", "conditional"), ("pyperplan", "strips")])
+@pytest.mark.parametrize("planner,form", [("fast-downward", PddlForm.CONDITIONAL), ("pyperplan", PddlForm.STRIPS)])
 def test_unsolvable(rules, planner, form):
     _require(planner)
-    texts = _conditional(rules, NEVER) if form == "conditional" else _strips(rules, NEVER)
+    texts = _conditional(rules, NEVER) if form is PddlForm.CONDITIONAL else _strips(rules, NEVER)
     result = solve_pddl(*texts, planner=planner, timeout_s=20)
     assert result.status is PlanStatus.UNSOLVABLE and result.plan == () and result.message
 
