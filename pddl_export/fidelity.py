@@ -54,6 +54,7 @@ class Fidelity:
 
     @property
     def fraction(self) -> float:
+        """Share of transitions reproduced exactly (1.0 when there are none)."""
         return self.n_exact / self.n_transitions if self.n_transitions else 1.0
 
 
@@ -93,6 +94,7 @@ class PddlFidelity:
 
     @property
     def fraction(self) -> float:
+        """Share of simulated cases whose PDDL successor equals the network's (1.0 when none)."""
         return self.n_agree / self.n_cases if self.n_cases else 1.0
 
 

@@ -103,6 +103,7 @@ def code_from_predicate(name: str) -> int:
 
 
 def object_name(index: int) -> str:
+    """'o3' for object 3: the PDDL name of the object at that index of the scene."""
     return f"o{int(index)}"
 
 

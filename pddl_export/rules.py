@@ -110,6 +110,7 @@ class Rule:
 
     @property
     def n_conditions(self) -> int:
+        """Number of count conditions on the other objects (0: the rule always fires on code_from)."""
         return len(self.requires) + len(self.forbids) + len(self.at_least) + len(self.fewer_than)
 
 
@@ -156,6 +157,7 @@ class RuleSet:
 
     @property
     def n_rules(self) -> int:
+        """Number of rules (what the report counts)."""
         return len(self.rules)
 
     @functools.cached_property
@@ -172,6 +174,7 @@ class RuleSet:
         return tuple(sorted({r.action for r in self.rules}))
 
     def rules_for(self, action: int, code_from: int) -> tuple[Rule, ...]:
+        """The rules of one (action, own code), mutually exclusive; () if none."""
         return self._index.get((int(action), int(code_from)), ())
 
 
