@@ -18,8 +18,8 @@ import numpy as np
 import torch
 
 from pddl_export.enumeration import enumerate_transitions, multiset_indices
+from pddl_export.rules_io import load_rules
 from pddl_export.symbolic import N_ACTIONS
-from symlearn.planning.export import load_rules
 from symlearn.provenance import atomic_write_json, versions
 from symlearn.symbolic.learned_transition import LearnedTransition
 

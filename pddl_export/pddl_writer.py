@@ -1,6 +1,7 @@
 """Write learned rules as PDDL text: a lifted conditional-effects domain or a grounded STRIPS task.
 
-Two encodings of the same rules (see /work/shared/PDDL_NOTES.md for what each planner takes):
+Two encodings of the same rules (docs/DESIGN.md, "Encoding learned rules for the planners",
+says which planner takes which):
 
 * Conditional form (`conditional_domain` + `problem_pddl`): one parameterless action
   `pick-P-release-R` per real action that changes something, whose effect is
@@ -31,7 +32,7 @@ Two encodings of the same rules (see /work/shared/PDDL_NOTES.md for what each pl
   assignment and whose effect changes exactly the objects that change. Objects are domain
   constants; only :strips and :typing are needed, so every planner (pyperplan,
   fast-downward-opt) takes it. Its size grows with the reachable state space. The task also
-  carries its states and edges, from which search.classical.strips_problem builds the same
+  carries its states and edges, from which search.up_problem.strips_problem builds the same
   problem for unified-planning without its PDDL reader.
 
 Names: codes are predicates `code-<bits, MSB first>` (`code-00011011`), objects `o0, o1, ...`.
@@ -53,17 +54,22 @@ Every function returns a string; `pddl_export.files.atomic_write_text` puts one 
 """
 from __future__ import annotations
 
-import os
 import re
-import tempfile
 from dataclasses import dataclass
-from pathlib import Path
+from enum import Enum
 from typing import Sequence
 
 import numpy as np
 
 from pddl_export.rules import INF, Rule, RuleSet, apply_rules_batch
 from pddl_export.symbolic import N_ACTIONS, N_LOCATIONS, SymbolicGoal, code_str
+
+class PddlForm(str, Enum):
+    """The two PDDL encodings of the rules; the values are the names used on the command line and in JSON."""
+
+    CONDITIONAL = "conditional"  # conditional_domain + problem_pddl: lifted, one action per real action
+    STRIPS = "strips"  # strips_pddl: grounded over the states reachable from one initial state
+
 
 OBJECT_TYPE = "obj"
 SCENE_TYPE, SCENE_CONSTANT, SCENE_VAR = "scene", "the-scene", "?s"  # the one-object wrapper type
@@ -97,6 +103,7 @@ def code_from_predicate(name: str) -> int:
 
 
 def object_name(index: int) -> str:
+    """'o3' for object 3: the PDDL name of the object at that index of the scene."""
     return f"o{int(index)}"
 
 
@@ -207,7 +214,7 @@ def conditional_domain(rules: RuleSet, model_hash: str, name: str = "symlearn") 
     flags += [":negative-preconditions"] if uses["neg"] else []
     flags += [":equality"] if uses["eq"] else []
     preds = " ".join(f"({code_predicate(c, bits)} ?o - {OBJECT_TYPE})" for c in rules.codes)
-    lines = _header("domain (conditional form)", model_hash, rules, [f"actions: {len(actions)}"])
+    lines = _header(f"domain ({PddlForm.CONDITIONAL.value} form)", model_hash, rules, [f"actions: {len(actions)}"])
     types = f"{OBJECT_TYPE} {SCENE_TYPE}" if uses["exists"] else OBJECT_TYPE
     lines += [f"(define (domain {pddl_name(name)})", f"  {_requirements(*flags)}", f"  (:types {types})"]
     lines += [f"  (:constants {SCENE_CONSTANT} - {SCENE_TYPE})"] if uses["exists"] else []

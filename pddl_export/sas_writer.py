@@ -45,6 +45,7 @@ from __future__ import annotations
 import functools
 import itertools
 from dataclasses import dataclass
+from enum import Enum
 from typing import Sequence
 
 from pddl_export.pddl_writer import action_name, checked_task, code_predicate, object_name
@@ -91,7 +92,14 @@ class _Body:
     n_axioms: int
 
 
-Option = tuple[str, tuple[int, ...]]  # ("eq", (j,)): z has X_j; ("not", T): z has none of X_j, j in T
+class TermKind(str, Enum):
+    """What one term of a context DNF says about one other object z (str-valued: compares equal to its name)."""
+
+    EQ = "eq"  # (EQ, (j,)): z has X_j
+    NOT = "not"  # (NOT, T): z has none of X_j, j in T (T empty: z is free)
+
+
+Option = tuple[TermKind, tuple[int, ...]]
 
 
 @functools.lru_cache(maxsize=4096)
@@ -111,11 +119,13 @@ def context_terms(intervals: tuple[tuple[int, int], ...], k: int) -> tuple[tuple
              if all(lo <= c.count(j) < hi for j, (lo, hi) in enumerate(intervals))}
     everything: tuple[int, ...] = tuple(range(m))
     if m > MAX_SUBSET_CODES:
-        return tuple(tuple(("eq", (j,)) if j < m else ("not", everything) for j in cell) for cell in sorted(cells))
-    options: list[tuple[Option, frozenset[int], int]] = [(("eq", (j,)), frozenset([j]), 1) for j in range(m)]
+        return tuple(tuple((TermKind.EQ, (j,)) if j < m else (TermKind.NOT, everything) for j in cell)
+                     for cell in sorted(cells))
+    options: list[tuple[Option, frozenset[int], int]] = [((TermKind.EQ, (j,)), frozenset([j]), 1)
+                                                          for j in range(m)]
     for size in range(m + 1):
         for t in itertools.combinations(range(m), size):
-            options.append((("not", t), frozenset(cats) - frozenset(t), size))
+            options.append(((TermKind.NOT, t), frozenset(cats) - frozenset(t), size))
     implicants = []
     for combo in itertools.product(options, repeat=k):
         covered = frozenset(itertools.product(*(c for _, c, _ in combo)))
@@ -180,7 +190,7 @@ class SASEncoder:
                     for term in terms:
                         cond = list(own)
                         for z, (kind, js) in zip(others, term):
-                            if kind == "eq":
+                            if kind is TermKind.EQ:
                                 cond.append((z, self.value[xs[js[0]]]))
                             else:
                                 cond += [(has_var(z, xs[j]), 0) for j in js]

@@ -42,6 +42,18 @@ class SearchOutcome(Generic[S, A]):
     time_s: float
 
 
+def _path(parent: dict[S, tuple[S, A] | None], goal: S) -> tuple[tuple[A, ...], tuple[S, ...]]:
+    """The actions and states from the start to goal, following parent links back from goal."""
+    actions: list[A] = []
+    states: list[S] = [goal]
+    node = goal
+    while (link := parent[node]) is not None:
+        node, action = link
+        actions.append(action)
+        states.append(node)
+    return tuple(reversed(actions)), tuple(reversed(states))
+
+
 def astar(
     start: S,
     is_goal: Callable[[S], bool],
@@ -73,19 +85,9 @@ def astar(
     expansions, generated = 0, 1
 
     def outcome(status: PlanStatus, goal: S | None = None) -> SearchOutcome[S, A]:
-        actions: list[A] = []
-        states: list[S] = []
-        if goal is not None:
-            node: S = goal
-            states.append(node)
-            while (link := parent[node]) is not None:
-                node, action = link
-                actions.append(action)
-                states.append(node)
-            actions.reverse()
-            states.reverse()
+        actions, states = _path(parent, goal) if goal is not None else ((), ())
         return SearchOutcome(
-            status=status, actions=tuple(actions), states=tuple(states),
+            status=status, actions=actions, states=states,
             cost=best_g[goal] if goal is not None else math.inf,
             expansions=expansions, generated=generated, time_s=time.perf_counter() - t0)
 

@@ -13,8 +13,9 @@ SymK run as subprocesses in their own session, killed by unified-planning at the
 grace_s leaves room for that before the guard fires.
 
 When the chosen engine does not accept the problem as written, unified-planning compilers
-are applied in the order of /work/shared/PDDL_NOTES.md (quantifiers removing, grounding,
-disjunctive- and negative-conditions removing), each only when needed. Conditional effects
+are applied in the order given in docs/DESIGN.md ("Encoding learned rules for the planners":
+quantifiers removing, grounding, disjunctive- and negative-conditions removing), each only
+when needed. Conditional effects
 are compiled away only on request (compile_conditional_effects=True): that compiler makes
 2^(number of conditional effects) actions per action, so for pyperplan and
 fast-downward-opt the grounded STRIPS form of pddl_export.pddl_writer is the scalable route.
@@ -22,11 +23,10 @@ Plans of the compiled problem are mapped back (map_back_action_instance, in reve
 validated on the original problem with unified-planning's PlanValidator, converted to
 action ids by name (`pick-P-release-R[-sN]` -> P * 6 + R) and replayed with the
 SequentialSimulator to report the predicted symbolic states (objects `o<i>`, predicates
-`code-<bits>`).
+`code-<bits>`). Building and reading the problems is search.up_problem's job.
 """
 from __future__ import annotations
 
-import hashlib
 import math
 import multiprocessing as mp
 import re
@@ -35,9 +35,9 @@ import warnings
 from dataclasses import dataclass
 from typing import Any
 
-from pddl_export.pddl_writer import (OBJECT_TYPE, StripsTask, action_id_from_name, action_name, code_from_predicate,
-                                     code_predicate, object_index, object_name)
+from pddl_export.pddl_writer import action_id_from_name
 from search.result import PlanResult, PlanStatus, failed, one_line
+from search.up_problem import parsed_domain, predicted_states, problem_on_domain, with_only_actions
 
 
 @dataclass(frozen=True)
@@ -82,7 +82,7 @@ def _status_from_up(status: Any) -> PlanStatus:
 
 
 def _compile_steps(compile_conditional_effects: bool):
-    """(compilation kind name, whether the problem needs it) in the order PDDL_NOTES.md gives."""
+    """(compilation kind name, whether the problem needs it) in the order docs/DESIGN.md gives."""
     return [
         ("QUANTIFIERS_REMOVING", lambda p, k: k.has_existential_conditions() or k.has_universal_conditions()
          or k.has_forall_effects()),
@@ -93,188 +93,12 @@ def _compile_steps(compile_conditional_effects: bool):
     ]
 
 
-def _decode_state(state: Any, objects: list, fluents: list) -> tuple[int, ...]:
-    """Per object (o0, o1, ...) the code whose predicate holds; -1 if not exactly one."""
-    out = []
-    for o in objects:
-        held = [code for code, f in fluents if state.get_value(f(o)).bool_constant_value()]
-        out.append(held[0] if len(held) == 1 else -1)
-    return tuple(out)
-
-
-def _predicted_states(problem: Any, plan: Any) -> tuple[tuple[tuple[int, ...], ...], str]:
-    """Replay the plan on the original problem; ((), why) when objects/predicates are not ours."""
-    from unified_planning.shortcuts import SequentialSimulator
-
-    try:
-        objects = sorted((o for o in problem.all_objects if o.type.name == OBJECT_TYPE),
-                         key=lambda o: object_index(o.name))
-        fluents = [(code_from_predicate(f.name), f) for f in problem.fluents]
-    except ValueError as e:
-        return (), f"no predicted states: {e}"
-    if [object_index(o.name) for o in objects] != list(range(len(objects))):
-        return (), "no predicted states: objects are not o0..oK-1"
-    with SequentialSimulator(problem) as sim:
-        state = sim.get_initial_state()
-        states = [_decode_state(state, objects, fluents)]
-        for ai in plan.actions:
-            state = sim.apply(state, ai)
-            states.append(_decode_state(state, objects, fluents))
-    if any(c < 0 for s in states for c in s):
-        return (), "no predicted states: some object does not hold exactly one code"
-    return tuple(states), ""
-
-
-def strips_problem(task: StripsTask) -> Any:
-    """unified-planning's Problem for a grounded STRIPS task, built from its data without the PDDL reader.
-
-    The same problem as reading task.domain and task.problem (tests compare the two); the reader
-    does not finish within a minute on the ~12 MB of a 2-object task of the learned rules.
-    """
-    from unified_planning.shortcuts import BoolType, Fluent, InstantaneousAction, Object, Problem, UserType
-
-    if not task.states or not task.bits:
-        raise ValueError("the STRIPS task carries no states; make it with pddl_export.pddl_writer.strips_pddl")
-    obj_type = UserType(OBJECT_TYPE)
-    n = len(task.states[0])
-    objects = [Object(object_name(i), obj_type) for i in range(n)]
-    problem = Problem(task.name)
-    fluents = {}
-    for c in sorted(set(task.codes) | {c for c in task.goal if c is not None}):
-        fluents[c] = Fluent(code_predicate(c, task.bits), BoolType(), o=obj_type)
-        problem.add_fluent(fluents[c], default_initial_value=False)
-    problem.add_objects(objects)
-    atoms: dict[tuple[int, int], Any] = {}
-
-    def atom(code: int, i: int) -> Any:
-        if (code, i) not in atoms:
-            atoms[code, i] = fluents[code](objects[i])
-        return atoms[code, i]
-
-    actions = []
-    for i, a, j in task.edges:
-        act = InstantaneousAction(f"{action_name(a)}-s{i}")
-        pre, post = task.states[i], task.states[j]
-        for k, c in enumerate(pre):
-            act.add_precondition(atom(c, k))
-        for k, (c, d) in enumerate(zip(pre, post)):
-            if c != d:
-                act.add_effect(atom(c, k), False)
-                act.add_effect(atom(d, k), True)
-        actions.append(act)
-    if len({a.name for a in actions}) != len(actions):
-        raise ValueError("the STRIPS task has two ground actions with one name")
-    listed = getattr(problem, "_actions", None)
-    if isinstance(listed, list) and not listed:
-        # Problem.add_action compares each new name with every action's (quadratic: hours for the
-        # 64,000 actions of a 2-object task); the names are checked unique above.
-        listed.extend(actions)
-    else:
-        problem.add_actions(actions)
-    for k, c in enumerate(task.states[0]):
-        problem.set_initial_value(atom(c, k), True)
-    for k, c in enumerate(task.goal):
-        if c is not None:
-            problem.add_goal(atom(c, k))
-    return problem
-
-
 _FEW_ACTIONS = 1000  # above this many actions, plans are validated on the problem cut to the plan's actions
 
 
-def _with_only_actions(problem: Any, plan: Any) -> Any:
-    """The problem with the same fluents, objects, initial state and goals, and only the plan's actions."""
-    from unified_planning.model import Problem
-
-    sub = Problem(problem.name, problem.environment)
-    for f in problem.fluents:
-        sub.add_fluent(f, default_initial_value=problem.fluents_defaults.get(f))
-    sub.add_objects(problem.all_objects)
-    used = {ai.action.name for ai in plan.actions}
-    for a in problem.actions:
-        if a.name in used:
-            sub.add_action(a)
-    for fluent, value in problem.explicit_initial_values.items():
-        sub.set_initial_value(fluent, value)
-    for g in problem.goals:
-        sub.add_goal(g)
-    return sub
-
-
-_DOMAINS: dict[str, Any] = {}  # sha256 of a domain text -> its unified-planning problem without objects
-
-
-def parsed_domain(domain_text: str) -> Any:
-    """unified-planning's parse of a domain alone, cached by the text's hash.
-
-    Parsing is the slow part of a call on a large learned domain (unified-planning's reader
-    takes about 30 s for a 1,000-rule domain), so repeated calls on one domain parse it once.
-    """
-    key = hashlib.sha256(domain_text.encode()).hexdigest()
-    if key not in _DOMAINS:
-        from unified_planning.io import PDDLReader
-
-        _DOMAINS[key] = PDDLReader().parse_problem_string(domain_text)
-    return _DOMAINS[key]
-
-
-def _instance(domain: Any, problem_text: str) -> Any | None:
-    """The problem on a copy of a parsed domain, or None if it is more than this reads.
-
-    The problem text is read with the `pddl` package: typed objects, positive ground init
-    atoms and a goal that is an atom or a conjunction of atoms and negated atoms (what
-    pddl_export.pddl_writer.problem_pddl writes). Anything else returns None, and the
-    caller parses domain and problem together with unified-planning.
-    """
-    import sys
-
-    from pddl.logic.base import And, Not
-    from pddl.logic.predicates import Predicate
-    from pddl.parser.problem import ProblemParser
-    from unified_planning.model import Object
-
-    old = getattr(sys, "tracebacklimit", None)
+def _engine_class(planner: str, spec: PlannerSpec, t0: float) -> Any:
+    """unified-planning's engine class for the spec, or a failed PlanResult (not installed)."""
     try:
-        parsed = ProblemParser()(problem_text)
-    except Exception:  # noqa: BLE001 - let unified-planning's reader report the error
-        return None
-    finally:  # the pddl parser leaves sys.tracebacklimit at 0 on errors
-        if old is None and hasattr(sys, "tracebacklimit"):
-            del sys.tracebacklimit
-    problem = domain.clone()
-    problem.name = str(parsed.name).lower()
-    try:
-        for const in sorted(parsed.objects, key=lambda c: c.name):
-            if len(const.type_tags) != 1:
-                return None
-            type_name = str(next(iter(const.type_tags))).lower()
-            problem.add_object(Object(str(const.name).lower(), domain.user_type(type_name)))
-
-        def atom(lit: Any) -> Any:
-            if not isinstance(lit, Predicate):
-                raise ValueError("not an atom")
-            return problem.fluent(str(lit.name).lower())(*[problem.object(str(t.name).lower()) for t in lit.terms])
-
-        for lit in parsed.init:
-            problem.set_initial_value(atom(lit), True)
-        goals = parsed.goal.operands if isinstance(parsed.goal, And) else (parsed.goal,)
-        for g in goals:
-            problem.add_goal(~atom(g.argument) if isinstance(g, Not) else atom(g))
-    except Exception:  # noqa: BLE001 - an unknown name, type or form: fall back to the full parse
-        return None
-    return problem
-
-
-def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: float,
-                compile_conditional_effects: bool, domain: Any = None, prebuilt: Any = None) -> PlanResult:
-    """The whole pipeline in this process; never raises (ERROR instead)."""
-    t0 = time.perf_counter()
-    deadline = t0 + timeout_s
-    spec = PLANNERS[planner]
-    try:
-        from unified_planning.engines import CompilationKind, PlanGenerationResultStatus, ValidationResultStatus
-        from unified_planning.io import PDDLReader
-        from unified_planning.shortcuts import Compiler, MinimizeSequentialPlanLength, OneshotPlanner, PlanValidator
         from unified_planning.shortcuts import get_environment
     except ImportError as e:
         return failed(planner, PlanStatus.ERROR, t0, f"unified-planning is not installed: {e}")
@@ -282,22 +106,40 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
     env.credits_stream = None
     if spec.engine not in env.factory.engines:
         return failed(planner, PlanStatus.ERROR, t0, f"engine {spec.engine!r} is not installed")
-    engine_cls = env.factory.engine(spec.engine)
-    original = prebuilt if prebuilt is not None else _instance(domain, problem_text) if domain is not None else None
+    return env.factory.engine(spec.engine)
+
+
+def _read_problem(domain_text: str, problem_text: str, planner: str, t0: float, domain: Any, prebuilt: Any) -> Any:
+    """The problem to solve (prebuilt, built on the cached domain, or parsed from both texts) or a failed PlanResult."""
+    from unified_planning.io import PDDLReader
+    from unified_planning.shortcuts import get_environment
+
+    original = prebuilt if prebuilt is not None else problem_on_domain(domain, problem_text) if domain is not None else None
     if original is None:
         try:
-            original = PDDLReader(env).parse_problem_string(domain_text, problem_text)
+            original = PDDLReader(get_environment()).parse_problem_string(domain_text, problem_text)
         except Exception as e:  # noqa: BLE001 - any parser failure is reported, not raised
             return failed(planner, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}")
-    t_parse = time.perf_counter() - t0
+    return original
+
+
+@dataclass(frozen=True)
+class _Compiled:
+    """The problem the engine gets, its kind, and the compilations that led to it (in order)."""
+
+    problem: Any
+    kind: Any
+    chain: tuple[Any, ...]
+    names: tuple[str, ...]
+
+
+def _compile(original: Any, pkind: Any, planner: str, spec: PlannerSpec, engine_cls: Any,
+             compile_conditional_effects: bool, deadline: float, t0: float) -> _Compiled | PlanResult:
+    """Add the length metric for optimal planners and apply the compilers the engine needs (docs/DESIGN.md order)."""
+    from unified_planning.engines import CompilationKind
+    from unified_planning.shortcuts import Compiler, MinimizeSequentialPlanLength
 
     problem, chain, names = original, [], []
-    pkind = original.kind  # computed once per problem: it walks every action (11 s for 64,000 of them)
-    if (pkind.has_conditional_effects() and not compile_conditional_effects
-            and not engine_cls.supported_kind().has_conditional_effects()):
-        return failed(planner, PlanStatus.ERROR, t0, f"{planner} does not support CONDITIONAL_EFFECTS; use the "
-                       "grounded STRIPS form (pddl_export.pddl_writer.strips_pddl) or compile_conditional_effects=True",
-                       engine=spec.engine, parse_time_s=t_parse)
     try:
         if spec.optimal:  # ask for a shortest plan explicitly, so the status says SOLVED_OPTIMALLY
             with_metric = original.clone()
@@ -321,15 +163,54 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
                 return failed(planner, PlanStatus.TIMEOUT, t0, f"time limit reached while compiling ({kind_name.lower()})")
     except Exception as e:  # noqa: BLE001
         return failed(planner, PlanStatus.ERROR, t0, f"compilation failed: {type(e).__name__}: {e}")
-    t_compile = time.perf_counter() - t0 - t_parse
-    extra: dict[str, Any] = {
-        "engine": spec.engine, "parse_time_s": t_parse, "compile_time_s": t_compile,
-        "compilers": ",".join(names), "n_actions": len(problem.actions)}
-    if not engine_cls.supports(pkind):
-        missing = sorted(set(pkind.features) - set(engine_cls.supported_kind().features))
-        hint = ("; use the grounded STRIPS form (pddl_export.pddl_writer.strips_pddl)"
-                if "CONDITIONAL_EFFECTS" in missing else "")
-        return failed(planner, PlanStatus.ERROR, t0, f"{planner} does not support {', '.join(missing)}{hint}", **extra)
+    return _Compiled(problem, pkind, tuple(chain), tuple(names))
+
+
+def _unsolved(res: Any, status: PlanStatus, planner: str, timeout_s: float, t0: float, extra: dict) -> PlanResult:
+    """The failed result for a planner answer other than SOLVED, with the reason in words."""
+    from unified_planning.engines import PlanGenerationResultStatus
+
+    why = {PlanStatus.UNSOLVABLE: "no plan exists" if res.status == PlanGenerationResultStatus.UNSOLVABLE_PROVEN
+           else "search space exhausted (no proof of unsolvability)",
+           PlanStatus.TIMEOUT: f"{planner} hit the {timeout_s:g} s time limit"}.get(
+               status, f"{planner} ended with {res.status.name}")
+    return failed(planner, status, t0, why, **extra)
+
+
+def _validated_plan(original: Any, plan: Any, chain: tuple[Any, ...], planner: str, t0: float,
+                    expansions: int | None, extra: dict) -> PlanResult:
+    """Map the plan back through the compilations, validate it on the original problem and replay it."""
+    from unified_planning.engines import ValidationResultStatus
+    from unified_planning.shortcuts import PlanValidator
+
+    try:
+        t2 = time.perf_counter()
+        for compiled in reversed(chain):
+            plan = plan.replace_action_instances(compiled.map_back_action_instance)
+        # A sequential plan's validity depends on the initial state, the goal and the actions it uses,
+        # so a large grounded problem is validated with only those (the validator and the simulator
+        # recompute the problem kind, a walk over every action, several times).
+        checked = original if len(original.actions) <= _FEW_ACTIONS else with_only_actions(original, plan)
+        with PlanValidator(problem_kind=checked.kind, plan_kind=plan.kind) as validator:
+            check = validator.validate(checked, plan)
+        extra["validate_time_s"] = time.perf_counter() - t2
+        if check.status != ValidationResultStatus.VALID:
+            reason = getattr(check, "reason", None) or getattr(check, "inapplicable_action", None) or ""
+            return failed(planner, PlanStatus.ERROR, t0, f"plan failed validation on the original problem {reason}", **extra)
+        ids = tuple(action_id_from_name(ai.action.name) for ai in plan.actions)
+        states, note = predicted_states(checked, plan)
+    except Exception as e:  # noqa: BLE001
+        return failed(planner, PlanStatus.ERROR, t0, f"plan mapping/validation failed: {type(e).__name__}: {e}", **extra)
+    if note:
+        extra["note"] = note
+    return PlanResult(planner=planner, status=PlanStatus.SOLVED, plan=ids, predicted_states=states,
+                      expansions=expansions, planning_time_s=time.perf_counter() - t0, extra=extra)
+
+
+def _plan(problem: Any, planner: str, spec: PlannerSpec, timeout_s: float, deadline: float, t0: float,
+          extra: dict) -> Any:
+    """Run the engine on the compiled problem with the time left: (its result, seconds) or a failed PlanResult."""
+    from unified_planning.shortcuts import OneshotPlanner
 
     remaining = deadline - time.perf_counter()
     if remaining <= 0:
@@ -340,49 +221,60 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
             with OneshotPlanner(name=spec.engine, params=dict(spec.params)) as engine:
                 t1 = time.perf_counter()
                 res = engine.solve(problem, timeout=remaining if spec.native_timeout else None)
-                planner_time = time.perf_counter() - t1
+                return res, time.perf_counter() - t1
     except Exception as e:  # noqa: BLE001
         return failed(planner, PlanStatus.ERROR, t0, f"{planner} failed: {type(e).__name__}: {e}", **extra)
+
+
+def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: float,
+                compile_conditional_effects: bool, domain: Any = None, prebuilt: Any = None) -> PlanResult:
+    """The whole pipeline in this process (read, compile, plan, validate); never raises (ERROR instead)."""
+    t0 = time.perf_counter()
+    deadline = t0 + timeout_s
+    spec = PLANNERS[planner]
+    engine_cls = _engine_class(planner, spec, t0)
+    if isinstance(engine_cls, PlanResult):
+        return engine_cls
+    original = _read_problem(domain_text, problem_text, planner, t0, domain, prebuilt)
+    if isinstance(original, PlanResult):
+        return original
+    t_parse = time.perf_counter() - t0
+    pkind = original.kind  # computed once per problem: it walks every action (11 s for 64,000 of them)
+    if (pkind.has_conditional_effects() and not compile_conditional_effects
+            and not engine_cls.supported_kind().has_conditional_effects()):
+        return failed(planner, PlanStatus.ERROR, t0, f"{planner} does not support CONDITIONAL_EFFECTS; use the "
+                      "grounded STRIPS form (pddl_export.pddl_writer.strips_pddl) or compile_conditional_effects=True",
+                      engine=spec.engine, parse_time_s=t_parse)
+    comp = _compile(original, pkind, planner, spec, engine_cls, compile_conditional_effects, deadline, t0)
+    if isinstance(comp, PlanResult):
+        return comp
+    extra: dict[str, Any] = {
+        "engine": spec.engine, "parse_time_s": t_parse, "compile_time_s": time.perf_counter() - t0 - t_parse,
+        "compilers": ",".join(comp.names), "n_actions": len(comp.problem.actions)}
+    if not engine_cls.supports(comp.kind):
+        missing = sorted(set(comp.kind.features) - set(engine_cls.supported_kind().features))
+        hint = ("; use the grounded STRIPS form (pddl_export.pddl_writer.strips_pddl)"
+                if "CONDITIONAL_EFFECTS" in missing else "")
+        return failed(planner, PlanStatus.ERROR, t0, f"{planner} does not support {', '.join(missing)}{hint}", **extra)
+    ran = _plan(comp.problem, planner, spec, timeout_s, deadline, t0, extra)
+    if isinstance(ran, PlanResult):
+        return ran
+    res, planner_time = ran
+    from unified_planning.engines import PlanGenerationResultStatus
+
     extra.update(planner_time_s=planner_time, up_status=res.status.name,
                  optimal=res.status == PlanGenerationResultStatus.SOLVED_OPTIMALLY)
-    logs = " ".join(m.message for m in (res.log_messages or []))
-    found = _EXPANDED_RE.findall(logs)
+    found = _EXPANDED_RE.findall(" ".join(m.message for m in (res.log_messages or [])))
     expansions = int(found[-1]) if found else None
     status = _status_from_up(res.status)
     if not spec.native_timeout and time.perf_counter() > deadline:
         return failed(planner, PlanStatus.TIMEOUT, t0, f"{planner} ran past the {timeout_s:g} s limit "
-                       f"({planner_time:.3f} s; it has no time limit of its own)", **extra)
+                      f"({planner_time:.3f} s; it has no time limit of its own)", **extra)
     if status is not PlanStatus.SOLVED:
-        why = {PlanStatus.UNSOLVABLE: "no plan exists" if res.status == PlanGenerationResultStatus.UNSOLVABLE_PROVEN
-               else "search space exhausted (no proof of unsolvability)",
-               PlanStatus.TIMEOUT: f"{planner} hit the {timeout_s:g} s time limit"}.get(
-                   status, f"{planner} ended with {res.status.name}")
-        return failed(planner, status, t0, why, **extra)
+        return _unsolved(res, status, planner, timeout_s, t0, extra)
     if res.plan is None:
         return failed(planner, PlanStatus.ERROR, t0, f"{planner} reported {res.status.name} without a plan", **extra)
-    try:
-        t2 = time.perf_counter()
-        plan = res.plan
-        for compiled in reversed(chain):
-            plan = plan.replace_action_instances(compiled.map_back_action_instance)
-        # A sequential plan's validity depends on the initial state, the goal and the actions it uses,
-        # so a large grounded problem is validated with only those (the validator and the simulator
-        # recompute the problem kind, a walk over every action, several times).
-        checked = original if len(original.actions) <= _FEW_ACTIONS else _with_only_actions(original, plan)
-        with PlanValidator(problem_kind=checked.kind, plan_kind=plan.kind) as validator:
-            check = validator.validate(checked, plan)
-        extra["validate_time_s"] = time.perf_counter() - t2
-        if check.status != ValidationResultStatus.VALID:
-            reason = getattr(check, "reason", None) or getattr(check, "inapplicable_action", None) or ""
-            return failed(planner, PlanStatus.ERROR, t0, f"plan failed validation on the original problem {reason}", **extra)
-        ids = tuple(action_id_from_name(ai.action.name) for ai in plan.actions)
-        states, note = _predicted_states(checked, plan)
-    except Exception as e:  # noqa: BLE001
-        return failed(planner, PlanStatus.ERROR, t0, f"plan mapping/validation failed: {type(e).__name__}: {e}", **extra)
-    if note:
-        extra["note"] = note
-    return PlanResult(planner=planner, status=PlanStatus.SOLVED, plan=ids, predicted_states=states,
-                      expansions=expansions, planning_time_s=time.perf_counter() - t0, extra=extra)
+    return _validated_plan(original, res.plan, comp.chain, planner, t0, expansions, extra)
 
 
 def _worker(conn: Any, *args: Any) -> None:
@@ -399,6 +291,63 @@ def _worker(conn: Any, *args: Any) -> None:
 def _context() -> Any:
     methods = mp.get_all_start_methods()
     return mp.get_context("fork" if "fork" in methods else "spawn")
+
+
+def _check_limits(timeout_s: float, grace_s: float) -> None:
+    """ValueError unless timeout_s > 0 and grace_s >= 0 are finite numbers."""
+    if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
+        raise ValueError(f"timeout_s must be a positive number, got {timeout_s!r}")
+    if not (math.isfinite(grace_s) and grace_s >= 0):
+        raise ValueError(f"grace_s must be >= 0, got {grace_s!r}")
+
+
+def _prepare(name: str, domain_text: str, cache_domain: bool, t0: float) -> Any:
+    """Load unified-planning (so a forked child starts with it) and, with cache_domain, the parsed domain.
+
+    Returns the domain (None without cache_domain) or a failed PlanResult.
+    """
+    if name not in PLANNERS:
+        return failed(name or "unknown", PlanStatus.ERROR, t0, f"unknown planner {name!r}; known: {', '.join(PLANNERS)}",
+                      total_time_s=time.perf_counter() - t0)
+    try:
+        import unified_planning.shortcuts  # noqa: F401
+        from unified_planning.shortcuts import get_environment
+
+        get_environment().credits_stream = None
+    except ImportError as e:
+        return failed(name, PlanStatus.ERROR, t0, f"unified-planning is not installed: {e}",
+                      total_time_s=time.perf_counter() - t0)
+    if not cache_domain:
+        return None
+    try:
+        return parsed_domain(domain_text)
+    except Exception as e:  # noqa: BLE001
+        return failed(name, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}",
+                      total_time_s=time.perf_counter() - t0)
+
+
+def _run_guarded(args: tuple, wait_s: float) -> tuple[Any, int | None]:
+    """_solve_here(*args) in a child process: (its JSON answer, None if it died, or "late"; the child's exit code)."""
+    ctx = _context()
+    recv, send = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_worker, args=(send, *args), daemon=True)
+    answer: Any = None  # stays None if the child dies (or on an exception here); "late" on the guard
+    proc.start()
+    send.close()
+    try:
+        if recv.poll(wait_s):
+            try:
+                answer = recv.recv()
+            except EOFError:
+                answer = None
+        else:
+            answer = "late"
+    finally:
+        recv.close()
+        if not isinstance(answer, dict):
+            proc.kill()
+        proc.join(5.0)
+    return answer, proc.exitcode
 
 
 def solve_pddl(
@@ -419,58 +368,22 @@ def solve_pddl(
     "pyperplan". The call takes at most about timeout_s + grace_s seconds. With cache_domain, the domain
     is parsed once in this process (parsed_domain; the first call's time includes it, outside
     the guard) and each call reads only the problem. With `problem` (a unified-planning Problem
-    equal to the texts, e.g. strips_problem), nothing is parsed.
+    equal to the texts, e.g. search.up_problem.strips_problem), nothing is parsed.
     """
     t0 = time.perf_counter()
-    if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
-        raise ValueError(f"timeout_s must be a positive number, got {timeout_s!r}")
-    if not (math.isfinite(grace_s) and grace_s >= 0):
-        raise ValueError(f"grace_s must be >= 0, got {grace_s!r}")
+    _check_limits(timeout_s, grace_s)
     name = str(planner)
-    if name not in PLANNERS:
-        return failed(name or "unknown", PlanStatus.ERROR, t0, f"unknown planner {name!r}; known: {', '.join(PLANNERS)}",
-                       total_time_s=time.perf_counter() - t0)
-    try:  # import here so a forked child starts with unified-planning loaded
-        import unified_planning.shortcuts  # noqa: F401
-        from unified_planning.shortcuts import get_environment
-
-        get_environment().credits_stream = None
-    except ImportError as e:
-        return failed(name, PlanStatus.ERROR, t0, f"unified-planning is not installed: {e}",
-                       total_time_s=time.perf_counter() - t0)
-    domain = None
-    if cache_domain:
-        try:
-            domain = parsed_domain(domain_text)
-        except Exception as e:  # noqa: BLE001
-            return failed(name, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}",
-                           total_time_s=time.perf_counter() - t0)
-    ctx = _context()
-    recv, send = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_worker, args=(send, domain_text, problem_text, name, float(timeout_s),
-                                             compile_conditional_effects, domain, problem), daemon=True)
-    answer: Any = None  # stays None if the child dies (or on an exception here); "late" on the guard
-    proc.start()
-    send.close()
-    try:
-        if recv.poll(timeout_s + grace_s):
-            try:
-                answer = recv.recv()
-            except EOFError:
-                answer = None
-        else:
-            answer = "late"
-    finally:
-        recv.close()
-        if not isinstance(answer, dict):
-            proc.kill()
-        proc.join(5.0)
+    domain = _prepare(name, domain_text, cache_domain, t0)
+    if isinstance(domain, PlanResult):
+        return domain
+    answer, exitcode = _run_guarded((domain_text, problem_text, name, float(timeout_s), compile_conditional_effects,
+                                     domain, problem), timeout_s + grace_s)
     total = time.perf_counter() - t0
     if answer == "late":
         return failed(name, PlanStatus.TIMEOUT, t0, f"no answer within {timeout_s:g} s + {grace_s:g} s grace; "
-                       "planner process killed", total_time_s=total)
+                      "planner process killed", total_time_s=total)
     if answer is None:
-        return failed(name, PlanStatus.ERROR, t0, f"planner process died (exit code {proc.exitcode})", total_time_s=total)
+        return failed(name, PlanStatus.ERROR, t0, f"planner process died (exit code {exitcode})", total_time_s=total)
     if "error" in answer:
         return failed(name, PlanStatus.ERROR, t0, answer["error"], total_time_s=total)
     inner = PlanResult.from_json(answer)

@@ -85,6 +85,68 @@ def _limit_memory(pid: int, mb: int) -> None:
         pass
 
 
+def _read_log(log: str, extra: dict) -> int | None:
+    """Put the planner's own search and total times into extra; the number of expanded states (None if absent)."""
+    for key, name in (("Search time", "fd_search_time_s"), ("Total time", "fd_total_time_s")):
+        found = _TIME_RE[key].findall(log)
+        if found:
+            extra[name] = float(found[-1])
+    expanded = _EXPANDED_RE.findall(log)
+    return int(expanded[-1]) if expanded else None
+
+
+def _run_search(binary: Path, spec: SASPlanner, task_text: str, planner: str, timeout_s: float, write_s: float,
+                memory_mb: int, t0: float, extra: dict) -> tuple[list[str], int | None] | PlanResult:
+    """Run the search binary on the task (standard input): the plan's operator names and expansions, or a failure."""
+    with tempfile.TemporaryDirectory(prefix="symlearn-fd-") as tmp:  # for the plan file
+        plan_path = Path(tmp) / "plan"
+        args = [str(binary), "--search", spec.search, "--internal-plan-file", str(plan_path)]
+        t1 = time.perf_counter()
+        try:
+            proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                    text=True, cwd=tmp, start_new_session=True)
+        except OSError as e:
+            return failed(planner, PlanStatus.ERROR, t0, f"could not run {planner}: {e}", **extra)
+        if memory_mb:
+            _limit_memory(proc.pid, memory_mb)
+        try:
+            log, err = proc.communicate(task_text, timeout=max(timeout_s - write_s, 1e-3))
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.communicate()
+            return failed(planner, PlanStatus.TIMEOUT, t0, f"{planner} hit the {timeout_s:g} s time limit "
+                          "(process killed)", planner_time_s=time.perf_counter() - t1, **extra)
+        extra["planner_time_s"] = time.perf_counter() - t1
+        expansions = _read_log(log, extra)
+        if proc.returncode != 0 or not plan_path.is_file():
+            status, why = _EXIT.get(proc.returncode, (PlanStatus.ERROR, f"exited with code {proc.returncode}"))
+            why = why if status is PlanStatus.UNSOLVABLE else f"{planner} {why}"
+            tail = (err.strip().splitlines() or [""])[-1]
+            return failed(planner, status, t0, f"{why}{': ' + tail if status is PlanStatus.ERROR and tail else ''}",
+                          **extra)
+        names = [ln.strip()[1:-1] for ln in plan_path.read_text().splitlines() if ln.strip().startswith("(")]
+    return names, expansions
+
+
+def _replayed(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal, names: list[str], planner: str,
+              spec: SASPlanner, expansions: int | None, t0: float, extra: dict) -> PlanResult:
+    """The plan as action ids, replayed with the rules; an ERROR if it names unknown operators or misses the goal."""
+    try:
+        plan = tuple(action_id_from_name(n) for n in names)
+    except ValueError as e:
+        return failed(planner, PlanStatus.ERROR, t0, f"{planner} returned an unknown operator: {e}", **extra)
+    states = [np.asarray([int(c) for c in init], np.int64)]
+    for a in plan:
+        states.append(apply_rules(encoder.rules, states[-1], a))
+    if not goal.satisfied(states[-1])[0]:
+        return failed(planner, PlanStatus.ERROR, t0, f"the plan does not reach the goal under the rules "
+                      f"(the SAS+ encoding disagrees with apply_rules)", **extra)
+    return PlanResult(planner=planner, status=PlanStatus.SOLVED, plan=plan,
+                      predicted_states=tuple(tuple(int(c) for c in s) for s in states), expansions=expansions,
+                      planning_time_s=time.perf_counter() - t0,
+                      extra=dict(extra, optimal=spec.optimal))
+
+
 def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Sequence[int | None], planner: str,
               timeout_s: float, *, memory_mb: int = MEMORY_LIMIT_MB, write_to: Path | None = None) -> PlanResult:
     """Plan from init to goal codes with a SAS+ planner (SAS_PLANNERS); failures come back as a status.
@@ -114,49 +176,8 @@ def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Seq
              "sas_operators": task.n_operators, "sas_effects": task.n_effects, "sas_axioms": task.n_axioms}
     if write_to is not None:
         atomic_write_text(Path(write_to), task.text)
-    with tempfile.TemporaryDirectory(prefix="symlearn-fd-") as tmp:  # for the plan file
-        plan_path = Path(tmp) / "plan"
-        args = [str(binary), "--search", spec.search, "--internal-plan-file", str(plan_path)]
-        t1 = time.perf_counter()
-        try:
-            proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                    text=True, cwd=tmp, start_new_session=True)
-        except OSError as e:
-            return failed(planner, PlanStatus.ERROR, t0, f"could not run {planner}: {e}", **extra)
-        if memory_mb:
-            _limit_memory(proc.pid, memory_mb)
-        try:
-            log, err = proc.communicate(task.text, timeout=max(timeout_s - write_s, 1e-3))
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.communicate()
-            return failed(planner, PlanStatus.TIMEOUT, t0, f"{planner} hit the {timeout_s:g} s time limit "
-                          "(process killed)", planner_time_s=time.perf_counter() - t1, **extra)
-        extra["planner_time_s"] = time.perf_counter() - t1
-        for key, name in (("Search time", "fd_search_time_s"), ("Total time", "fd_total_time_s")):
-            found = _TIME_RE[key].findall(log)
-            if found:
-                extra[name] = float(found[-1])
-        expanded = _EXPANDED_RE.findall(log)
-        expansions = int(expanded[-1]) if expanded else None
-        if proc.returncode != 0 or not plan_path.is_file():
-            status, why = _EXIT.get(proc.returncode, (PlanStatus.ERROR, f"exited with code {proc.returncode}"))
-            why = why if status is PlanStatus.UNSOLVABLE else f"{planner} {why}"
-            tail = (err.strip().splitlines() or [""])[-1]
-            return failed(planner, status, t0, f"{why}{': ' + tail if status is PlanStatus.ERROR and tail else ''}",
-                          **extra)
-        names = [ln.strip()[1:-1] for ln in plan_path.read_text().splitlines() if ln.strip().startswith("(")]
-    try:
-        plan = tuple(action_id_from_name(n) for n in names)
-    except ValueError as e:
-        return failed(planner, PlanStatus.ERROR, t0, f"{planner} returned an unknown operator: {e}", **extra)
-    states = [np.asarray([int(c) for c in init], np.int64)]
-    for a in plan:
-        states.append(apply_rules(encoder.rules, states[-1], a))
-    if not goal_g.satisfied(states[-1])[0]:
-        return failed(planner, PlanStatus.ERROR, t0, f"the plan does not reach the goal under the rules "
-                      f"(the SAS+ encoding disagrees with apply_rules)", **extra)
-    return PlanResult(planner=planner, status=PlanStatus.SOLVED, plan=plan,
-                      predicted_states=tuple(tuple(int(c) for c in s) for s in states), expansions=expansions,
-                      planning_time_s=time.perf_counter() - t0,
-                      extra=dict(extra, optimal=spec.optimal))
+    ran = _run_search(binary, spec, task.text, planner, timeout_s, write_s, memory_mb, t0, extra)
+    if isinstance(ran, PlanResult):
+        return ran
+    names, expansions = ran
+    return _replayed(encoder, init, goal_g, names, planner, spec, expansions, t0, extra)

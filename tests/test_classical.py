@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 
 from pddl_export.enumeration import enumerate_transitions
-from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl
-from pddl_export.rules import distil_rules
-from search.classical import PLANNERS, PlannerSpec, solve_pddl, strips_problem
+from pddl_export.pddl_writer import PddlForm, conditional_domain, problem_pddl, strips_pddl
+from pddl_export.distil import distil_rules
+from search.classical import PLANNERS, PlannerSpec, solve_pddl
+from search.up_problem import strips_problem
 from search.result import PlanStatus
 from pddl_export.symbolic import SymbolicGoal
 from test_pddl_export import FAR, NEAR, RIDER, RIDER_M, STICK, TOY_VOCAB, UNDER, ToyRobot
@@ -85,13 +86,13 @@ def test_cached_domain_reads_only_the_problem(rules, monkeypatch, tmp_path):
     """cache_domain parses the domain once; each call builds its problem from the problem text."""
     import hashlib
 
-    import search.classical as classical
+    import search.up_problem as up_problem
     from unified_planning.io import PDDLReader
     from unified_planning.shortcuts import OneshotPlanner
 
     _require("fast-downward")
     domain, problem = _conditional(rules, UNCOVER_TWICE)
-    classical._DOMAINS.pop(hashlib.sha256(domain.encode()).hexdigest(), None)
+    up_problem._DOMAINS.pop(hashlib.sha256(domain.encode()).hexdigest(), None)
     log, real = tmp_path / "parses.txt", PDDLReader.parse_problem_string
 
     def counted(self, domain_str, problem_str=None):  # the forked planner processes inherit it
@@ -108,7 +109,7 @@ def test_cached_domain_reads_only_the_problem(rules, monkeypatch, tmp_path):
     assert log.read_text().split() == ["domain-only"]  # one parse of the domain, none of a problem
     monkeypatch.undo()
     # the instance built on the cached domain is the problem unified-planning's reader gives
-    built = classical._instance(classical.parsed_domain(domain), other)
+    built = up_problem.problem_on_domain(up_problem.parsed_domain(domain), other)
     from unified_planning.io import PDDLReader
     full = PDDLReader().parse_problem_string(domain, other)
     assert {o.name for o in built.all_objects} == {o.name for o in full.all_objects}
@@ -117,7 +118,7 @@ def test_cached_domain_reads_only_the_problem(rules, monkeypatch, tmp_path):
         {str(k): str(v) for k, v in full.explicit_initial_values.items()}
     with OneshotPlanner(name="fast-downward") as engine:
         assert engine.solve(built).plan is not None
-    assert classical._instance(classical.parsed_domain(domain), "(define (problem x) (:domain d) (:objects a - nosuchtype) (:init) (:goal (and)))") is None
+    assert up_problem.problem_on_domain(up_problem.parsed_domain(domain), "(define (problem x) (:domain d) (:objects a - nosuchtype) (:init) (:goal (and)))") is None
 
 
 @pytest.mark.parametrize("problem", [STICK_CARRIES_RIDER, UNCOVER_TWICE])
@@ -176,11 +177,11 @@ def test_strips_problem_built_directly_equals_the_parsed_one(rules):
 
 
 def test_validation_on_the_plans_actions_decides_like_the_whole_problem(rules):
-    """_with_only_actions keeps init, goal and the used actions: valid plans stay valid, invalid ones invalid."""
+    """with_only_actions keeps init, goal and the used actions: valid plans stay valid, invalid ones invalid."""
     from unified_planning.plans import ActionInstance, SequentialPlan
     from unified_planning.shortcuts import PlanValidator
 
-    from search.classical import _with_only_actions
+    from search.up_problem import with_only_actions
 
     p = UNCOVER_TWICE
     whole = strips_problem(strips_pddl(rules, p.init, p.goal, "test"))
@@ -192,11 +193,11 @@ def test_validation_on_the_plans_actions_decides_like_the_whole_problem(rules):
     shuffled = SequentialPlan(list(reversed(good.actions)))
     for plan, want in ((good, "VALID"), (bad, "INVALID"), (shuffled, None)):
         verdicts = []
-        for problem in (whole, _with_only_actions(whole, plan)):
+        for problem in (whole, with_only_actions(whole, plan)):
             with PlanValidator(problem_kind=problem.kind) as validator:
                 verdicts.append(validator.validate(problem, plan).status.name)
         assert verdicts[0] == verdicts[1] and want in (None, verdicts[0]), verdicts
-    sub = _with_only_actions(whole, good)
+    sub = with_only_actions(whole, good)
     assert len(sub.actions) == len({ai.action.name for ai in good.actions}) < len(names)
 
 
@@ -221,10 +222,10 @@ def test_conditional_form_refused_by_fd_opt_with_a_reason(rules):
     assert result.status is PlanStatus.ERROR and "STRIPS" in result.message and result.plan == ()
 
 
-@pytest.mark.parametrize("planner,form", [("fast-downward", "conditional"), ("pyperplan", "strips")])
+@pytest.mark.parametrize("planner,form", [("fast-downward", PddlForm.CONDITIONAL), ("pyperplan", PddlForm.STRIPS)])
 def test_unsolvable(rules, planner, form):
     _require(planner)
-    texts = _conditional(rules, NEVER) if form == "conditional" else _strips(rules, NEVER)
+    texts = _conditional(rules, NEVER) if form is PddlForm.CONDITIONAL else _strips(rules, NEVER)
     result = solve_pddl(*texts, planner=planner, timeout_s=20)
     assert result.status is PlanStatus.UNSOLVABLE and result.plan == () and result.message
 

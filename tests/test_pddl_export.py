@@ -31,16 +31,9 @@ from pddl_export.pddl_writer import (
     strips_pddl,
 )
 from pddl_export.files import atomic_write_text
-from pddl_export.rules import (
-    AmbiguousRulesError,
-    NotEquivariantError,
-    Rule,
-    RuleSet,
-    apply_rules,
-    apply_rules_batch,
-    distil_rules,
-    rule_fidelity,
-)
+from pddl_export.distil import NotEquivariantError, distil_rules
+from pddl_export.fidelity import rule_fidelity
+from pddl_export.rules import AmbiguousRulesError, Rule, RuleSet, apply_rules, apply_rules_batch
 from pddl_export.symbolic import N_ACTIONS
 
 NEAR, FAR, STICK, RIDER, UNDER, STICK_M, RIDER_M = 1, 2, 3, 4, 5, 6, 7
@@ -330,27 +323,55 @@ def test_conditional_domain_parses_with_both_parsers(toy, tmp_path):
     assert len(up_problem.goals) == 1
 
 
+def _pddl_successor(domain: str, rules: RuleSet, codes: list[int], action: int) -> list[int]:
+    """Each object's code after `action`, simulated on the written PDDL by unified-planning (-1: not one code)."""
+    from unified_planning.shortcuts import SequentialSimulator
+
+    prob = _up_parse(domain, problem_pddl(rules, codes, [codes[0]] + [None] * (len(codes) - 1), "h"))
+    names = [a.name for a in prob.actions]
+    if action_name(action) not in names:
+        return list(codes)
+    objs = [prob.object(object_name(i)) for i in range(len(codes))]
+    fluents = {c: prob.fluent(code_predicate(c, rules.bits)) for c in rules.codes}
+    with SequentialSimulator(prob) as sim:
+        state = sim.apply(sim.get_initial_state(), prob.action(action_name(action)), ())
+        held = [[c for c, f in fluents.items() if state.get_value(f(o)).bool_constant_value()] for o in objs]
+    return [h[0] if len(h) == 1 else -1 for h in held]
+
+
 def test_requirements_follow_what_is_used():
+    """Declared requirements match the features used, and the written conditions mean what the rules say."""
+    from pddl.requirements import Requirements as R
+
     plain = RuleSet(2, (1, 2), 2, (Rule(0, 1, 2),), 1)
-    assert "(:requirements :strips :typing :conditional-effects)" in conditional_domain(plain, "h")
+    d, _ = _pddl_parse(conditional_domain(plain, "h"), problem_pddl(plain, [1], [2], "h"))
+    assert d.requirements == {R.STRIPS, R.TYPING, R.CONDITIONAL_EFFECTS} and not d.constants
     absent = RuleSet(2, (1, 2, 3), 2, (Rule(0, 1, 2, forbids=(3,)),), 1)
     text = conditional_domain(absent, "h")
-    assert "(:requirements :strips :typing :conditional-effects :existential-preconditions " \
-           ":universal-preconditions :negative-preconditions :equality)" in text
-    # a context is wrapped in a universal over the one-object type `scene` (see the writer's docstring)
-    assert "(:constants the-scene - scene)" in text and "(when (forall (?s - scene) (and (= ?s the-scene) " \
-           "(code-01 ?o) (not (exists (?z - obj) (code-11 ?z)))))" in text
-    assert "the-scene" not in conditional_domain(plain, "h")
+    d, _ = _pddl_parse(text, problem_pddl(absent, [1], [2], "h"))
+    assert d.requirements == {R.STRIPS, R.TYPING, R.CONDITIONAL_EFFECTS, R.EXISTENTIAL_PRECONDITION,
+                              R.UNIVERSAL_PRECONDITION, R.NEG_PRECONDITION, R.EQUALITY}
+    # a context is wrapped in a universal over a one-object type (see the writer's docstring)
+    assert [str(c.name) for c in d.constants] == ["the-scene"]
+    # "no other object has 3": the rule fires unless another object holds 3, and an object's own 3 does not count
+    for codes in ([1], [1, 2], [1, 3], [3, 1], [1, 1], [2, 3]):
+        assert _pddl_successor(text, absent, codes, 0) == apply_rules(absent, np.array(codes), 0).tolist(), codes
+    assert _pddl_successor(text, absent, [1, 3], 0) == [1, 3] and _pddl_successor(text, absent, [1, 1], 0) == [2, 2]
     empty = RuleSet(2, (1, 2), 2, (), 0)
     text = conditional_domain(empty, "h")
-    assert "(:requirements :strips :typing)" in text and ":action" not in text
-    _up_parse(text, problem_pddl(empty, [1], [2], "h"))
+    d, _ = _pddl_parse(text, problem_pddl(empty, [1], [2], "h"))
+    assert d.requirements == {R.STRIPS, R.TYPING} and not d.actions
+    assert not _up_parse(text, problem_pddl(empty, [1], [2], "h")).actions
 
 
 def test_problem_writer_checks_codes(toy):
     _, rs = toy
     text = problem_pddl(rs, [NEAR, FAR], [None, UNDER], model_hash="h")
-    assert "(:init (code-001 o0) (code-010 o1))" in text and "(:goal (and (code-101 o1)))" in text
+    _, p = _pddl_parse(conditional_domain(rs, "h"), text)
+    atoms = lambda lits: {(code_from_predicate(str(a.name)), str(a.terms[0].name)) for a in lits}  # noqa: E731
+    assert atoms(p.init) == {(NEAR, "o0"), (FAR, "o1")} and sorted(str(o.name) for o in p.objects) == ["o0", "o1"]
+    goal = p.goal.operands if hasattr(p.goal, "operands") else (p.goal,)
+    assert atoms(goal) == {(UNDER, "o1")}
     with pytest.raises(ValueError, match="vocabulary"):
         problem_pddl(rs, [0, FAR], [None, UNDER], model_hash="h")
     with pytest.raises(ValueError):

@@ -14,9 +14,8 @@ import numpy as np
 import pytest
 
 from pddl_export.pddl_writer import action_name, conditional_domain, problem_pddl
-from pddl_export.rules import apply_rules_batch
-from pddl_export.rules import INF
-from pddl_export.sas_writer import SASEncoder, context_terms
+from pddl_export.rules import INF, Rule, RuleSet, apply_rules_batch
+from pddl_export.sas_writer import SASEncoder, TermKind, context_terms
 from search.sas_planners import SAS_PLANNERS, search_binary, solve_sas
 from search.result import PlanStatus
 from pddl_export.symbolic import N_ACTIONS, SymbolicGoal
@@ -79,7 +78,24 @@ def test_context_terms_cover_exactly_the_satisfying_cells():
             got |= set(itertools.product(*allowed))
         assert got == want, (intervals, k)
     assert len(context_terms(((1, INF),), 2)) == 2  # "some other has X": z1 = X or z2 = X, not 3 cells
-    assert context_terms(((0, 1),), 2) == ((("not", (0,)), ("not", (0,))),)  # "none has X": one term
+    (term,) = context_terms(((0, 1),), 2)  # "none has X": one term, forbidding X on each other object
+    assert [set(range(2)) - set(js) if kind is TermKind.NOT else set(js) for kind, js in term] == [{1}, {1}]
+
+
+@pytest.mark.parametrize("init,goal,want", [((1, 3), (2, None), -1), ((1, 2), (2, None), 1), ((3, 1), (None, 2), -1),
+                                            ((1, 1, 2), (2, 2, None), 1), ((1,), (3,), 2)])
+def test_forbidding_context_plans_like_breadth_first_search(init, goal, want):
+    """"Unless some other object has 3": plan lengths of the SAS+ task equal a breadth-first search over the rules."""
+    _require("fast-downward-sas-opt")
+    rs = RuleSet(2, (1, 2, 3), 3, (Rule(0, 1, 2, forbids=(3,)), Rule(1, 2, 3), Rule(1, 3, 1, requires=(2,))), 3)
+    goal_g = SymbolicGoal(goal)
+    assert _bfs_length(rs, list(init), goal_g) == want
+    res = solve_sas(SASEncoder(rs), init, goal_g, "fast-downward-sas-opt", timeout_s=20)
+    if want < 0:
+        assert res.status is PlanStatus.UNSOLVABLE, res.message
+    else:
+        assert res.status is PlanStatus.SOLVED and len(res.plan) == want, res.message
+        assert goal_g.satisfied(np.array(res.predicted_states[-1]))[0]
 
 
 @pytest.mark.parametrize("planner", [p for p, spec in SAS_PLANNERS.items() if spec.optimal])

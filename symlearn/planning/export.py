@@ -12,7 +12,6 @@ Writes RUN/pddl/domain.pddl, rules.json, report.json.
 from __future__ import annotations
 
 import dataclasses
-import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,14 +19,13 @@ from pathlib import Path
 import numpy as np
 
 from pddl_export.enumeration import enumerate_scenes, enumerate_transitions, vocabulary_closure
-from pddl_export.fidelity import pddl_fidelity
+from pddl_export.distil import distil_rules
+from pddl_export.fidelity import pddl_fidelity, rule_fidelity
 from pddl_export.files import atomic_write_text, sha256_file
 from pddl_export.pddl_writer import conditional_domain
-from pddl_export.rules import Rule, RuleSet, distil_rules, rule_fidelity
+from pddl_export.rules_io import PDDL_DIR, rules_to_json
 from pddl_export.symbolic import code_str
 from symlearn.provenance import atomic_write_json, versions
-
-PDDL_DIR = "pddl"
 
 
 @dataclass(frozen=True)
@@ -85,39 +83,6 @@ def observed_scenes(vocab: set[int], max_objects: int, *code_arrays: np.ndarray)
     return sorted(out)
 
 
-def rules_to_json(rules: RuleSet) -> dict:
-    b = rules.bits
-    return {"bits": b, "vocabulary": [code_str(c, b) for c in rules.vocabulary], "max_objects": rules.max_objects,
-            "n_rules_before_generalization": rules.n_rules_before_generalization,
-            "rules": [{"action": r.action, "pick": r.action // 6, "release": r.action % 6,
-                       "from": code_str(r.code_from, b), "to": code_str(r.code_to, b),
-                       "requires": [code_str(c, b) for c in r.requires], "forbids": [code_str(c, b) for c in r.forbids],
-                       "at_least": [[code_str(c, b), n] for c, n in r.at_least],
-                       "fewer_than": [[code_str(c, b), n] for c, n in r.fewer_than]} for r in rules.rules]}
-
-
-def rules_from_json(d: dict) -> RuleSet:
-    """Inverse of rules_to_json; refuses malformed files with a one-line error."""
-    try:
-        c = lambda s: int(s, 2)  # noqa: E731
-        rules = tuple(Rule(int(r["action"]), c(r["from"]), c(r["to"]), tuple(map(c, r["requires"])),
-                           tuple(map(c, r["forbids"])), tuple((c(x), int(n)) for x, n in r["at_least"]),
-                           tuple((c(x), int(n)) for x, n in r["fewer_than"])) for r in d["rules"])
-        return RuleSet(int(d["bits"]), tuple(map(c, d["vocabulary"])), int(d["max_objects"]), rules,
-                       int(d["n_rules_before_generalization"]))
-    except (KeyError, TypeError, ValueError) as e:
-        raise ValueError(f"malformed rules file: {type(e).__name__}: {e}") from None
-
-
-def load_rules(run_dir: Path) -> tuple[RuleSet, str]:
-    """RUN/pddl/rules.json and the model hash recorded with it."""
-    path = Path(run_dir) / PDDL_DIR / "rules.json"
-    if not path.exists():
-        raise ValueError(f"no exported rules at {path}; run 'symlearn export-pddl --run {run_dir}' first")
-    d = json.loads(path.read_text())
-    return rules_from_json(d), d.get("model_hash", "")
-
-
 def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path | None = None) -> dict:
     """Enumerate, distil, write and check; returns the report (also written as report.json)."""
     from symlearn.symbolic.learned_transition import LearnedTransition
@@ -167,7 +132,7 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
         "disagreements": [dataclasses.asdict(m) for m in fid.mismatches],
         "pddl_fidelity": None if pf is None else round(pf.fraction, 6),
         "pddl_fidelity_cases": None if pf is None else pf.n_cases,
-        "pddl_disagreements": [] if pf is None else [list(map(list, d[:1])) + [d[1]] + [list(d[2]), list(d[3])] for d in pf.disagreements],
+        "pddl_disagreements": [] if pf is None else [m.as_row() for m in pf.disagreements],
         "seconds": {"vocabulary": round(t_vocab, 1), "enumeration": round(enum.seconds, 1),
                     "rules": round(t_rules, 1), "pddl_fidelity": round(t_pddl, 1)},
         "versions": versions(),

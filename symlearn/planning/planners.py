@@ -21,13 +21,14 @@ import numpy as np
 from pddl_export.files import atomic_write_text
 from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl
 from pddl_export.rules import RuleSet
+from pddl_export.rules_io import load_rules
 from pddl_export.sas_writer import SASEncoder
-from search.classical import solve_pddl, strips_problem
+from search.classical import solve_pddl
+from search.up_problem import strips_problem
 from search.sas_planners import solve_sas
 from search.result import PlanResult, PlanStatus, failed
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
 from symlearn.planning.benchmark import PLANNERS, register_planner
-from symlearn.planning.export import load_rules
 
 # registry name -> (unified-planning engine name in search.classical, PDDL form)
 PDDL_PLANNERS = {

@@ -1,0 +1,51 @@
+"""Read and write distilled rules as JSON (RUN/pddl/rules.json); codes are bit strings, MSB first.
+
+    >>> from pddl_export.rules import Rule, RuleSet
+    >>> rs = RuleSet(2, (1, 2), 2, (Rule(5, 1, 2, forbids=(3,)),), 1)
+    >>> rules_to_json(rs)["rules"][0]["from"], rules_from_json(rules_to_json(rs)).rules == rs.rules
+    ('01', True)
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from pddl_export.rules import Rule, RuleSet
+from pddl_export.symbolic import code_str
+
+PDDL_DIR = "pddl"  # RUN/pddl holds domain.pddl, rules.json and report.json
+RULES_FILE = "rules.json"
+
+
+def rules_to_json(rules: RuleSet) -> dict:
+    """The rules as a JSON-ready dict (codes as bit strings, actions also as pick/release)."""
+    b = rules.bits
+    return {"bits": b, "vocabulary": [code_str(c, b) for c in rules.vocabulary], "max_objects": rules.max_objects,
+            "n_rules_before_generalization": rules.n_rules_before_generalization,
+            "rules": [{"action": r.action, "pick": r.action // 6, "release": r.action % 6,
+                       "from": code_str(r.code_from, b), "to": code_str(r.code_to, b),
+                       "requires": [code_str(c, b) for c in r.requires], "forbids": [code_str(c, b) for c in r.forbids],
+                       "at_least": [[code_str(c, b), n] for c, n in r.at_least],
+                       "fewer_than": [[code_str(c, b), n] for c, n in r.fewer_than]} for r in rules.rules]}
+
+
+def rules_from_json(d: dict) -> RuleSet:
+    """Inverse of rules_to_json; refuses malformed files with a one-line error."""
+    try:
+        c = lambda s: int(s, 2)  # noqa: E731
+        rules = tuple(Rule(int(r["action"]), c(r["from"]), c(r["to"]), tuple(map(c, r["requires"])),
+                           tuple(map(c, r["forbids"])), tuple((c(x), int(n)) for x, n in r["at_least"]),
+                           tuple((c(x), int(n)) for x, n in r["fewer_than"])) for r in d["rules"])
+        return RuleSet(int(d["bits"]), tuple(map(c, d["vocabulary"])), int(d["max_objects"]), rules,
+                       int(d["n_rules_before_generalization"]))
+    except (KeyError, TypeError, ValueError) as e:
+        raise ValueError(f"malformed rules file: {type(e).__name__}: {e}") from None
+
+
+def load_rules(run_dir: Path) -> tuple[RuleSet, str]:
+    """RUN/pddl/rules.json and the model hash recorded with it."""
+    path = Path(run_dir) / PDDL_DIR / RULES_FILE
+    if not path.exists():
+        raise ValueError(f"no exported rules at {path}; run 'symlearn export-pddl --run {run_dir}' first")
+    d = json.loads(path.read_text())
+    return rules_from_json(d), d.get("model_hash", "")
