@@ -12,7 +12,7 @@ from search.result import PlanResult, PlanStatus
 from symlearn.sim.collect import CollectConfig, collect
 from symlearn.planning.export import ExportConfig, export_pddl, load_rules, rules_from_json, rules_to_json
 from symlearn.planning.planners import make_pddl_planner, network_agrees
-from symlearn.planning.problems import generate_problems
+from symlearn.planning.problem_generation import generate_problems
 from symlearn.learning.training import TrainConfig, train
 from symlearn.symbolic.transition import LearnedTransition, TransitionConfig, train_transition
 

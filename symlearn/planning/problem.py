@@ -1,0 +1,176 @@
+"""Planning problems as JSON files: an initial scene, a goal scene, and the actions that made it.
+
+This module holds the problem format only: the Problem dataclass, its validation, and loading
+and saving. Problems are drawn in the simulator by symlearn.planning.problem_generation; scenes
+are placed and encoded by symlearn.planning.scenes.
+
+    >>> problem = load_problem(Path("problems/p13/problem_0000.json"))  # doctest: +SKIP
+    >>> problem.generator_length, problem.initial.k                     # doctest: +SKIP
+    (3, 2)
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from symlearn.sim.exploration import MAX_OBJECTS
+from symlearn.provenance import atomic_write_json
+from symlearn.world import N_ACTIONS, N_LOCATIONS, ObjectType, Scene, decode_action
+
+PROBLEM_FORMAT = "symlearn-problem"
+PROBLEM_VERSION = 1
+GOAL_TOLERANCE_M = 0.02  # success: every object within this distance of its goal position
+_KEYS = ("format", "version", "name", "seed", "spec", "initial", "actions", "goal", "generator_length")
+
+
+@dataclass(frozen=True)
+class Problem:
+    """A named planning problem: build `spec`, place `initial`, reach `goal` (object order is identity)."""
+
+    name: str
+    seed: int  # the generator's base seed: problem i of a set is drawn from default_rng([seed, i])
+    spec: tuple[tuple[ObjectType, int], ...]  # objects dropped in order at (type, near-row location)
+    initial: Scene  # poses after building and settling
+    actions: tuple[int, ...]  # the generator's action ids: a known valid plan
+    goal: Scene  # poses the generator's actions ended in
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError("problem name must be a non-empty string")
+        if not _is_int(self.seed):
+            raise ValueError(f"problem {self.name}: seed must be an integer, got {self.seed!r}")
+        spec = tuple((ObjectType(t), int(loc)) for t, loc in self.spec)
+        object.__setattr__(self, "spec", spec)
+        object.__setattr__(self, "actions", tuple(int(a) for a in self.actions))
+        p = f"problem {self.name}"
+        if not 1 <= len(spec) <= MAX_OBJECTS:
+            raise ValueError(f"{p}: {len(spec)} objects, expected 1..{MAX_OBJECTS}")
+        bad = [loc for _, loc in spec if not 0 <= loc < N_LOCATIONS]
+        if bad:
+            raise ValueError(f"{p}: object location {bad[0]} is out of range 0..{N_LOCATIONS - 1}")
+        bad = [a for a in self.actions if not 0 <= a < N_ACTIONS]
+        if bad:
+            raise ValueError(f"{p}: action id {bad[0]} is out of range 0..{N_ACTIONS - 1}")
+        types = tuple(t for t, _ in spec)
+        for what, scene in (("initial", self.initial), ("goal", self.goal)):
+            if not isinstance(scene, Scene):
+                raise ValueError(f"{p}: {what} must be a Scene")
+            if tuple(o.type for o in scene.objects) != types:
+                raise ValueError(f"{p}: {what} scene objects {[o.type.name.lower() for o in scene.objects]} "
+                                 f"do not match the spec {[t.name.lower() for t in types]}")
+            if not np.all(np.isfinite(scene.positions())):
+                raise ValueError(f"{p}: {what} scene has non-finite positions")
+
+    @property
+    def k(self) -> int:
+        return len(self.spec)
+
+    @property
+    def generator_length(self) -> int:
+        """Length of the generator's own plan."""
+        return len(self.actions)
+
+    def to_json(self) -> dict:
+        return {"format": PROBLEM_FORMAT, "version": PROBLEM_VERSION, "name": self.name, "seed": self.seed,
+                "spec": [[t.name.lower(), loc] for t, loc in self.spec], "initial": self.initial.to_json(),
+                "actions": list(self.actions),
+                "actions_readable": [f"pick {decode_action(a).pick} -> release {decode_action(a).release}"
+                                     for a in self.actions],
+                "goal": self.goal.to_json(), "generator_length": self.generator_length}
+
+    @staticmethod
+    def from_json(d: dict, where: str = "problem") -> "Problem":
+        """Parse and validate; every refusal is a one-line ValueError that names the problem."""
+        if not isinstance(d, dict):
+            raise ValueError(f"{where}: expected a JSON object, got {type(d).__name__}")
+        name = d.get("name") if isinstance(d.get("name"), str) else where
+        p = f"problem {name}" if name != where else where
+        missing = [k for k in _KEYS if k not in d]
+        if missing:
+            raise ValueError(f"{p}: missing keys {', '.join(missing)}")
+        if d["format"] != PROBLEM_FORMAT:
+            raise ValueError(f"{p}: not a symlearn problem (format {d['format']!r})")
+        if d["version"] != PROBLEM_VERSION:
+            raise ValueError(f"{p}: problem version {d['version']!r}, this symlearn reads version {PROBLEM_VERSION}")
+        if not isinstance(d["name"], str) or not d["name"]:
+            raise ValueError(f"{p}: name must be a non-empty string")
+        if not _is_int(d["seed"]):
+            raise ValueError(f"{p}: seed must be an integer, got {d['seed']!r}")
+        spec = d["spec"]
+        if not isinstance(spec, list) or not all(isinstance(e, list) and len(e) == 2 for e in spec):
+            raise ValueError(f"{p}: spec must be a list of [type, location] pairs")
+        parsed = []
+        for t, loc in spec:
+            if not isinstance(t, str) or t.upper() not in ObjectType.__members__:
+                raise ValueError(f"{p}: unknown object type {t!r} (expected cube or stick)")
+            if not _is_int(loc) or not 0 <= loc < N_LOCATIONS:
+                raise ValueError(f"{p}: object location {loc!r} is out of range 0..{N_LOCATIONS - 1}")
+            parsed.append((ObjectType[t.upper()], loc))
+        actions = d["actions"]
+        if not isinstance(actions, list) or not all(_is_int(a) for a in actions):
+            raise ValueError(f"{p}: actions must be a list of integer action ids")
+        if d["generator_length"] != len(actions):
+            raise ValueError(f"{p}: generator_length {d['generator_length']!r} does not match "
+                             f"{len(actions)} actions")
+        scenes = {}
+        for key in ("initial", "goal"):
+            scenes[key] = _scene(d[key], f"{p}: {key} scene")
+        try:
+            return Problem(d["name"], int(d["seed"]), tuple(parsed), scenes["initial"], tuple(actions), scenes["goal"])
+        except ValueError as e:
+            msg = str(e)
+            raise ValueError(msg if msg.startswith(p) else f"{p}: {msg}") from None
+
+
+def _is_int(x) -> bool:
+    return isinstance(x, int) and not isinstance(x, bool)
+
+
+def _scene(d, where: str) -> Scene:
+    """A scene from JSON with type and shape checks on every object."""
+    if not isinstance(d, dict) or not isinstance(d.get("objects"), list):
+        raise ValueError(f"{where} must be an object with an 'objects' list")
+    for o in d["objects"]:
+        if not isinstance(o, dict) or not isinstance(o.get("type"), str):
+            raise ValueError(f"{where}: every object needs a type")
+        for key, n in (("position", 3), ("orientation", 4)):
+            v = o.get(key, [0, 0, 0, 1] if key == "orientation" else None)
+            if (not isinstance(v, list) or len(v) != n
+                    or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)):
+                raise ValueError(f"{where}: object {key} must be {n} finite numbers, got {v!r}")
+    try:
+        return Scene.from_json(d)
+    except (ValueError, KeyError) as e:
+        raise ValueError(f"{where}: {str(e).splitlines()[0]}") from None
+
+
+def save_problem(path: Path, problem: Problem) -> None:
+    """Write one problem file atomically."""
+    atomic_write_json(Path(path), problem.to_json())
+
+
+def load_problem(path: Path) -> Problem:
+    """Read and validate one problem file; refuses malformed files with a one-line ValueError."""
+    path = Path(path)
+    if not path.exists():
+        raise ValueError(f"problem {path.name}: no such file {path}")
+    try:
+        d = json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+        raise ValueError(f"problem {path.name}: not valid JSON ({e})") from None
+    return Problem.from_json(d, where=f"problem {path.name}")
+
+
+def load_problems(problems_dir: Path) -> list[tuple[Path, Problem]]:
+    """All *.json problems of a directory, in name order."""
+    problems_dir = Path(problems_dir)
+    if not problems_dir.is_dir():
+        raise ValueError(f"no problem directory at {problems_dir}; run 'symlearn problems' first")
+    paths = sorted(problems_dir.glob("*.json"))
+    if not paths:
+        raise ValueError(f"{problems_dir} holds no problem files (*.json)")
+    return [(p, load_problem(p)) for p in paths]
