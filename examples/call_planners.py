@@ -9,11 +9,11 @@ import argparse
 from pathlib import Path
 
 from pddl_export.symbolic import SymbolicGoal, code_str
-from symlearn.planning.benchmark import PLANNERS
 from symlearn.learning.checkpoint import load_effect_model
 from symlearn.planning.execution import safe_plan
-from symlearn.planning.planners import register_pddl_planners
-from symlearn.planning.problems import goal_codes, load_problem, place_scene
+from symlearn.planning.planners import PLANNERS, make_planners
+from symlearn.planning.problem import load_problem
+from symlearn.planning.scenes import goal_codes, place_scene
 from symlearn.sim.simulator import TabletopSimulator
 from symlearn.symbolic.learned_transition import LearnedTransition
 from symlearn.symbolic.transition_data import encode_observation
@@ -27,7 +27,7 @@ def main() -> None:
     ap.add_argument("--timeout", type=float, default=30.0)
     args = ap.parse_args()
     run = Path(args.run)
-    register_pddl_planners(run)
+    planners = make_planners(list(PLANNERS), run)
     encoder, _ = load_effect_model(run)
     transition = LearnedTransition.from_run(run)
     problem = load_problem(Path(args.problem))
@@ -37,8 +37,8 @@ def main() -> None:
         start = encode_observation(encoder, sim.observe())
     bits = transition.bits
     print(f"{problem.name}: start {[code_str(c, bits) for c in start]} -> goal {[code_str(c, bits) for c in goal]}")
-    for name in PLANNERS:
-        res = safe_plan(name, PLANNERS[name], transition, start, SymbolicGoal(tuple(int(c) for c in goal)), args.timeout)
+    for name, fn in planners.items():
+        res = safe_plan(name, fn, transition, start, SymbolicGoal(tuple(int(c) for c in goal)), args.timeout)
         steps = ", ".join(f"pick {decode_action(a).pick} release {decode_action(a).release}" for a in res.plan)
         print(f"{name:>18}: {res.status.value:<10} {res.planning_time_s:7.3f} s  [{steps}] {res.message[:80]}")
 

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from symlearn.planning.benchmark import benchmark, format_table
-from symlearn.planning.planners import PDDL_PLANNERS, register_pddl_planners
+from symlearn.planning.planners import PLANNERS
 
 
 def main() -> None:
@@ -14,13 +14,12 @@ def main() -> None:
     ap.add_argument("--run", required=True)
     ap.add_argument("--problems", required=True)
     ap.add_argument("--out", required=True)
-    ap.add_argument("--planners", default="astar,astar-ucs," + ",".join(PDDL_PLANNERS))
+    ap.add_argument("--planners", default=",".join(PLANNERS))
     ap.add_argument("--timeout", type=float, default=30.0)
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     planners = args.planners.split(",")
-    register_pddl_planners(Path(args.run), planners)
     res = benchmark(Path(args.run), Path(args.problems), planners, out / "benchmark.json", closed_loop=False,
                     timeout_s=args.timeout, show_progress=False)
     table = format_table(res)

@@ -5,10 +5,11 @@ import sys
 import numpy as np
 import pytest
 
-from symlearn.sim.collect import CollectConfig, CollectError, collect, shard_name
+from symlearn.sim.collect import CollectConfig, CollectError, collect, collect_shard, shard_name
 from symlearn.data.dataset import ARRAY_NAMES, DataError, load_manifest, load_split, summarize
 from symlearn.data.model_input import model_inputs
 from symlearn.sim.exploration import ExplorationConfig
+from symlearn.world import N_LOCATIONS
 
 CFG = CollectConfig(n=24, seed=3, shard_size=2)
 
@@ -134,3 +135,35 @@ def test_cli_collect_and_refusals(tmp_path):
     bad = subprocess.run(run[:-2] + ["0-6", "--quiet"], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and "out of range" in bad.stderr and len(bad.stderr.strip().splitlines()) == 1
     assert summarize(out)["shards"] == 12
+
+
+class _DroppingSim:
+    """A stand-in simulator whose every action drops an object off the table."""
+
+    def __init__(self, cfg):
+        self.steps = 0
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+    def build(self, spec):
+        pass
+
+    def observe(self):
+        return None
+
+    def occupied(self):
+        return np.ones(N_LOCATIONS, bool)
+
+    def step(self, action):
+        self.steps += 1
+        return type("Res", (), {"off_table": True})()
+
+
+def test_collect_shard_gives_up_after_failed_episodes(monkeypatch):
+    monkeypatch.setattr("symlearn.sim.collect.TabletopSimulator", _DroppingSim)
+    with pytest.raises(CollectError, match="shard 0: 5 episodes in a row recorded no sample"):
+        collect_shard(CFG, 0, 2, max_failed_episodes=5)

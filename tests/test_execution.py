@@ -6,6 +6,7 @@ not the quality of learned symbols.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 
 import numpy as np
@@ -16,9 +17,14 @@ from search.result import PlanResult, PlanStatus
 from symlearn.planning import benchmark as bench
 from symlearn.learning.checkpoint import save_checkpoint
 from symlearn.cli.planning import add_planning_commands
-from symlearn.planning.execution import ExecutionConfig, ObservedTransitions, ProblemRun, execute_plan, run_problem
+from symlearn.planning.execution import (ExecutionConfig, FailureStage, ObservedTransitions, ProblemRun, execute_plan,
+                                        run_problem)
+from symlearn.planning.planners import PLANNERS, PlannerContext, make_planner
+from pddl_export.symbolic import SymbolicGoal
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig
-from symlearn.planning.problems import GOAL_TOLERANCE_M, generate_problems, goal_codes, load_problem, scene_codes
+from symlearn.planning.problem import GOAL_TOLERANCE_M, load_problem
+from symlearn.planning.problem_generation import generate_problems
+from symlearn.planning.scenes import goal_codes, scene_codes
 from pddl_export.files import sha256_file
 from symlearn.symbolic.learned_transition import LearnedTransition
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, save_transition
@@ -258,23 +264,43 @@ def test_benchmark_writes_summary_and_rows(tmp_path, sim, run_dir, problems):
     assert "astar-ucs" in bench.format_table(res)
 
 
-def test_unknown_planner_lists_known_ones(tmp_path, run_dir):
-    with pytest.raises(ValueError, match="unknown planner 'fast-downward'; known: astar, astar-ucs") as info:
-        bench.benchmark(run_dir, tmp_path, ["astar", "fast-downward"], tmp_path / "b.json")
-    assert "\n" not in str(info.value)
+def test_unknown_planner_lists_every_planner(tmp_path, run_dir):
+    with pytest.raises(ValueError, match="unknown planner 'ghost'; known: astar, astar-ucs, fast-downward, ") as info:
+        bench.benchmark(run_dir, tmp_path, ["astar", "ghost"], tmp_path / "b.json")
+    msg = str(info.value)
+    assert "\n" not in msg and all(name in msg for name in PLANNERS)
 
 
-def test_register_planner(monkeypatch):
-    monkeypatch.setattr(bench, "PLANNERS", dict(bench.PLANNERS))
-    fn = _fixed(lambda s, g: None)
-    bench.register_planner("pyperplan", fn)
-    assert bench.get_planner("pyperplan") is fn
-    with pytest.raises(ValueError, match="already registered"):
-        bench.register_planner("astar", fn)
-    bench.register_planner("astar", fn, replace=True)
-    assert bench.get_planner("astar") is fn
-    with pytest.raises(ValueError, match="without commas"):
-        bench.register_planner("a,b", fn)
+def test_registry_holds_every_planner_and_is_immutable():
+    assert list(PLANNERS) == ["astar", "astar-ucs", "fast-downward", "symk", "pyperplan", "fast-downward-opt",
+                              "fast-downward-blind", "fast-downward-sas", "fast-downward-sas-opt", "symk-sas"]
+    assert [n for n, s in PLANNERS.items() if not s.needs_rules] == ["astar", "astar-ucs"]
+    assert all(s.name == n and s.description for n, s in PLANNERS.items())
+    with pytest.raises(TypeError):
+        PLANNERS["mine"] = PLANNERS["astar"]  # type: ignore[index]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        PLANNERS["astar"].needs_rules = True  # type: ignore[misc]
+
+
+def test_make_planner_builds_and_refuses(tmp_path, run_dir):
+    res = make_planner("astar-ucs")(LearnedTransition.from_run(run_dir), np.array([0]), SymbolicGoal((0,)), 2.0)
+    assert res.planner == "astar-ucs" and res.found and res.plan == ()
+    with pytest.raises(ValueError, match="plans on the exported rules, and none were given"):
+        make_planner("fast-downward", PlannerContext())
+    with pytest.raises(ValueError, match="no exported rules"):  # rules are read only when a planner needs them
+        PlannerContext.for_run(tmp_path, ["astar", "symk-sas"])
+    assert PlannerContext.for_run(tmp_path, ["astar", "astar-ucs"]).rules is None
+
+
+def test_failure_stage_values_are_the_json_strings():
+    assert [s.value for s in FailureStage] == ["no_plan", "timeout", "execution", "goal_mismatch", "rules_vs_net"]
+    base = dict(problem="p", planner="astar", found=False, status="timeout", plan_length=None, planning_time_s=0.1,
+                expansions=None, success=False, symbolic_match=False, max_distance_m=None, closed_loop=False,
+                replans=0, generator_length=1)
+    row = ProblemRun(**base, failure_stage="timeout")
+    assert row.failure_stage is FailureStage.TIMEOUT and f"{row.failure_stage}" == "timeout"
+    assert json.loads(json.dumps(row.to_json()))["failure_stage"] == "timeout"
+    assert bench.summarize_rows([row])["astar"]["failure_stages"] == {"timeout": 1}
 
 
 def test_cli_parses_planning_commands():

@@ -14,7 +14,7 @@ from symlearn.sim.collect import CollectConfig, collect
 from pddl_export.rules_io import load_rules, rules_from_json, rules_to_json
 from symlearn.planning.export import ExportConfig, export_pddl
 from symlearn.planning.planners import make_pddl_planner, network_agrees
-from symlearn.planning.problems import generate_problems
+from symlearn.planning.problem_generation import generate_problems
 from symlearn.learning.training import TrainConfig, train
 from symlearn.symbolic.learned_transition import LearnedTransition
 from symlearn.symbolic.transition_model import TransitionConfig

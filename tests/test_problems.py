@@ -7,9 +7,11 @@ import json
 import numpy as np
 import pytest
 
-from symlearn.planning.problems import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, ProblemConfig, generate_problems,
-                               load_problem, load_problems, max_goal_distance, save_problem)
-from symlearn.world import ObjectType, Scene, decode_action
+from symlearn.planning.problem import GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems, save_problem
+from symlearn.planning.problem_generation import MAX_ACTION_DRAWS, ProblemConfig, _changing_action, generate_problems
+from symlearn.sim.exploration import ExplorationConfig
+from symlearn.planning.scenes import max_goal_distance
+from symlearn.world import N_LOCATIONS, ObjectType, Scene, decode_action
 
 
 @pytest.fixture(scope="module")
@@ -75,6 +77,16 @@ def test_problem_config_refuses_bad_ranges(objects, length):
 def test_generate_refuses_zero_problems(tmp_path):
     with pytest.raises(ValueError, match="at least 1"):
         generate_problems(tmp_path / "none", 0)
+
+
+def test_changing_action_is_bounded():
+    rng = np.random.default_rng(0)
+    occupied = np.zeros(N_LOCATIONS, bool)
+    occupied[4] = True
+    a = _changing_action(rng, occupied, ExplorationConfig())
+    assert a.pick == 4 and a.release != 4
+    with pytest.raises(RuntimeError, match=f"after {MAX_ACTION_DRAWS} draws"):  # nothing to pick: no endless loop
+        _changing_action(rng, np.zeros(N_LOCATIONS, bool), ExplorationConfig())
 
 
 def _corrupt(d: dict, how: str) -> dict:

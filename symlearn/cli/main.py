@@ -11,7 +11,8 @@ import sys
 import time
 from pathlib import Path
 
-from symlearn.cli.planning import _int_range
+from symlearn.cli.args import int_range
+from symlearn.cli.planning import add_planning_commands
 
 
 def cmd_collect(args: argparse.Namespace) -> int:
@@ -140,27 +141,31 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="symlearn", description="Learn planning symbols from robot interaction.")
-    sub = p.add_subparsers(dest="command", required=True)
-
+def add_collect_command(sub) -> None:
+    """Add `collect` to the CLI's sub-parsers."""
     c = sub.add_parser("collect", help="collect interaction data in the simulator")
     c.add_argument("--out", required=True, help="data set directory (created, or resumed)")
     c.add_argument("--n", type=int, default=12000, help="number of samples (actions)")
     c.add_argument("--workers", type=int, default=1, help="worker processes")
     c.add_argument("--seed", type=int, default=0)
-    c.add_argument("--objects", type=_int_range, default=None,
+    c.add_argument("--objects", type=int_range, default=None,
                    help="objects per scene, e.g. 4-5 (default: the paper's mix of 1-3)")
     c.add_argument("--shard-size", type=int, default=250, help="samples per shard")
     c.add_argument("--quiet", action="store_true", help="no progress bar")
     c.set_defaults(func=cmd_collect)
 
+
+def add_scenarios_command(sub) -> None:
+    """Add `scenarios` to the CLI's sub-parsers."""
     s = sub.add_parser("scenarios", help="run the named physics scenarios and print their effects")
     s.add_argument("names", nargs="*", help="scenario names (default: all)")
     s.add_argument("--json", action="store_true", help="print JSON")
     s.add_argument("--gui", action="store_true", help="watch in pybullet's GUI")
     s.set_defaults(func=cmd_scenarios)
 
+
+def add_train_command(sub) -> None:
+    """Add `train` to the CLI's sub-parsers."""
     t = sub.add_parser("train", help="train the attentive effect model (runs under torchrun too)")
     t.add_argument("--data", required=True)
     t.add_argument("--out", required=True, help="run directory (resumed if it holds the same run)")
@@ -180,6 +185,9 @@ def build_parser() -> argparse.ArgumentParser:
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=cmd_train)
 
+
+def add_analysis_commands(sub) -> None:
+    """Add `evaluate`, `table1` and `symbols` (reports on a trained run) to the CLI's sub-parsers."""
     e = sub.add_parser("evaluate", help="effect errors on the test split, with ablation rows")
     e.add_argument("--run", required=True)
     e.add_argument("--data", required=True)
@@ -197,6 +205,9 @@ def build_parser() -> argparse.ArgumentParser:
     sy.add_argument("--min-count", type=int, default=100, help="a symbol is frequent from this many objects")
     sy.set_defaults(func=cmd_symbols)
 
+
+def add_export_pddl_command(sub) -> None:
+    """Add `export-pddl` to the CLI's sub-parsers."""
     x = sub.add_parser("export-pddl", help="distil the transition network into rules and a PDDL domain")
     x.add_argument("--run", required=True)
     x.add_argument("--data", required=True, help="the data set whose training codes form the vocabulary")
@@ -211,8 +222,16 @@ def build_parser() -> argparse.ArgumentParser:
     x.add_argument("--seed", type=int, default=0)
     x.set_defaults(func=cmd_export_pddl)
 
-    from symlearn.cli.planning import add_planning_commands
 
+def build_parser() -> argparse.ArgumentParser:
+    """The `symlearn` parser with every sub-command, in the order `symlearn --help` lists them."""
+    p = argparse.ArgumentParser(prog="symlearn", description="Learn planning symbols from robot interaction.")
+    sub = p.add_subparsers(dest="command", required=True)
+    add_collect_command(sub)
+    add_scenarios_command(sub)
+    add_train_command(sub)
+    add_analysis_commands(sub)
+    add_export_pddl_command(sub)
     add_planning_commands(sub)
     return p
 

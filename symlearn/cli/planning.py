@@ -16,24 +16,7 @@ import json
 import sys
 from pathlib import Path
 
-
-def _int_range(text: str) -> tuple[int, int]:
-    """'1-3' -> (1, 3); '4' -> (4, 4)."""
-    try:
-        lo, _, hi = text.partition("-")
-        lo_i, hi_i = int(lo), int(hi or lo)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"range {text!r} must look like 1-3 or 4") from None
-    if lo_i > hi_i:
-        raise argparse.ArgumentTypeError(f"range {text!r} is empty")
-    return lo_i, hi_i
-
-
-def _planner_list(text: str) -> list[str]:
-    names = [n.strip() for n in text.split(",") if n.strip()]
-    if not names:
-        raise argparse.ArgumentTypeError("give at least one planner, e.g. astar,astar-ucs")
-    return names
+from symlearn.cli.args import int_range, planner_list
 
 
 def cmd_train_transition(args: argparse.Namespace) -> int:
@@ -54,7 +37,7 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
 
 
 def cmd_problems(args: argparse.Namespace) -> int:
-    from symlearn.planning.problems import generate_problems
+    from symlearn.planning.problem_generation import generate_problems
 
     print(f"problems: {args.n} problems, objects {args.objects[0]}-{args.objects[1]}, length "
           f"{args.length[0]}-{args.length[1]}, seed {args.seed} -> {args.out}", file=sys.stderr)
@@ -64,25 +47,23 @@ def cmd_problems(args: argparse.Namespace) -> int:
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
-    from symlearn.planning.benchmark import get_planner
     from symlearn.learning.checkpoint import load_effect_model
     from symlearn.planning.execution import ExecutionConfig, run_problem
-    from symlearn.planning.problems import load_problem
+    from symlearn.planning.planners import make_planners
+    from symlearn.planning.problem import load_problem
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.learned_transition import LearnedTransition
 
-    from symlearn.planning.planners import register_pddl_planners
-
     problem = load_problem(Path(args.problem))
-    register_pddl_planners(Path(args.run), [args.planner], write_dir=Path(args.run) / "pddl" / "problems" / problem.name)
-    fn = get_planner(args.planner)
+    write_dir = Path(args.run) / "pddl" / "problems" / problem.name
+    fn = make_planners([args.planner], Path(args.run), write_dir=write_dir)[args.planner]
     encoder, _ = load_effect_model(Path(args.run))
     transition = LearnedTransition.from_run(Path(args.run))
     cfg = ExecutionConfig(closed_loop=args.closed_loop, max_replans=args.max_replans, timeout_s=args.timeout)
     with TabletopSimulator() as sim:
         row = run_problem(sim, encoder, transition, problem, args.planner, fn, cfg)
-    if (Path(args.run) / "pddl" / "problems" / problem.name).exists():
-        print(f"wrote {Path(args.run) / 'pddl' / 'problems' / problem.name / 'problem.pddl'}")
+    if write_dir.exists():
+        print(f"wrote {write_dir / 'problem.pddl'}")
     print(f"{problem.name} [{args.planner}{', closed loop' if row.closed_loop else ''}]: found {row.found} "
           f"({row.status}), length {row.plan_length} (generator {row.generator_length}), "
           f"time {row.planning_time_s:.3f} s, expansions {row.expansions}, success {row.success}, "
@@ -92,12 +73,8 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 
 def cmd_benchmark(args: argparse.Namespace) -> int:
-    from symlearn.planning.benchmark import benchmark, format_table, get_planner
-    from symlearn.planning.planners import register_pddl_planners
+    from symlearn.planning.benchmark import benchmark, format_table
 
-    register_pddl_planners(Path(args.run), args.planners)
-    for name in args.planners:
-        get_planner(name)
     res = benchmark(Path(args.run), Path(args.problems), args.planners, Path(args.out), closed_loop=args.closed_loop,
                     timeout_s=args.timeout, max_replans=args.max_replans, show_progress=not args.quiet)
     print(format_table(res))
@@ -105,8 +82,8 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_planning_commands(sub) -> None:
-    """Add train-transition, problems, plan and benchmark to the CLI's sub-parsers."""
+def add_train_transition_command(sub) -> None:
+    """Add `train-transition` to the CLI's sub-parsers."""
     t = sub.add_parser("train-transition", help="train the symbolic transition model m(z) on a run's codes")
     t.add_argument("--run", required=True, help="run directory with the trained effect model (best.pt)")
     t.add_argument("--data", required=True, help="the data set to encode")
@@ -117,28 +94,51 @@ def add_planning_commands(sub) -> None:
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=cmd_train_transition)
 
+
+def add_problems_command(sub) -> None:
+    """Add `problems` to the CLI's sub-parsers."""
     p = sub.add_parser("problems", help="generate planning problems (initial scene, goal scene) in the simulator")
     p.add_argument("--out", required=True, help="directory for the problem JSON files")
     p.add_argument("--n", type=int, default=20, help="number of problems")
-    p.add_argument("--objects", type=_int_range, default=(1, 3), help="objects per scene, e.g. 1-3 or 4-5")
-    p.add_argument("--length", type=_int_range, default=(1, 4), help="generator actions per problem, e.g. 1-4")
+    p.add_argument("--objects", type=int_range, default=(1, 3), help="objects per scene, e.g. 1-3 or 4-5")
+    p.add_argument("--length", type=int_range, default=(1, 4), help="generator actions per problem, e.g. 1-4")
     p.add_argument("--seed", type=int, default=0)
     p.set_defaults(func=cmd_problems)
 
-    for name, helptext in (("plan", "plan one problem with the learned symbols and execute it"),
-                           ("benchmark", "plan and execute every problem of a directory with several planners")):
-        c = sub.add_parser(name, help=helptext)
-        c.add_argument("--run", required=True, help="run directory with best.pt and transition.pt")
-        if name == "plan":
-            c.add_argument("--problem", required=True, help="problem JSON file")
-            c.add_argument("--planner", default="astar")
-        else:
-            c.add_argument("--problems", required=True, help="directory of problem JSON files")
-            c.add_argument("--planners", type=_planner_list, default=["astar", "astar-ucs"],
-                           help="comma-separated planner names")
-            c.add_argument("--out", required=True, help="benchmark JSON file")
-            c.add_argument("--quiet", action="store_true")
-        c.add_argument("--closed-loop", action="store_true", help="replan when the scene departs from the prediction")
-        c.add_argument("--max-replans", type=int, default=3)
-        c.add_argument("--timeout", type=float, default=30.0, help="seconds per planner call")
-        c.set_defaults(func=cmd_plan if name == "plan" else cmd_benchmark)
+
+def _add_execution_flags(c: argparse.ArgumentParser) -> None:
+    """The execution flags `plan` and `benchmark` share."""
+    c.add_argument("--closed-loop", action="store_true", help="replan when the scene departs from the prediction")
+    c.add_argument("--max-replans", type=int, default=3)
+    c.add_argument("--timeout", type=float, default=30.0, help="seconds per planner call")
+
+
+def add_plan_command(sub) -> None:
+    """Add `plan` to the CLI's sub-parsers."""
+    c = sub.add_parser("plan", help="plan one problem with the learned symbols and execute it")
+    c.add_argument("--run", required=True, help="run directory with best.pt and transition.pt")
+    c.add_argument("--problem", required=True, help="problem JSON file")
+    c.add_argument("--planner", default="astar")
+    _add_execution_flags(c)
+    c.set_defaults(func=cmd_plan)
+
+
+def add_benchmark_command(sub) -> None:
+    """Add `benchmark` to the CLI's sub-parsers."""
+    c = sub.add_parser("benchmark", help="plan and execute every problem of a directory with several planners")
+    c.add_argument("--run", required=True, help="run directory with best.pt and transition.pt")
+    c.add_argument("--problems", required=True, help="directory of problem JSON files")
+    c.add_argument("--planners", type=planner_list, default=["astar", "astar-ucs"],
+                   help="comma-separated planner names")
+    c.add_argument("--out", required=True, help="benchmark JSON file")
+    c.add_argument("--quiet", action="store_true")
+    _add_execution_flags(c)
+    c.set_defaults(func=cmd_benchmark)
+
+
+def add_planning_commands(sub) -> None:
+    """Add train-transition, problems, plan and benchmark to the CLI's sub-parsers."""
+    add_train_transition_command(sub)
+    add_problems_command(sub)
+    add_plan_command(sub)
+    add_benchmark_command(sub)

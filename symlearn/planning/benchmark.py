@@ -1,12 +1,9 @@
 """Benchmarking planners on a directory of problems: plan with the learned symbols, execute, score.
 
-Planners live in an explicit registry, name -> function (transition, start_codes, goal,
-timeout_s) -> PlanResult. The learned-net A* ("astar", greedy-ish with the mismatch
-heuristic) and its uniform-cost variant ("astar-ucs", shortest plans) are registered here;
-another module adds more (e.g. the PDDL planners) with `register_planner` without editing
-this file.
+Planners are named entries of the one registry, symlearn.planning.planners.PLANNERS (the
+learned-net A* variants and the planners on the exported rules); `benchmark` builds the named
+ones for the run and refuses unknown names before any work.
 
-    >>> register_planner("fast-downward", my_fd_adapter)                                # doctest: +SKIP
     >>> res = benchmark(Path("runs/paper"), Path("problems/p13"), ["astar", "astar-ucs"],
     ...                 Path("runs/paper/bench.json"), closed_loop=True, timeout_s=30)  # doctest: +SKIP
     >>> print(format_table(res))                                                        # doctest: +SKIP
@@ -17,42 +14,9 @@ import statistics
 import time
 from pathlib import Path
 
-import numpy as np
-
-from search.learned_astar import plan_symbolic
-from search.result import PlanResult
-from pddl_export.symbolic import SymbolicGoal, TransitionFn
-from symlearn.planning.execution import ExecutionConfig, PlannerFn, ProblemRun, run_problem
+from symlearn.planning.execution import ExecutionConfig, ProblemRun, run_problem
+from symlearn.planning.planners import make_planners
 from symlearn.provenance import atomic_write_json, sha256_bytes, versions
-
-
-def _astar(transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
-    return plan_symbolic(transition, start, goal, timeout_s=timeout_s, planner_name="astar")
-
-
-def _astar_ucs(transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
-    return plan_symbolic(transition, start, goal, timeout_s=timeout_s, uniform_cost=True, planner_name="astar-ucs")
-
-
-PLANNERS: dict[str, PlannerFn] = {"astar": _astar, "astar-ucs": _astar_ucs}
-
-
-def register_planner(name: str, fn: PlannerFn, replace: bool = False) -> None:
-    """Add a planner under `name`; refuses to overwrite an existing one unless replace=True."""
-    if not isinstance(name, str) or not name or "," in name:
-        raise ValueError(f"planner name {name!r} must be a non-empty string without commas")
-    if not callable(fn):
-        raise ValueError(f"planner {name!r} must be callable")
-    if name in PLANNERS and not replace:
-        raise ValueError(f"planner {name!r} is already registered")
-    PLANNERS[name] = fn
-
-
-def get_planner(name: str) -> PlannerFn:
-    """The registered planner function, or a one-line error listing the known names."""
-    if name not in PLANNERS:
-        raise ValueError(f"unknown planner {name!r}; known: {', '.join(sorted(PLANNERS))}")
-    return PLANNERS[name]
 
 
 def _rate(rows: list[ProblemRun], key: str) -> float | None:
@@ -70,7 +34,7 @@ def summarize_rows(rows: list[ProblemRun]) -> dict:
         stages: dict[str, int] = {}
         for r in base:
             if r.failure_stage is not None:
-                stages[r.failure_stage] = stages.get(r.failure_stage, 0) + 1
+                stages[r.failure_stage.value] = stages.get(r.failure_stage.value, 0) + 1
         s = {"n_problems": len(base), "success_rate": _rate(open_rows, "success"), "found_rate": _rate(base, "found"),
              "symbolic_match_rate": _rate(open_rows, "symbolic_match"),
              "median_time_s": round(statistics.median(r.planning_time_s for r in base), 5) if base else None,
@@ -100,15 +64,15 @@ def benchmark(run_dir: Path, problems_dir: Path, planners: list[str], out_file: 
               show_progress: bool = True) -> dict:
     """Plan and execute every problem with every planner (closed loop too if asked); write out_file."""
     from symlearn.learning.checkpoint import load_effect_model
-    from symlearn.planning.problems import load_problems
+    from symlearn.planning.problem import load_problems
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.learned_transition import LearnedTransition
     from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
 
     if not planners:
         raise ValueError("no planners given")
-    fns = {name: get_planner(name) for name in planners}  # refuse unknown names before any work
     run_dir, problems_dir, out_file = Path(run_dir), Path(problems_dir), Path(out_file)
+    fns = make_planners(list(planners), run_dir)  # refuses unknown names (and missing rules) before any work
     problems = load_problems(problems_dir)
     encoder, _ = load_effect_model(run_dir)
     transition = LearnedTransition.from_run(run_dir)

@@ -9,7 +9,7 @@ observed codes, at most `max_replans` times; the replanning search uses the netw
 by every transition seen so far in this execution (ObservedTransitions), so it does not repeat an
 action the scene has just answered differently than predicted.
 
-    >>> row = run_problem(sim, encoder, transition, problem, "astar", get_planner("astar"),
+    >>> row = run_problem(sim, encoder, transition, problem, "astar", make_planner("astar"),
     ...                   ExecutionConfig(closed_loop=True))                       # doctest: +SKIP
     >>> row.found, row.plan_length, row.success, row.failure_stage               # doctest: +SKIP
     (True, 2, True, None)
@@ -18,18 +18,32 @@ from __future__ import annotations
 
 import time
 from dataclasses import asdict, dataclass, field
+from enum import Enum
 from typing import Callable
 
 import numpy as np
 
 from search.result import PlanResult, PlanStatus, failed
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
-from symlearn.planning.problems import GOAL_TOLERANCE_M, Problem, goal_codes, max_goal_distance, place_scene
+from symlearn.planning.problem import GOAL_TOLERANCE_M, Problem
+from symlearn.planning.scenes import goal_codes, max_goal_distance, place_scene
 from symlearn.symbolic.transition_data import encode_observation
 from symlearn.world import decode_action
 
 PlannerFn = Callable[[TransitionFn, np.ndarray, SymbolicGoal, float], PlanResult]
-FAILURE_STAGES = (None, "no_plan", "timeout", "execution", "goal_mismatch", "rules_vs_net")
+
+
+class FailureStage(str, Enum):
+    """Where a benchmark run failed; the value is what the JSON rows and summaries hold."""
+
+    def __str__(self) -> str:  # as StrEnum (Python 3.11+) does, on 3.10 too
+        return self.value
+
+    NO_PLAN = "no_plan"  # the planner found no plan (unsolvable, node limit, error)
+    TIMEOUT = "timeout"  # the planner ran out of time
+    EXECUTION = "execution"  # the executed scene departed from the plan's predictions
+    GOAL_MISMATCH = "goal_mismatch"  # the plan ran as predicted but the scene is not within tolerance of the goal
+    RULES_VS_NET = "rules_vs_net"  # the PDDL plan's states are not what the network predicts
 
 
 @dataclass(frozen=True)
@@ -161,31 +175,37 @@ class ProblemRun:
     max_distance_m: float | None  # None when nothing was executed
     closed_loop: bool
     replans: int
-    failure_stage: str | None  # one of FAILURE_STAGES
+    failure_stage: FailureStage | None  # a FailureStage (or its value), None on success
     generator_length: int
     message: str = ""
     n_objects: int = 0
     timings: dict = field(default_factory=dict)  # planner-specific, e.g. pddl_write_time_s, planner_time_s
 
     def __post_init__(self) -> None:
-        if self.failure_stage not in FAILURE_STAGES:
-            raise ValueError(f"unknown failure stage {self.failure_stage!r}; known: {FAILURE_STAGES}")
+        if self.failure_stage is not None:
+            if self.failure_stage not in FailureStage.__members__.values():
+                raise ValueError(f"unknown failure stage {self.failure_stage!r}; "
+                                 f"known: {', '.join(s.value for s in FailureStage)}")
+            object.__setattr__(self, "failure_stage", FailureStage(self.failure_stage))
         if self.success and self.failure_stage is not None:
             raise ValueError("a successful run has no failure stage")
 
     def to_json(self) -> dict:
-        return asdict(self)
+        """The row as plain JSON values (the failure stage as its string value)."""
+        d = asdict(self)
+        d["failure_stage"] = None if self.failure_stage is None else self.failure_stage.value
+        return d
 
 
-def failure_stage(plan: PlanResult, ex: ExecutionResult | None) -> str | None:
+def failure_stage(plan: PlanResult, ex: ExecutionResult | None) -> FailureStage | None:
     """Where a run failed: no plan, timeout, execution departing from predictions, or goal tolerance."""
     if not plan.found:
-        return "timeout" if plan.status is PlanStatus.TIMEOUT else "no_plan"
+        return FailureStage.TIMEOUT if plan.status is PlanStatus.TIMEOUT else FailureStage.NO_PLAN
     if ex is None or ex.success:
         return None
     if plan.extra.get("rules_vs_net"):  # the network would not have predicted the PDDL plan's states
-        return "rules_vs_net"
-    return "goal_mismatch" if ex.on_prediction else "execution"
+        return FailureStage.RULES_VS_NET
+    return FailureStage.GOAL_MISMATCH if ex.on_prediction else FailureStage.EXECUTION
 
 
 def safe_plan(planner: str, planner_fn: PlannerFn, transition: TransitionFn, start: np.ndarray,

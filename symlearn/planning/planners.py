@@ -1,20 +1,32 @@
-"""Classical planners on the exported PDDL, as entries of the benchmark's planner registry.
+"""Every planner the benchmark, the CLI and the examples can run, in one immutable registry.
 
-Each planner writes the problem for the start and goal codes (and, for STRIPS-only planners,
-the grounded STRIPS form of the domain for this problem), calls the planner through
-unified-planning (search.classical), or, for the `-sas` planners, writes the rules for this
-problem as a SAS+ task and runs Fast Downward's or SymK's search on it without a translator
-(search.sas_planners), and checks the plan against the network: if rolling the
+`PLANNERS` maps a name to a PlannerSpec: a description, whether it plans on the exported rules
+(RUN/pddl/rules.json), and how to build its planner function (transition, start_codes, goal,
+timeout_s) -> PlanResult from a PlannerContext. The registry is built once and cannot be
+changed at run time; `make_planner(name, context)` is the one way to get a planner function.
+
+The learned-net A* ("astar", greedy-ish with the mismatch heuristic) and its uniform-cost
+variant ("astar-ucs", shortest plans) search with the transition network. The classical
+planners write the problem for the start and goal codes (and, for STRIPS-only planners, the
+grounded STRIPS form of the domain for this problem) and call the planner through
+unified-planning (search.classical), or, for the `-sas` planners, write the rules for this
+problem as a SAS+ task and run Fast Downward's or SymK's search on it without a translator
+(search.sas_planners). Their plans are checked against the network: if rolling the
 transition network along the plan gives other states than the PDDL predicted, the result is
 marked `rules_vs_net`. PDDL writing time and the planner's own time are reported separately.
 
-    >>> register_pddl_planners(Path("runs/paper"))  # doctest: +SKIP
+    >>> context = PlannerContext.for_run(Path("runs/paper"), ["astar", "fast-downward"])  # doctest: +SKIP
+    >>> plan = make_planner("fast-downward", context)                                      # doctest: +SKIP
 """
 from __future__ import annotations
 
 import dataclasses
 import time
+import types
+from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
+from typing import Callable, Mapping
 
 import numpy as np
 
@@ -23,24 +35,55 @@ from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pdd
 from pddl_export.rules import RuleSet
 from pddl_export.rules_io import load_rules
 from pddl_export.sas_writer import SASEncoder
-from search.classical import solve_pddl
-from search.up_problem import strips_problem
-from search.sas_planners import solve_sas
-from search.result import PlanResult, PlanStatus, failed
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
-from symlearn.planning.benchmark import PLANNERS, register_planner
+from search.classical import solve_pddl
+from search.learned_astar import plan_symbolic
+from search.result import PlanResult, PlanStatus, failed
+from search.sas_planners import solve_sas
+from search.up_problem import strips_problem
+from symlearn.planning.execution import PlannerFn
 
-# registry name -> (unified-planning engine name in search.classical, PDDL form)
-PDDL_PLANNERS = {
-    "fast-downward": ("fast-downward", "conditional"),
-    "symk": ("symk", "conditional"),
-    "pyperplan": ("pyperplan", "strips"),
-    "fast-downward-opt": ("fast-downward-opt", "strips"),
-    "fast-downward-blind": ("fast-downward-blind", "conditional"),
-    "fast-downward-sas": ("fast-downward-sas", "sas"),  # Fast Downward's search on a direct SAS+ task
-    "fast-downward-sas-opt": ("fast-downward-sas-opt", "sas"),
-    "symk-sas": ("symk-sas", "sas"),  # SymK's symbolic search on the same SAS+ task
-}
+
+@dataclass(frozen=True)
+class PlannerContext:
+    """What building a planner may need: the exported rules (for rule-based planners) and where to save tasks."""
+
+    rules: RuleSet | None = None  # RUN/pddl/rules.json, needed by every spec with needs_rules
+    model_hash: str = ""  # the transition model's hash recorded with the rules
+    write_dir: Path | None = None  # save every problem/task a planner writes here (None: keep nothing)
+
+    @staticmethod
+    def for_run(run_dir: Path, names: list[str], write_dir: Path | None = None) -> "PlannerContext":
+        """A context for the named planners of a run: loads RUN/pddl/rules.json only when one of them needs it."""
+        specs = [planner_spec(n) for n in names]  # refuse unknown names before reading anything
+        if not any(s.needs_rules for s in specs):
+            return PlannerContext(write_dir=write_dir)
+        rules, model_hash = load_rules(Path(run_dir))
+        return PlannerContext(rules=rules, model_hash=model_hash, write_dir=write_dir)
+
+
+@dataclass(frozen=True)
+class PlannerSpec:
+    """One registry entry: a planner's name, what it is, and how to build its function from a context."""
+
+    name: str
+    description: str
+    needs_rules: bool  # plans on the exported rules (RUN/pddl/rules.json) rather than the network alone
+    build: Callable[[PlannerContext], PlannerFn]
+
+
+# ------------------------------------------------------------------------------- learned-net A*
+
+
+def _astar(transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
+    return plan_symbolic(transition, start, goal, timeout_s=timeout_s, planner_name="astar")
+
+
+def _astar_ucs(transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
+    return plan_symbolic(transition, start, goal, timeout_s=timeout_s, uniform_cost=True, planner_name="astar-ucs")
+
+
+# ------------------------------------------------------------------------------- planners on the exported rules
 
 
 def network_agrees(transition: TransitionFn, plan: PlanResult) -> bool:
@@ -55,75 +98,132 @@ def network_agrees(transition: TransitionFn, plan: PlanResult) -> bool:
     return True
 
 
-def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Path | None = None):
-    """A benchmark planner function for registry name `name` over the exported rules.
+class _RulesPlanner:
+    """A planner function over the exported rules: PDDL (conditional or grounded STRIPS) or a SAS+ task.
 
     With `write_dir`, every problem it writes is also saved there (problem.pddl, then
     problem_2.pddl for a replan, ...; STRIPS planners save their grounded domain beside it,
     SAS+ planners the task.sas they ran).
     """
-    engine, form = PDDL_PLANNERS[name]
-    domain = conditional_domain(rules, model_hash) if form == "conditional" else None
-    encoder = SASEncoder(rules) if form == "sas" else None
-    calls = [0]
 
-    def plan(transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
-        t0 = time.perf_counter()
+    def __init__(self, rules: RuleSet, model_hash: str, name: str, engine: str, form: str,
+                 write_dir: Path | None) -> None:
+        self.rules, self.model_hash, self.name, self.engine, self.form = rules, model_hash, name, engine, form
+        self.write_dir = None if write_dir is None else Path(write_dir)
+        self.domain = conditional_domain(rules, model_hash) if form == "conditional" else None
+        self.encoder = SASEncoder(rules) if form == "sas" else None
+        self.calls = 0
+
+    def __call__(self, transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
         init = [int(c) for c in start]
-        if encoder is not None:  # the SAS+ task is saved next to the same problem in PDDL, for reading
-            prob_path = _next_path("problem", ".pddl")
-            if prob_path is not None:
-                try:
-                    atomic_write_text(prob_path, problem_pddl(rules, init, goal, model_hash))
-                except ValueError:
-                    pass  # unknown codes: solve_sas reports them
-            sas_path = None if prob_path is None else prob_path.with_name(prob_path.name.replace("problem", "task")
-                                                                          .replace(".pddl", ".sas"))
-            return _checked(transition, solve_sas(encoder, init, goal, engine, timeout_s, write_to=sas_path))
+        if self.encoder is not None:
+            return self._checked(transition, self._solve_sas(init, goal, timeout_s))
+        return self._solve_pddl(transition, init, goal, timeout_s)
+
+    def _solve_sas(self, init: list[int], goal: SymbolicGoal, timeout_s: float) -> PlanResult:
+        prob_path = self._next_path("problem", ".pddl")
+        if prob_path is not None:  # the SAS+ task is saved next to the same problem in PDDL, for reading
+            try:
+                atomic_write_text(prob_path, problem_pddl(self.rules, init, goal, self.model_hash))
+            except ValueError:
+                pass  # unknown codes: solve_sas reports them
+        sas_path = None if prob_path is None else prob_path.with_name(prob_path.name.replace("problem", "task")
+                                                                      .replace(".pddl", ".sas"))
+        return solve_sas(self.encoder, init, goal, self.engine, timeout_s, write_to=sas_path)
+
+    def _solve_pddl(self, transition: TransitionFn, init: list[int], goal: SymbolicGoal,
+                    timeout_s: float) -> PlanResult:
+        t0 = time.perf_counter()
         try:
             prebuilt = None
-            if form == "strips":  # built directly: unified-planning's reader is too slow for its size
-                task = strips_pddl(rules, init, goal, model_hash)
+            if self.form == "strips":  # built directly: unified-planning's reader is too slow for its size
+                task = strips_pddl(self.rules, init, goal, self.model_hash)
                 dom, prob, prebuilt = task.domain, task.problem, strips_problem(task)
             else:
-                dom, prob = domain, problem_pddl(rules, init, goal, model_hash)
+                dom, prob = self.domain, problem_pddl(self.rules, init, goal, self.model_hash)
         except (ValueError, RuntimeError) as e:  # codes outside the vocabulary, too many states
-            return failed(name, PlanStatus.ERROR, t0, str(e))
-        prob_path = _next_path("problem", ".pddl")
+            return failed(self.name, PlanStatus.ERROR, t0, str(e))
+        prob_path = self._next_path("problem", ".pddl")
         if prob_path is not None:
             atomic_write_text(prob_path, prob)
-            if form == "strips":
+            if self.form == "strips":
                 atomic_write_text(prob_path.with_name(prob_path.name.replace("problem", "domain_strips")), dom)
         write_s = time.perf_counter() - t0
-        res = solve_pddl(dom, prob, engine, max(timeout_s - write_s, 0.001), cache_domain=form == "conditional",
-                         problem=prebuilt)
+        res = solve_pddl(dom, prob, self.engine, max(timeout_s - write_s, 0.001),
+                         cache_domain=self.form == "conditional", problem=prebuilt)
         res = dataclasses.replace(res, planning_time_s=write_s + res.planning_time_s,
                                   extra=dict(res.extra, pddl_write_time_s=round(write_s, 5)))
-        return _checked(transition, res)
+        return self._checked(transition, res)
 
-    def _next_path(stem: str, suffix: str) -> Path | None:
-        """RUN's write_dir/problem.pddl, then problem_2.pddl for a replan, ... (None without write_dir)."""
-        if write_dir is None:
+    def _next_path(self, stem: str, suffix: str) -> Path | None:
+        """write_dir/problem.pddl, then problem_2.pddl for a replan, ... (None without write_dir)."""
+        if self.write_dir is None:
             return None
-        calls[0] += 1
-        Path(write_dir).mkdir(parents=True, exist_ok=True)
-        return Path(write_dir) / (f"{stem}{suffix}" if calls[0] == 1 else f"{stem}_{calls[0]}{suffix}")
+        self.calls += 1
+        self.write_dir.mkdir(parents=True, exist_ok=True)
+        return self.write_dir / (f"{stem}{suffix}" if self.calls == 1 else f"{stem}_{self.calls}{suffix}")
 
-    def _checked(transition: TransitionFn, res: PlanResult) -> PlanResult:
+    def _checked(self, transition: TransitionFn, res: PlanResult) -> PlanResult:
         extra = dict(res.extra)
         if res.found:
             extra["rules_vs_net"] = not network_agrees(transition, res)
-        return dataclasses.replace(res, planner=name, extra=extra)
-
-    return plan
+        return dataclasses.replace(res, planner=self.name, extra=extra)
 
 
-def register_pddl_planners(run_dir: Path, names: list[str] | None = None, write_dir: Path | None = None) -> list[str]:
-    """Register the PDDL planners over RUN/pddl/rules.json (replacing earlier registrations)."""
-    names = list(PDDL_PLANNERS) if names is None else [n for n in names if n in PDDL_PLANNERS]
-    if not names:
-        return []
-    rules, model_hash = load_rules(Path(run_dir))
-    for n in names:
-        register_planner(n, make_pddl_planner(rules, model_hash, n, write_dir), replace=n in PLANNERS)
-    return names
+# registry name -> (engine name in search.classical / search.sas_planners, task form, description)
+_RULES_PLANNERS = {
+    "fast-downward": ("fast-downward", "conditional", "Fast Downward on the conditional-effects PDDL domain"),
+    "symk": ("symk", "conditional", "SymK on the conditional-effects PDDL domain"),
+    "pyperplan": ("pyperplan", "strips", "pyperplan on the grounded STRIPS form of the problem"),
+    "fast-downward-opt": ("fast-downward-opt", "strips", "optimal Fast Downward on the grounded STRIPS form"),
+    "fast-downward-blind": ("fast-downward-blind", "conditional", "Fast Downward, blind search, on the PDDL domain"),
+    "fast-downward-sas": ("fast-downward-sas", "sas", "Fast Downward's search on a direct SAS+ task"),
+    "fast-downward-sas-opt": ("fast-downward-sas-opt", "sas", "optimal Fast Downward search on the SAS+ task"),
+    "symk-sas": ("symk-sas", "sas", "SymK's symbolic search on the same SAS+ task"),
+}
+
+
+def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Path | None = None) -> PlannerFn:
+    """The planner function of rule-based planner `name` over the exported rules (saving its tasks in write_dir)."""
+    if name not in _RULES_PLANNERS:
+        raise ValueError(f"{name!r} is not a planner on the exported rules; known: {', '.join(_RULES_PLANNERS)}")
+    engine, form, _ = _RULES_PLANNERS[name]
+    return _RulesPlanner(rules, model_hash, name, engine, form, write_dir)
+
+
+def _build_rules_planner(name: str, context: PlannerContext) -> PlannerFn:
+    if context.rules is None:
+        raise ValueError(f"planner {name!r} plans on the exported rules, and none were given; "
+                         f"run 'symlearn export-pddl' first")
+    return make_pddl_planner(context.rules, context.model_hash, name, context.write_dir)
+
+
+# ------------------------------------------------------------------------------- the registry
+
+
+def _registry() -> Mapping[str, PlannerSpec]:
+    specs = [PlannerSpec("astar", "learned-net A* with the mismatch heuristic", False, lambda _: _astar),
+             PlannerSpec("astar-ucs", "learned-net uniform-cost search (shortest plans)", False, lambda _: _astar_ucs)]
+    specs += [PlannerSpec(n, desc, True, partial(_build_rules_planner, n)) for n, (_, _, desc) in _RULES_PLANNERS.items()]
+    return types.MappingProxyType({s.name: s for s in specs})
+
+
+PLANNERS: Mapping[str, PlannerSpec] = _registry()
+
+
+def planner_spec(name: str) -> PlannerSpec:
+    """The registry entry of `name`, or a one-line ValueError listing every planner."""
+    if name not in PLANNERS:
+        raise ValueError(f"unknown planner {name!r}; known: {', '.join(PLANNERS)}")
+    return PLANNERS[name]
+
+
+def make_planner(name: str, context: PlannerContext = PlannerContext()) -> PlannerFn:
+    """Build planner `name`'s function; unknown names and rule-based planners without rules are refused."""
+    return planner_spec(name).build(context)
+
+
+def make_planners(names: list[str], run_dir: Path, write_dir: Path | None = None) -> dict[str, PlannerFn]:
+    """name -> planner function for a run (its rules loaded once, only if needed); every name is checked first."""
+    context = PlannerContext.for_run(run_dir, names, write_dir)
+    return {name: make_planner(name, context) for name in names}

@@ -29,6 +29,7 @@ from symlearn.data.dataset import DATA_KIND, FORMAT_VERSION, SPLITS
 from symlearn.provenance import atomic_write_json, sha256_file, versions
 from symlearn.sim.simulator import SimConfig, TabletopSimulator
 
+MAX_FAILED_EPISODES = 1000  # consecutive episodes without a sample before collect_shard gives up
 
 
 class CollectError(RuntimeError):
@@ -72,8 +73,15 @@ class CollectConfig:
 
 
 def collect_shard(cfg: CollectConfig, index: int, size: int,
-                  progress: Callable[[int], None] | None = None) -> dict[str, np.ndarray]:
-    """Run episodes until `size` samples are recorded; arrays padded to cfg.max_objects objects."""
+                  progress: Callable[[int], None] | None = None,
+                  max_failed_episodes: int = MAX_FAILED_EPISODES) -> dict[str, np.ndarray]:
+    """Run episodes until `size` samples are recorded; arrays padded to cfg.max_objects objects.
+
+    An episode that records no sample (its first action drops an object off the table) is retried
+    with a fresh scene, at most `max_failed_episodes` times in a row; then a CollectError says so.
+    Kept as one function (over 60 lines): half of it is the table of preallocated arrays, and the
+    episode loop fills them in place, row by row.
+    """
     rng = np.random.default_rng([cfg.seed, index])
     K, S = cfg.max_objects, cfg.sim.crop
     a = {
@@ -95,9 +103,11 @@ def collect_shard(cfg: CollectConfig, index: int, size: int,
     }
     dropped = 0
     episode = 0
+    failed_in_a_row = 0
     i = 0
     with TabletopSimulator(cfg.sim) as sim:
         while i < size:
+            recorded_before = i
             spec = sample_scene_spec(rng, cfg.exploration)
             sim.build(spec)
             k = len(spec)
@@ -131,6 +141,11 @@ def collect_shard(cfg: CollectConfig, index: int, size: int,
                 if progress:
                     progress(1)
             episode += 1
+            failed_in_a_row = failed_in_a_row + 1 if i == recorded_before else 0
+            if failed_in_a_row >= max_failed_episodes:
+                raise CollectError(f"shard {index}: {failed_in_a_row} episodes in a row recorded no sample "
+                                   f"(each first action dropped an object off the table, or episodes are empty); "
+                                   f"check the scene and exploration settings")
     a["dropped"] = np.array(dropped, np.int32)
     return a
 

@@ -1,14 +1,11 @@
 """Planning problems as JSON files: an initial scene, a goal scene, and the actions that made it.
 
-A problem is generated in the simulator: a random scene of k objects is built by dropping
-them (exploration.sample_scene_spec), a random sequence of L actions that each move something
-is executed, and the scene it ends in is the goal. The generator's actions are kept as a known
-valid plan (its length is a reference for plan lengths). Goal symbols are the effect model's
-codes of the goal scene, rendered by placing the objects at the goal poses.
+This module holds the problem format only: the Problem dataclass, its validation, and loading
+and saving. Problems are drawn in the simulator by symlearn.planning.problem_generation; scenes
+are placed and encoded by symlearn.planning.scenes.
 
-    >>> paths = generate_problems(Path("problems/p13"), n=20, objects=(1, 3), length=(1, 4), seed=0)  # doctest: +SKIP
-    >>> problem = load_problem(paths[0])                                                               # doctest: +SKIP
-    >>> problem.generator_length, problem.initial.k                                                    # doctest: +SKIP
+    >>> problem = load_problem(Path("problems/p13/problem_0000.json"))  # doctest: +SKIP
+    >>> problem.generator_length, problem.initial.k                     # doctest: +SKIP
     (3, 2)
 """
 from __future__ import annotations
@@ -20,13 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from symlearn.sim.exploration import MAX_OBJECTS, ExplorationConfig, sample_action, sample_scene_spec
+from symlearn.sim.exploration import MAX_OBJECTS
 from symlearn.provenance import atomic_write_json
-from symlearn.world import N_ACTIONS, N_LOCATIONS, Action, ObjectType, Scene, decode_action
+from symlearn.world import N_ACTIONS, N_LOCATIONS, ObjectType, Scene, decode_action
 
 PROBLEM_FORMAT = "symlearn-problem"
 PROBLEM_VERSION = 1
-MOVE_EPS_M = 0.01  # an action "changes something" when some object moves farther than this
 GOAL_TOLERANCE_M = 0.02  # success: every object within this distance of its goal position
 _KEYS = ("format", "version", "name", "seed", "spec", "initial", "actions", "goal", "generator_length")
 
@@ -178,123 +174,3 @@ def load_problems(problems_dir: Path) -> list[tuple[Path, Problem]]:
     if not paths:
         raise ValueError(f"{problems_dir} holds no problem files (*.json)")
     return [(p, load_problem(p)) for p in paths]
-
-
-# ------------------------------------------------------------------------------- generation
-
-
-@dataclass(frozen=True)
-class ProblemConfig:
-    """How problems are drawn: object count and generator-plan length ranges, retry bounds."""
-
-    objects: tuple[int, int] = (1, 3)  # inclusive range of objects per scene
-    length: tuple[int, int] = (1, 4)  # inclusive range of generator actions
-    max_step_tries: int = 20  # draws per step before giving up on the scene
-    max_scene_tries: int = 20  # fresh scenes per problem before giving up
-    min_goal_distance_m: float = GOAL_TOLERANCE_M  # some object must end farther than this from its start
-
-    def __post_init__(self) -> None:
-        lo, hi = self.objects
-        if not 1 <= lo <= hi <= MAX_OBJECTS:
-            raise ValueError(f"object range {lo}-{hi} must lie within 1-{MAX_OBJECTS}")
-        lo, hi = self.length
-        if not 1 <= lo <= hi:
-            raise ValueError(f"length range {lo}-{hi} must be non-empty and start at 1 or more")
-        if self.max_step_tries < 1 or self.max_scene_tries < 1:
-            raise ValueError("max_step_tries and max_scene_tries must be positive")
-
-
-def _changing_action(rng: np.random.Generator, occupied: np.ndarray, cfg: ExplorationConfig) -> Action:
-    """A random action with the exploration's rule, made likely to move something: pick occupied, release elsewhere."""
-    while True:
-        a = sample_action(rng, occupied, cfg)
-        if occupied[a.pick] and a.release != a.pick:
-            return a
-
-
-def _replay(sim, initial: Scene, actions: list[int]) -> None:
-    sim.reset(initial)
-    for a in actions:
-        sim.step(decode_action(a))
-
-
-def generate_problem(sim, rng: np.random.Generator, cfg: ProblemConfig, name: str, seed: int) -> Problem:
-    """One problem: build a random scene, execute L actions that each move something, keep the end as goal."""
-    expl = ExplorationConfig.with_k_range(*cfg.objects)
-    expl = ExplorationConfig(k_values=expl.k_values, k_probs=expl.k_probs, pick_occupied_prob=1.0)
-    for _ in range(cfg.max_scene_tries):
-        spec = sample_scene_spec(rng, expl)
-        length = int(rng.integers(cfg.length[0], cfg.length[1] + 1))
-        sim.build(spec)
-        initial = sim.get_scene()
-        sim.reset(initial)  # execution starts from a reset to these poses, so generation does too
-        actions: list[int] = []
-        while len(actions) < length:
-            for _ in range(cfg.max_step_tries):
-                res = sim.step(_changing_action(rng, sim.occupied(), expl))
-                moved = float(np.linalg.norm(res.effect, axis=1).max()) > MOVE_EPS_M
-                last = len(actions) == length - 1
-                far = float(np.linalg.norm(res.after.positions() - initial.positions(), axis=1).max())
-                if moved and not res.off_table and (not last or far > cfg.min_goal_distance_m):
-                    actions.append(res.action.id)
-                    break
-                _replay(sim, initial, actions)  # undo exactly: the recorded actions from the initial poses
-            else:
-                break
-        if len(actions) == length:
-            return Problem(name, seed, tuple(spec), initial, tuple(actions), sim.get_scene())
-    raise RuntimeError(f"problem {name}: no valid action sequence after {cfg.max_scene_tries} scenes")
-
-
-def generate_problems(out_dir: Path, n: int, objects: tuple[int, int] = (1, 3), length: tuple[int, int] = (1, 4),
-                      seed: int = 0, sim=None) -> list[Path]:
-    """Write n problems to out_dir/problem_NNNN.json (problem i drawn from seed (seed, i))."""
-    from symlearn.sim.simulator import TabletopSimulator
-
-    if n < 1:
-        raise ValueError(f"n={n} must be at least 1")
-    cfg = ProblemConfig(objects=tuple(objects), length=tuple(length))
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    own = sim is None
-    sim = sim or TabletopSimulator()
-    paths = []
-    try:
-        for i in range(n):
-            name = f"problem_{i:04d}"
-            problem = generate_problem(sim, np.random.default_rng([seed, i]), cfg, name, seed)
-            path = out_dir / f"{name}.json"
-            save_problem(path, problem)
-            paths.append(path)
-    finally:
-        if own:
-            sim.close()
-    return paths
-
-
-# ------------------------------------------------------------------------------- scenes and symbols
-
-
-def place_scene(sim, scene: Scene) -> None:
-    """Put the scene's objects at their poses (the arm at home) and let them settle."""
-    sim.reset(scene)
-
-
-def scene_codes(sim, encoder, scene: Scene) -> np.ndarray:
-    """(k,) int64 codes of a scene: place it, render, encode with the effect model."""
-    from symlearn.symbolic.transition_data import encode_observation
-
-    place_scene(sim, scene)
-    return encode_observation(encoder, sim.observe())
-
-
-def goal_codes(sim, encoder, problem: Problem) -> np.ndarray:
-    """The goal symbols of a problem: the encoder's codes of the goal scene's crops."""
-    return scene_codes(sim, encoder, problem.goal)
-
-
-def max_goal_distance(scene: Scene, goal: Scene) -> float:
-    """Largest distance (m) between an object's position and its goal position."""
-    if scene.k != goal.k:
-        raise ValueError(f"scene has {scene.k} objects, goal {goal.k}")
-    return float(np.linalg.norm(scene.positions() - goal.positions(), axis=1).max()) if scene.k else 0.0

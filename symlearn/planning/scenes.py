@@ -1,0 +1,37 @@
+"""Scenes and their symbols: place a scene in the simulator, encode it, measure distance to a goal.
+
+Goal symbols are the effect model's codes of the goal scene, rendered by placing the objects
+at the goal poses; execution compares observed codes with them and judges success by
+max_goal_distance.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from symlearn.planning.problem import Problem
+from symlearn.world import Scene
+
+
+def place_scene(sim, scene: Scene) -> None:
+    """Put the scene's objects at their poses (the arm at home) and let them settle."""
+    sim.reset(scene)
+
+
+def scene_codes(sim, encoder, scene: Scene) -> np.ndarray:
+    """(k,) int64 codes of a scene: place it, render, encode with the effect model."""
+    from symlearn.symbolic.transition_data import encode_observation
+
+    place_scene(sim, scene)
+    return encode_observation(encoder, sim.observe())
+
+
+def goal_codes(sim, encoder, problem: Problem) -> np.ndarray:
+    """The goal symbols of a problem: the encoder's codes of the goal scene's crops."""
+    return scene_codes(sim, encoder, problem.goal)
+
+
+def max_goal_distance(scene: Scene, goal: Scene) -> float:
+    """Largest distance (m) between an object's position and its goal position."""
+    if scene.k != goal.k:
+        raise ValueError(f"scene has {scene.k} objects, goal {goal.k}")
+    return float(np.linalg.norm(scene.positions() - goal.positions(), axis=1).max()) if scene.k else 0.0
