@@ -246,7 +246,7 @@ def test_benchmark_rows_and_summary(tiny_run_copy, problems, tmp_path):
     for r in b["rows"]:
         assert r["failure_stage"] in FAILURE_STAGES and r["failure_stage"] != "rules_vs_net"
         assert r["replans"] <= (1 if r["closed_loop"] else 0) and r["n_objects"] in (1, 2)
-        assert r["plan_length"] is None or r["plan_length"] >= 0 and (r["max_distance_m"] or 0) >= 0
+        assert (r["plan_length"] is None) == (not r["found"]) == (r["max_distance_m"] is None)
 
 
 def _bit_flip_rules(rules_file: Path, problem: Path) -> None:
