@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import platform
 from importlib import metadata
-from pathlib import Path
 
 from pddl_export.files import (atomic_write_bytes, atomic_write_json, atomic_write_text,  # noqa: F401 (re-exported)
                                 sha256_bytes, sha256_file)

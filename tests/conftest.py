@@ -1,11 +1,99 @@
+"""Shared fixtures: one simulator, ONE tiny data set and ONE tiny trained run for the whole session.
+
+The data set and the run are built once, through the `symlearn` CLI (so the fixtures survive moves of
+library modules), and their JSON outputs are kept for the tests to check. Nothing here imports the
+simulator (pybullet) at module level: the search and PDDL tests run without pybullet installed.
+Tests that write into a run (evaluate, symbols, export, plan) take `tiny_run_copy` instead of
+writing into the shared one.
+"""
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
 import pytest
 
-from symlearn.sim.simulator import TabletopSimulator
+# The tiny data set: 48 samples in 12 shards (40 train, 4 val, 4 test).
+TINY_DATA_ARGS = ("--n", "48", "--seed", "5", "--shard-size", "4")
+# The tiny run: a one-epoch quick effect model, a 3-epoch quick transition model, rules for scenes of <= 2 objects.
+TINY_TRAIN_ARGS = ("--preset", "quick", "--epochs", "1", "--batch-size", "8", "--no-bf16")
+TINY_TRANSITION_ARGS = ("--preset", "quick", "--epochs", "3", "--seed", "0")
+TINY_EXPORT_ARGS = ("--max-objects", "2", "--pddl-fidelity-cases", "60")
+
+
+def cli(*args) -> tuple[int, str]:
+    """Run `symlearn ARGS` in this process; returns its exit code and what it printed on stdout."""
+    from symlearn.cli.main import main
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        rc = main([str(a) for a in args])
+    return rc, out.getvalue()
+
+
+def cli_json(*args) -> dict:
+    """Run a `symlearn` command that prints one JSON document, refusing a non-zero exit code."""
+    rc, out = cli(*args)
+    assert rc == 0, f"symlearn {' '.join(map(str, args))} exited {rc}"
+    return json.loads(out)
+
+
+@dataclass(frozen=True)
+class TinyData:
+    """The session's tiny data set and the summary `symlearn collect` printed for it."""
+
+    path: Path
+    summary: dict
+
+
+@dataclass(frozen=True)
+class TinyRun:
+    """The session's tiny run (best.pt, transition.pt, pddl/), its data set, and the commands' JSON outputs."""
+
+    path: Path
+    data: Path
+    train: dict  # what `symlearn train` printed
+    transition: dict  # what `symlearn train-transition` printed
+    export_report: dict  # RUN/pddl/report.json
 
 
 @pytest.fixture(scope="session")
 def sim():
     """One simulator for the session: every scenario rebuilds its own scene."""
+    from symlearn.sim.simulator import TabletopSimulator
+
     s = TabletopSimulator()
     yield s
     s.close()
+
+
+@pytest.fixture(scope="session")
+def tiny_data(tmp_path_factory) -> TinyData:
+    """A 48-sample data set collected once per session (read only: copy it before writing into it)."""
+    path = tmp_path_factory.mktemp("tiny") / "data"
+    summary = cli_json("collect", "--out", path, *TINY_DATA_ARGS, "--quiet")
+    return TinyData(path, summary)
+
+
+@pytest.fixture(scope="session")
+def tiny_run(tmp_path_factory, tiny_data) -> TinyRun:
+    """Effect model, transition network and exported rules trained once per session on tiny_data (read only)."""
+    path = tmp_path_factory.mktemp("tiny_run") / "run"
+    train = cli_json("train", "--data", tiny_data.path, "--out", path, *TINY_TRAIN_ARGS, "--quiet")
+    transition = cli_json("train-transition", "--run", path, "--data", tiny_data.path, *TINY_TRANSITION_ARGS, "--quiet")
+    rc, _ = cli("export-pddl", "--run", path, "--data", tiny_data.path, *TINY_EXPORT_ARGS)
+    assert rc == 0
+    report = json.loads((path / "pddl" / "report.json").read_text())
+    return TinyRun(path, tiny_data.path, train, transition, report)
+
+
+@pytest.fixture
+def tiny_run_copy(tiny_run, tmp_path) -> Path:
+    """A private copy of the tiny run's directory, for tests that write into a run."""
+    dst = tmp_path / "run"
+    shutil.copytree(tiny_run.path, dst)
+    return dst

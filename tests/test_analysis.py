@@ -1,25 +1,32 @@
 """evaluate, table1 and symbols on a tiny run: the files they promise, with sane numbers."""
 import json
+import shutil
 
 import numpy as np
 import pytest
 
-from symlearn.sim.collect import CollectConfig, collect
 from symlearn.learning.evaluation import evaluate, format_table
 from symlearn.symbolic.symbols import analyse_symbols, picked_objects
 from symlearn.data.dataset import load_split
 from symlearn.learning.table1 import CASES, format_table1, table1
-from symlearn.learning.training import TrainConfig, train
+from conftest import TINY_TRAIN_ARGS, cli_json
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory):
+def run(tmp_path_factory, tiny_data, tiny_run):
+    """ROOT/data: the session's tiny data set; ROOT/run: a copy of the tiny run; ROOT/base: a no-attention run."""
     root = tmp_path_factory.mktemp("analysis")
-    collect(root / "data", CollectConfig(n=48, seed=9, shard_size=4), show_progress=False)
-    cfg = dict(epochs=1, batch_size=8, bf16=False)
-    train(root / "data", root / "run", TrainConfig.from_preset("quick", **cfg), show_progress=False)
-    train(root / "data", root / "base", TrainConfig.from_preset("quick", attention=False, **cfg), show_progress=False)
+    (root / "data").symlink_to(tiny_data.path, target_is_directory=True)
+    shutil.copytree(tiny_run.path, root / "run")
+    cli_json("train", "--data", root / "data", "--out", root / "base", *TINY_TRAIN_ARGS, "--no-attention", "--quiet")
     return root
+
+
+def _png_size(path) -> tuple[int, int]:
+    """Width and height from a PNG file's header (refusing anything that is not a PNG)."""
+    head = path.read_bytes()[:24]
+    assert head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR", path
+    return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
 
 
 def test_evaluate_writes_rows_with_ablations(run):
@@ -28,8 +35,20 @@ def test_evaluate_writes_rows_with_ablations(run):
     assert saved["effect_mae_mm"] == res["effect_mae_mm"] and set(res["effect_mae_mm"]) == {"x", "y", "z"}
     assert set(res["ablations"]) == {"no_attention", "mean_effect"}
     assert res["n_test_samples"] == 4 and res["trained_on"] == res["data_fingerprint"]
+    # the mean-effect row is the training split's mean effect scored on the test split, recomputed here
+    tr, te = load_split(run / "data", "train"), load_split(run / "data", "test")
+    want = np.abs(tr.effect[tr.mask].astype(np.float64).mean(0) - te.effect[te.mask]).mean(0) * 1000
+    got = res["ablations"]["mean_effect"]["effect_mae_mm"]
+    np.testing.assert_allclose([got[a] for a in "xyz"], want, atol=0.02)
+    np.testing.assert_allclose([res["mean_abs_effect_mm"][a] for a in "xyz"],
+                               np.abs(te.effect[te.mask]).mean(0) * 1000, atol=0.02)
+    counts = {str(k): int(te.mask[te.n_objects == k].sum()) for k in np.unique(te.n_objects)}
     for row in (res, res["ablations"]["mean_effect"], res["ablations"]["no_attention"]):
-        assert all(0 <= v < 2000 for v in row["effect_mae_mm"].values())
+        assert set(row["by_objects"]) == set(counts)  # the overall error is the object-weighted mean of the rows
+        for a in "xyz":
+            by = sum(counts[k] * row["by_objects"][k][a] for k in counts) / sum(counts.values())
+            assert row["effect_mae_mm"][a] == pytest.approx(by, abs=0.02) and row["effect_mae_mm"][a] > 0
+    assert res["effect_mae_mm"] != res["ablations"]["no_attention"]["effect_mae_mm"]  # two different models
     assert "attentive" in format_table(res) and "mean_effect" in format_table(res)
 
 
@@ -39,7 +58,7 @@ def test_table1_runs_three_cases_against_simulator(run):
     case2 = res["cases"][1]["objects"]
     assert case2[0]["type"] == "stick" and abs(case2[0]["truth_mm"][1] - 180) < 10
     assert abs(case2[2]["truth_mm"][1] - 180) < 15 and abs(case2[1]["truth_mm"][1]) < 5
-    assert (run / "run" / "table1.json").exists() and "Ground truth" in format_table1(res)
+    assert json.loads((run / "run" / "table1.json").read_text()) == res and "Ground truth" in format_table1(res)
 
 
 def test_symbols_counts_cover_all_objects_and_write_figures(run):
@@ -47,8 +66,10 @@ def test_symbols_counts_cover_all_objects_and_write_figures(run):
     assert sum(r["count"] for r in res["symbols"]) == res["n_objects"]
     assert 1 <= res["n_symbols_for_95pct"] <= res["n_distinct"] <= 256
     assert all(len(r["code"]) == 8 and 0.5 <= r["type_purity"] <= 1 for r in res["symbols"])
-    for f in ("symbols.json", "symbols.png", "symbol_examples.png"):
-        assert (run / "run" / f).stat().st_size > 0
+    assert json.loads((run / "run" / "symbols.json").read_text()) == json.loads(json.dumps(res))
+    for f in ("symbols.png", "symbol_examples.png"):
+        w, h = _png_size(run / "run" / f)
+        assert w >= 200 and h >= 200, (f, w, h)
     with pytest.raises(ValueError, match="8-bit string"):
         analyse_symbols(run / "run", run / "data", symbol="0101")
 

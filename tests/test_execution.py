@@ -259,7 +259,17 @@ def test_benchmark_writes_summary_and_rows(tmp_path, sim, run_dir, problems):
         s = saved["summary"][name]
         assert {"success_rate", "found_rate", "median_time_s", "mean_plan_length", "mean_generator_length",
                 "success_rate_closed_loop"} <= set(s)
-        assert 0.0 <= s["success_rate"] <= 1.0 and 0.0 <= s["found_rate"] <= 1.0
+        # the summary is the rows' aggregate: recompute it from the rows
+        open_rows = [r for r in saved["rows"] if r["planner"] == name and not r["closed_loop"]]
+        closed = [r for r in saved["rows"] if r["planner"] == name and r["closed_loop"]]
+        assert len(open_rows) == len(closed) == s["n_problems"] == 2
+        assert s["success_rate"] == pytest.approx(np.mean([r["success"] for r in open_rows]), abs=1e-4)
+        assert s["found_rate"] == pytest.approx(np.mean([r["found"] for r in open_rows]), abs=1e-4)
+        assert s["success_rate_closed_loop"] == pytest.approx(np.mean([r["success"] for r in closed]), abs=1e-4)
+        stages = [r["failure_stage"] for r in open_rows if r["failure_stage"]]
+        assert s["failure_stages"] == {st: stages.count(st) for st in set(stages)}
+        assert all((r["failure_stage"] is None) == r["success"] for r in saved["rows"])
+        assert all(r["plan_length"] is None or r["plan_length"] >= 0 for r in saved["rows"])
     assert {r["closed_loop"] for r in saved["rows"]} == {False, True}
     assert "astar-ucs" in bench.format_table(res)
 

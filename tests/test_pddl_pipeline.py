@@ -1,5 +1,6 @@
 """export-pddl on a real (tiny) run, PDDL planners in the benchmark registry, and the examples."""
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -7,30 +8,26 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import cli
 from pddl_export.pddl_writer import action_name, code_from_predicate, conditional_domain, object_name, problem_pddl
+from pddl_export.rules_io import load_rules, rules_from_json, rules_to_json
 from pddl_export.symbolic import N_ACTIONS
 from search.result import PlanResult, PlanStatus
-from symlearn.sim.collect import CollectConfig, collect
-from pddl_export.rules_io import load_rules, rules_from_json, rules_to_json
 from symlearn.planning.export import ExportConfig, export_pddl
 from symlearn.planning.planners import make_pddl_planner, network_agrees
-from symlearn.planning.problem_generation import generate_problems
-from symlearn.learning.training import TrainConfig, train
 from symlearn.symbolic.learned_transition import LearnedTransition
-from symlearn.symbolic.transition_model import TransitionConfig
-from symlearn.symbolic.transition_training import train_transition
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory):
+def run(tmp_path_factory, tiny_data, tiny_run):
+    """ROOT/data: the session's tiny data set; ROOT/run: a copy of the tiny run; ROOT/problems: two problems."""
     root = tmp_path_factory.mktemp("pddl_pipeline")
-    collect(root / "data", CollectConfig(n=48, seed=2, shard_size=4), show_progress=False)
-    train(root / "data", root / "run", TrainConfig.from_preset("quick", epochs=1, batch_size=8, bf16=False),
-          show_progress=False)
-    train_transition(root / "run", root / "data", TransitionConfig.from_preset("quick", epochs=2))
-    generate_problems(root / "problems", 2, objects=(1, 2), length=(1, 2), seed=0)
+    (root / "data").symlink_to(tiny_data.path, target_is_directory=True)
+    shutil.copytree(tiny_run.path, root / "run")
+    rc, _ = cli("problems", "--out", root / "problems", "--n", 2, "--objects", "1-2", "--length", "1-2", "--seed", 0)
+    assert rc == 0
     return root
 
 

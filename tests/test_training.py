@@ -2,11 +2,11 @@ import json
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 import torch
 
 from symlearn.learning.checkpoint import CheckpointError, load_checkpoint, load_effect_model, save_checkpoint
-from symlearn.sim.collect import CollectConfig, collect
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig
 from symlearn.learning.training import TrainConfig, TrainingError, train
 
@@ -14,10 +14,9 @@ TINY = dict(epochs=2, batch_size=8, bf16=False)
 
 
 @pytest.fixture(scope="module")
-def data(tmp_path_factory):
-    out = tmp_path_factory.mktemp("train_data") / "d"
-    collect(out, CollectConfig(n=48, seed=5, shard_size=4), show_progress=False)
-    return out
+def data(tiny_data):
+    """The session's tiny data set (48 samples)."""
+    return tiny_data.path
 
 
 def _weights(run):
@@ -31,7 +30,12 @@ def test_quick_training_writes_run_files(data, tmp_path):
     assert len(out["history"]) == 2
     m = json.loads((run / "metrics.json").read_text())
     assert set(m["history"][0]) >= {"train_loss", "val_loss", "val_mae_mm", "crops_per_s"}
-    assert (run / "best.pt").exists() and (run / "last.pt").exists()
+    # best.pt holds the epoch of the lowest validation loss, last.pt the last epoch, both with that history
+    val = [h["val_loss"] for h in m["history"]]
+    best = load_checkpoint(run / "best.pt")
+    assert best.epoch == int(np.argmin(val)) and best.best_val == pytest.approx(min(val), abs=1e-5)
+    assert m["best_val_loss"] == out["best_val_loss"] == pytest.approx(min(val), abs=1e-5)
+    assert [h["epoch"] for h in load_checkpoint(run / "last.pt").history] == [1, 2]
     cfg = json.loads((run / "config.json").read_text())
     assert cfg["train_config"]["preset"] == "quick" and "torch" in cfg["versions"] and cfg["data_fingerprint"]
     ck = load_checkpoint(run / "last.pt")
