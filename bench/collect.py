@@ -1,6 +1,6 @@
 """Collection speed: samples/s with 1 and 2 workers, against the original code's motion timing.
 
-The baseline is this same simulator run at the original code's timing (REFERENCE_NOTES.md:
+The baseline is this same simulator run at the original code's timing (docs/DESIGN.md, reference facts:
 1/240 s steps, pybullet's 50 solver iterations, about 1.5 s of arm motion per segment), measured
 in the same run, so the figures are ratios on one machine. Writes JSON.
 

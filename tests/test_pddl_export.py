@@ -245,7 +245,7 @@ def test_rule_and_ruleset_validation():
         Rule(0, 1, 2, at_least=((3, 3),), fewer_than=((3, 2),))
     ok = RuleSet(2, (1, 2, 3), 2, (Rule(0, 1, 2, forbids=(3,)), Rule(0, 1, 3, requires=(3,))), 2)
     assert ok.n_rules == 2 and ok.codes == (1, 2, 3)
-    with pytest.raises(ValueError, match="mutually exclusive"):  # the exactness pitfall of PDDL_NOTES
+    with pytest.raises(ValueError, match="mutually exclusive"):  # the exactness pitfall (docs/DESIGN.md)
         RuleSet(2, (1, 2, 3), 2, (Rule(0, 1, 2), Rule(0, 1, 3, requires=(3,))), 2)
     with pytest.raises(ValueError):
         RuleSet(2, (1, 2, 3), 2, (Rule(0, 1, 4),), 1)  # code 4 does not fit in 2 bits

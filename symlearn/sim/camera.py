@@ -18,7 +18,7 @@ import numpy as np
 
 @dataclass(frozen=True)
 class CameraConfig:
-    """An overhead depth camera; numbers from REFERENCE_NOTES.md (about 24 px per 10 cm)."""
+    """An overhead depth camera; numbers from docs/DESIGN.md, "Reference facts" (about 24 px per 10 cm)."""
 
     eye: tuple[float, float, float] = (1.2, 0.0, 1.6)
     target: tuple[float, float, float] = (0.8, 0.0, 0.4)

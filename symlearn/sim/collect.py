@@ -72,6 +72,47 @@ class CollectConfig:
         return json.loads(json.dumps(dataclasses.asdict(self)))
 
 
+def _empty_arrays(size: int, k: int, s: int) -> dict[str, np.ndarray]:
+    """Preallocated shard arrays for `size` samples of up to `k` objects with s x s crops (padding: zeros, type -1)."""
+    return {
+        "pre_depth": np.zeros((size, k, s, s), np.float16),
+        "post_depth": np.zeros((size, k, s, s), np.float16),
+        "pre_origin": np.zeros((size, k, 2), np.int16),
+        "post_origin": np.zeros((size, k, 2), np.int16),
+        "pre_pixels": np.zeros((size, k), np.int32),
+        "post_pixels": np.zeros((size, k), np.int32),
+        "action": np.zeros(size, np.int8),
+        "effect": np.zeros((size, k, 3), np.float32),
+        "n_objects": np.zeros(size, np.int8),
+        "obj_type": np.full((size, k), -1, np.int8),
+        "pre_pose": np.zeros((size, k, 7), np.float32),
+        "post_pose": np.zeros((size, k, 7), np.float32),
+        "grasped": np.zeros(size, np.int8),
+        "episode": np.zeros(size, np.int32),
+        "step": np.zeros(size, np.int16),
+    }
+
+
+def _record(a: dict[str, np.ndarray], i: int, pre, post, action, res, episode: int, step: int) -> None:
+    """Fill row i of the shard arrays from one step: observations before/after, the step result, its place."""
+    k = len(res.before.objects)
+    a["pre_depth"][i, :k] = pre.crops
+    a["post_depth"][i, :k] = post.crops
+    a["pre_origin"][i, :k] = pre.origins
+    a["post_origin"][i, :k] = post.origins
+    a["pre_pixels"][i, :k] = pre.pixels
+    a["post_pixels"][i, :k] = post.pixels
+    a["action"][i] = action.id
+    a["effect"][i, :k] = res.effect
+    a["n_objects"][i] = k
+    a["obj_type"][i, :k] = [int(o.type) for o in res.before.objects]
+    a["pre_pose"][i, :k] = [o.position + o.orientation for o in res.before.objects]
+    a["post_pose"][i, :k] = [o.position + o.orientation for o in res.after.objects]
+    a["grasped"][i] = res.grasped
+    a["episode"][i] = episode
+    a["step"][i] = step
+
+
 def collect_shard(cfg: CollectConfig, index: int, size: int,
                   progress: Callable[[int], None] | None = None,
                   max_failed_episodes: int = MAX_FAILED_EPISODES) -> dict[str, np.ndarray]:
@@ -79,40 +120,17 @@ def collect_shard(cfg: CollectConfig, index: int, size: int,
 
     An episode that records no sample (its first action drops an object off the table) is retried
     with a fresh scene, at most `max_failed_episodes` times in a row; then a CollectError says so.
-    Kept as one function (over 60 lines): half of it is the table of preallocated arrays, and the
-    episode loop fills them in place, row by row.
     """
     rng = np.random.default_rng([cfg.seed, index])
-    K, S = cfg.max_objects, cfg.sim.crop
-    a = {
-        "pre_depth": np.zeros((size, K, S, S), np.float16),
-        "post_depth": np.zeros((size, K, S, S), np.float16),
-        "pre_origin": np.zeros((size, K, 2), np.int16),
-        "post_origin": np.zeros((size, K, 2), np.int16),
-        "pre_pixels": np.zeros((size, K), np.int32),
-        "post_pixels": np.zeros((size, K), np.int32),
-        "action": np.zeros(size, np.int8),
-        "effect": np.zeros((size, K, 3), np.float32),
-        "n_objects": np.zeros(size, np.int8),
-        "obj_type": np.full((size, K), -1, np.int8),
-        "pre_pose": np.zeros((size, K, 7), np.float32),
-        "post_pose": np.zeros((size, K, 7), np.float32),
-        "grasped": np.zeros(size, np.int8),
-        "episode": np.zeros(size, np.int32),
-        "step": np.zeros(size, np.int16),
-    }
-    dropped = 0
-    episode = 0
-    failed_in_a_row = 0
-    i = 0
+    a = _empty_arrays(size, cfg.max_objects, cfg.sim.crop)
+    dropped = episode = failed_in_a_row = i = 0
     with TabletopSimulator(cfg.sim) as sim:
         while i < size:
             recorded_before = i
             spec = sample_scene_spec(rng, cfg.exploration)
             sim.build(spec)
-            k = len(spec)
             pre = sim.observe()
-            for t in range(cfg.exploration.episode_length(k)):
+            for t in range(cfg.exploration.episode_length(len(spec))):
                 if i == size:
                     break
                 action = sample_action(rng, sim.occupied(), cfg.exploration)
@@ -121,21 +139,7 @@ def collect_shard(cfg: CollectConfig, index: int, size: int,
                 if res.off_table:  # an object left the table: its crop and effect mean nothing
                     dropped += 1
                     break
-                a["pre_depth"][i, :k] = pre.crops
-                a["post_depth"][i, :k] = post.crops
-                a["pre_origin"][i, :k] = pre.origins
-                a["post_origin"][i, :k] = post.origins
-                a["pre_pixels"][i, :k] = pre.pixels
-                a["post_pixels"][i, :k] = post.pixels
-                a["action"][i] = action.id
-                a["effect"][i, :k] = res.effect
-                a["n_objects"][i] = k
-                a["obj_type"][i, :k] = [int(o.type) for o in res.before.objects]
-                a["pre_pose"][i, :k] = [o.position + o.orientation for o in res.before.objects]
-                a["post_pose"][i, :k] = [o.position + o.orientation for o in res.after.objects]
-                a["grasped"][i] = res.grasped
-                a["episode"][i] = episode
-                a["step"][i] = t
+                _record(a, i, pre, post, action, res, episode, t)
                 i += 1
                 pre = post
                 if progress:

@@ -1,6 +1,6 @@
 """The robot's exploration protocol: random initial scenes and random actions (no pybullet).
 
-Numbers follow REFERENCE_NOTES.md, which reproduce the paper's 28,607 objects in 10,000 samples:
+Numbers follow docs/DESIGN.md's reference facts, which reproduce the paper's 28,607 objects in 10,000 samples:
 1, 2, 3 objects with probability 0.1, 0.2, 0.7; episodes of 4, 8, 20 actions; the pick location
 is an occupied one with probability 0.8; the release location is uniform over all six.
 

@@ -83,7 +83,7 @@ class SimConfig:
     grasp_reach: float = 0.02  # suction takes hold within this distance of the surface
     release_gap: float = 0.004  # held object's bottom above the surface when released
     home: tuple[float, float, float] = (0.25, 0.0, 0.95)  # tool position out of the camera's view
-    # The UR10 stands on a pedestal level with the table: with its base at z = 0 (REFERENCE_NOTES)
+    # The UR10 stands on a pedestal level with the table: with its base at z = 0 (docs/DESIGN.md)
     # the tool cannot point down above the far row higher than 0.25 m over the table.
     robot_base: tuple[float, float, float] = (0.0, 0.0, TABLE_TOP_Z)
     friction: float = 1.0  # lateral friction of objects and table: objects ride on a carried stick
