@@ -167,3 +167,30 @@ def test_collect_shard_gives_up_after_failed_episodes(monkeypatch):
     monkeypatch.setattr("symlearn.sim.collect.TabletopSimulator", _DroppingSim)
     with pytest.raises(CollectError, match="shard 0: 5 episodes in a row recorded no sample"):
         collect_shard(CFG, 0, 2, max_failed_episodes=5)
+
+
+def test_authors_type_draw_matches_their_protocol():
+    """First k of a shuffled (stick, cube, cube): every 3-object scene has one stick, a third of objects are sticks."""
+    from symlearn.sim.exploration import sample_types
+    from symlearn.world import ObjectType
+    rng = np.random.default_rng(0)
+    cfg = ExplorationConfig()
+    assert cfg.type_draw == "authors"
+    three = [sample_types(rng, cfg, 3) for _ in range(300)]
+    assert all(t.count(ObjectType.STICK) == 1 for t in three)
+    two = np.mean([sample_types(rng, cfg, 2).count(ObjectType.STICK) for _ in range(3000)])
+    one = np.mean([sample_types(rng, cfg, 1)[0] == ObjectType.STICK for _ in range(3000)])
+    assert abs(two - 2 / 3) < 0.03 and abs(one - 1 / 3) < 0.03
+    five = [sample_types(rng, cfg, 5) for _ in range(100)]
+    assert all(t.count(ObjectType.STICK) == 1 for t in five)
+
+
+def test_independent_type_draw_allows_scenes_without_stick():
+    from symlearn.sim.exploration import sample_types
+    from symlearn.world import ObjectType
+    rng = np.random.default_rng(0)
+    cfg = ExplorationConfig(type_draw="independent")
+    counts = [sample_types(rng, cfg, 3).count(ObjectType.STICK) for _ in range(2000)]
+    assert max(counts) == 1 and 0.2 < np.mean(np.array(counts) == 0) < 0.35  # (1 - 0.35)^3 = 0.27
+    with pytest.raises(ValueError, match="type_draw"):
+        ExplorationConfig(type_draw="random")

@@ -60,10 +60,17 @@ def test_table1_case2_cube_on_stick_moves_too(effects):
     np.testing.assert_allclose(e[2], [0, 0.18, 0], atol=1.5 * CM)  # the cube on the stick
 
 
-def test_table1_case3_both_stacked_cubes_move_with_stick(effects):
-    e = effects["table1_case3"].effect
+@pytest.mark.parametrize("name", ["table1_case3", "table1_case3_stacked"])
+def test_table1_case3_both_cubes_ride_with_stick(effects, name):
+    """Paper's case 3 (a cube near each end) and the extra stacked variant: both cubes ride +180 mm."""
+    e = effects[name].effect
     np.testing.assert_allclose(e[0], [0, 0.18, 0], atol=1 * CM)
     assert np.all(np.abs(e[1:, 1] - 0.18) < 3 * CM), e
+
+
+def test_table1_case3_cubes_stand_near_opposite_ends():
+    spec = SCENARIO_BY_NAME["table1_case3"].spec
+    assert [loc for _, loc in spec] == [1, 0, 2]  # stick centred at far-middle, cubes at its two neighbours
 
 
 def test_scenarios_are_deterministic(sim, effects):

@@ -1,8 +1,10 @@
 """The robot's exploration protocol: random initial scenes and random actions (no pybullet).
 
-Numbers follow docs/DESIGN.md's reference facts, which reproduce the paper's 28,607 objects in 10,000 samples:
-1, 2, 3 objects with probability 0.1, 0.2, 0.7; episodes of 4, 8, 20 actions; the pick location
-is an occupied one with probability 0.8; the release location is uniform over all six.
+The authors' protocol (docs/DESIGN.md, reference facts), which reproduces the paper's 28,607 objects in 10,000
+samples: 1, 2, 3 objects with probability 0.1, 0.2, 0.7; episodes of 4, 8, 20 actions; object
+types the first k of a random permutation of (stick, cube, cube), so every 3-object scene holds
+exactly one stick; the pick location is an occupied one with probability 0.8; the release
+location is uniform over all six.
 
     >>> cfg = ExplorationConfig()
     >>> rng = np.random.default_rng(0)
@@ -19,6 +21,7 @@ import numpy as np
 from symlearn.world import N_LOCATIONS, NEAR_ROW, Action, ObjectType
 
 MAX_OBJECTS = 5  # scenes larger than this are not supported (crops, padding, planners)
+TYPE_DRAWS = ("authors", "independent")
 
 
 @dataclass(frozen=True)
@@ -28,7 +31,12 @@ class ExplorationConfig:
     k_values: tuple[int, ...] = (1, 2, 3)  # numbers of objects a scene may hold
     k_probs: tuple[float, ...] = (0.1, 0.2, 0.7)  # the paper's mix gives about 2.86 objects/sample
     episode_lengths: tuple[int, ...] = (4, 8, 20)  # actions per scene, by k (last one for larger k)
-    stick_prob: float = 0.35  # chance that an object is a stick, while the scene has none yet
+    # "authors": the first k of a shuffled (stick, cube, cube) (one stick in every scene of 3 or more
+    # objects, a third of all objects sticks; 4-5 object scenes add cubes to the pool);
+    # "independent": each object a stick with probability stick_prob while none is present (this
+    # toolkit's protocol before 2026-11-28: 24.6% sticks, 27.5% of 3-object scenes without one)
+    type_draw: str = "authors"
+    stick_prob: float = 0.35  # used by type_draw="independent" only
     pick_occupied_prob: float = 0.8  # else the pick location is uniform over all six
 
     def __post_init__(self) -> None:
@@ -39,6 +47,8 @@ class ExplorationConfig:
                 raise ValueError(f"number of objects k={k!r} is out of range 1..{MAX_OBJECTS}")
         if abs(sum(self.k_probs) - 1.0) > 1e-6 or min(self.k_probs) < 0:
             raise ValueError(f"k_probs {self.k_probs} must be non-negative and sum to 1")
+        if self.type_draw not in TYPE_DRAWS:
+            raise ValueError(f"type_draw={self.type_draw!r}: expected one of {', '.join(TYPE_DRAWS)}")
         if not 0.0 <= self.stick_prob <= 1.0 or not 0.0 <= self.pick_occupied_prob <= 1.0:
             raise ValueError("stick_prob and pick_occupied_prob must lie in [0, 1]")
 
@@ -46,31 +56,38 @@ class ExplorationConfig:
         return self.episode_lengths[min(k, len(self.episode_lengths)) - 1]
 
     @staticmethod
-    def with_k_range(lo: int, hi: int) -> "ExplorationConfig":
+    def with_k_range(lo: int, hi: int, type_draw: str = "authors") -> "ExplorationConfig":
         """Uniform over lo..hi objects (e.g. 4-5 for generalization scenes)."""
         ks = tuple(range(lo, hi + 1))
         if not ks:
             raise ValueError(f"empty object range {lo}-{hi}")
-        return ExplorationConfig(k_values=ks, k_probs=tuple([1.0 / len(ks)] * len(ks)))
+        return ExplorationConfig(k_values=ks, k_probs=tuple([1.0 / len(ks)] * len(ks)), type_draw=type_draw)
+
+
+def sample_types(rng: np.random.Generator, cfg: ExplorationConfig, k: int) -> list[ObjectType]:
+    """Types of a k-object scene, drawn as `cfg.type_draw` says (see ExplorationConfig)."""
+    if cfg.type_draw == "authors":
+        pool = [ObjectType.STICK] + [ObjectType.CUBE] * (max(k, 3) - 1)
+        return [pool[i] for i in rng.permutation(len(pool))[:k]]
+    types, has_stick = [], False
+    for _ in range(k):
+        is_stick = (not has_stick) and rng.random() < cfg.stick_prob
+        has_stick |= is_stick
+        types.append(ObjectType.STICK if is_stick else ObjectType.CUBE)
+    return types
 
 
 def sample_scene_spec(rng: np.random.Generator, cfg: ExplorationConfig,
                       k: int | None = None) -> list[tuple[ObjectType, int]]:
     """Objects to drop, in order: (type, near-row location). Distinct locations while they last,
-    then stacked on a random near-row location; at most one stick."""
+    then stacked on a random near-row location; at most one stick (types by `sample_types`)."""
     if k is None:
         k = int(rng.choice(cfg.k_values, p=cfg.k_probs))
     if not 1 <= k <= MAX_OBJECTS:
         raise ValueError(f"number of objects k={k} is out of range 1..{MAX_OBJECTS}")
     locs = list(rng.permutation(NEAR_ROW))
-    spec = []
-    has_stick = False
-    for i in range(k):
-        is_stick = (not has_stick) and rng.random() < cfg.stick_prob
-        has_stick |= is_stick
-        loc = int(locs[i]) if i < len(locs) else int(rng.choice(NEAR_ROW))
-        spec.append((ObjectType.STICK if is_stick else ObjectType.CUBE, loc))
-    return spec
+    types = sample_types(rng, cfg, k)
+    return [(t, int(locs[i]) if i < len(locs) else int(rng.choice(NEAR_ROW))) for i, t in enumerate(types)]
 
 
 def sample_action(rng: np.random.Generator, occupied: np.ndarray, cfg: ExplorationConfig) -> Action:

@@ -55,8 +55,10 @@ SCENARIOS: tuple[Scenario, ...] = (
              ((S, 1), (C, 3), (C, 5)), Action(1, 2)),
     Scenario("table1_case2", "stick moved one location right; one cube on its left end",
              ((S, 1), (C, 3), (C, 0)), Action(1, 2)),
-    Scenario("table1_case3", "stick moved one location right; two cubes stacked on its left end",
-             ((S, 1), (C, 0), (C, 0)), Action(1, 2)),
+    Scenario("table1_case3", "stick moved one location right; two cubes on it, one near each end",
+             ((S, 1), (C, 0), (C, 2)), Action(1, 2)),
+    Scenario("table1_case3_stacked", "stick moved one location right; two cubes stacked on its left end "
+             "(an extra case, not in the paper)", ((S, 1), (C, 0), (C, 0)), Action(1, 2)),
 )
 SCENARIO_BY_NAME = {s.name: s for s in SCENARIOS}
 

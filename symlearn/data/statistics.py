@@ -1,0 +1,57 @@
+"""What a data set holds beyond effect sizes: shares of sticks, stacked objects and riders.
+
+A *rider* is an object that was not held and still moved at least `RIDE_MIN_M` horizontally
+while another object was carried: it stood on the carried object (Table I's cubes on a moved
+stick). Objects knocked over by a released one count too; in this protocol that is rare. A
+*stacked* object starts at least `STACK_MIN_M` above its resting height on the table, i.e.
+on another object. Both are computed from poses, which the models never see.
+
+    >>> shares = object_shares(load_split(Path("data/paper"), "all"))   # doctest: +SKIP
+    >>> shares["stick_share"]                                           # doctest: +SKIP
+    0.333
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from symlearn.data.dataset import InteractionData
+from symlearn.world import OBJECT_SIZE, TABLE_TOP_Z, ObjectType
+
+RIDE_MIN_M = 0.05  # a rider moves with the carried object: 5 cm is far above settling jitter (< 1 cm)
+STACK_MIN_M = 0.02  # an object on another one starts at least its support's height (>= 5 cm) higher
+
+
+def rider_mask(data: InteractionData) -> np.ndarray:
+    """(N, K) bool: real objects that moved >= 5 cm horizontally while another object was held."""
+    k = data.effect.shape[1]
+    held = data.grasped[:, None] == np.arange(k)[None, :]
+    moved = np.linalg.norm(data.effect[..., :2], axis=-1) >= RIDE_MIN_M
+    return data.mask & ~held & moved & (data.grasped[:, None] >= 0)
+
+
+def stacked_mask(data: InteractionData) -> np.ndarray:
+    """(N, K) bool: real objects that start on top of another object rather than on the table."""
+    rest = np.full(data.obj_type.shape, np.inf, np.float32)
+    for t in ObjectType:
+        rest[data.obj_type == t] = TABLE_TOP_Z + OBJECT_SIZE[t][2] / 2
+    return data.mask & (data.pre_pose[..., 2] - rest >= STACK_MIN_M)
+
+
+def object_shares(data: InteractionData) -> dict:
+    """Counts and shares of sticks, stacked objects and riders, and how many scenes of each size hold a stick."""
+    mask = data.mask
+    n_obj = int(mask.sum())
+    sticks = mask & (data.obj_type == ObjectType.STICK)
+    riders, stacked = rider_mask(data), stacked_mask(data)
+    with_stick = {}
+    for k in np.unique(data.n_objects):
+        rows = data.n_objects == k
+        with_stick[str(int(k))] = round(float(sticks[rows].any(axis=1).mean()), 3)
+    share = lambda m: round(float(m.sum() / max(n_obj, 1)), 4)  # noqa: E731
+    return {"objects": n_obj, "sticks": int(sticks.sum()), "stick_share": share(sticks),
+            "stacked": int(stacked.sum()), "stacked_share": share(stacked),
+            "riders": int(riders.sum()), "rider_share": share(riders),
+            "riders_on_stick": int((riders & (data.obj_type == ObjectType.CUBE)
+                                    & (data.obj_type[np.arange(len(data)), np.maximum(data.grasped, 0)]
+                                       == ObjectType.STICK)[:, None]).sum()),
+            "scenes_with_stick_by_objects": with_stick}
