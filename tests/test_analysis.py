@@ -8,6 +8,7 @@ import pytest
 from symlearn.learning.evaluation import evaluate, format_table
 from symlearn.symbolic.symbols import analyse_symbols, picked_objects
 from symlearn.data.dataset import load_split
+from symlearn.data.statistics import rider_mask
 from symlearn.learning.table1 import CASES, format_table1, table1
 from conftest import TINY_TRAIN_ARGS, cli_json
 
@@ -49,6 +50,15 @@ def test_evaluate_writes_rows_with_ablations(run):
             by = sum(counts[k] * row["by_objects"][k][a] for k in counts) / sum(counts.values())
             assert row["effect_mae_mm"][a] == pytest.approx(by, abs=0.02) and row["effect_mae_mm"][a] > 0
     assert res["effect_mae_mm"] != res["ablations"]["no_attention"]["effect_mae_mm"]  # two different models
+    # rider rows: the count is the rider mask's, and the mean-effect row's rider error is recomputed here
+    riders = rider_mask(te)
+    assert res["riders"]["count"] == int(riders.sum())
+    if riders.any():
+        want = np.abs(tr.effect[tr.mask].astype(np.float64).mean(0) - te.effect[riders]).mean(0) * 1000
+        got = res["ablations"]["mean_effect"]["riders"]["effect_mae_mm"]
+        np.testing.assert_allclose([got[a] for a in "xyz"], want, atol=0.02)
+    else:
+        assert res["riders"]["effect_mae_mm"] is None
     assert "attentive" in format_table(res) and "mean_effect" in format_table(res)
 
 

@@ -2,7 +2,9 @@
 
 Rows: the trained run, optionally a no-attention run (DeepSym-style), and the mean-effect
 predictor (the training set's mean effect for every object). Errors are mean absolute errors per
-axis in millimetres over real objects, overall and by number of objects in the scene.
+axis in millimetres over real objects, overall, by number of objects in the scene, and on riders
+(objects that moved because they stood on a carried one; `symlearn.data.statistics.rider_mask`),
+the relational effect the attention is for.
 """
 from __future__ import annotations
 
@@ -12,21 +14,23 @@ import numpy as np
 import torch
 
 from symlearn.data.dataset import data_fingerprint, load_split
+from symlearn.data.statistics import rider_mask
 from symlearn.learning.checkpoint import effect_model_sha256, load_effect_model, stage_record
 from symlearn.provenance import atomic_write_json
 from symlearn.learning.training import predict_effects, to_tensors
 
 
-def _mae_rows(pred_m: np.ndarray, true_m: np.ndarray, mask: np.ndarray, n_objects: np.ndarray) -> dict:
-    """MAE in mm per axis overall and by scene size; inputs in metres."""
+def _mae_rows(pred_m: np.ndarray, true_m: np.ndarray, mask: np.ndarray, n_objects: np.ndarray,
+              riders: np.ndarray) -> dict:
+    """MAE in mm per axis overall, by scene size and on riders ((N, K) bool); inputs in metres."""
     err = np.abs(pred_m - true_m) * 1000
 
-    def row(sel):
-        m = mask & sel[:, None]
+    def mae(m):
         return dict(zip("xyz", np.round(err[m].mean(0), 2).tolist())) if m.any() else None
 
-    out = {"effect_mae_mm": row(np.ones(len(mask), bool))}
-    out["by_objects"] = {str(k): row(n_objects == k) for k in sorted(set(n_objects.tolist()))}
+    out = {"effect_mae_mm": mae(mask)}
+    out["by_objects"] = {str(k): mae(mask & (n_objects == k)[:, None]) for k in sorted(set(n_objects.tolist()))}
+    out["riders"] = {"count": int(riders.sum()), "effect_mae_mm": mae(riders)}
     return out
 
 
@@ -38,7 +42,7 @@ def evaluate(run_dir: Path, data_dir: Path, baseline_run: Path | None = None) ->
     mean, std = ck.effect_mean, ck.effect_std
     t = to_tensors(test, mean, std)
     truth = test.effect
-    mask, nobj = test.mask, test.n_objects.astype(int)
+    mask, nobj, riders = test.mask, test.n_objects.astype(int), rider_mask(test)
 
     def denorm(p: torch.Tensor) -> np.ndarray:
         return p.numpy() * std + mean
@@ -51,15 +55,15 @@ def evaluate(run_dir: Path, data_dir: Path, baseline_run: Path | None = None) ->
               "mean_abs_effect_by_objects_mm": {
                   str(k): dict(zip("xyz", np.round(np.abs(truth[mask & (nobj == k)[:, None]]).mean(0) * 1000, 2).tolist()))
                   for k in sorted(set(nobj.tolist()))}}
-    result.update(_mae_rows(denorm(predict_effects(model, t)), truth, mask, nobj))
+    result.update(_mae_rows(denorm(predict_effects(model, t)), truth, mask, nobj, riders))
     ablations = {}
     if baseline_run is not None:
         base, bck = load_effect_model(Path(baseline_run))
         tb = to_tensors(test, bck.effect_mean, bck.effect_std)
         pb_ = predict_effects(base, tb).numpy() * bck.effect_std + bck.effect_mean
         ablations["no_attention"] = {"run": str(baseline_run), "effect_model_sha256": effect_model_sha256(baseline_run),
-                                     **_mae_rows(pb_, truth, mask, nobj)}
-    ablations["mean_effect"] = _mae_rows(np.broadcast_to(mean, truth.shape), truth, mask, nobj)
+                                     **_mae_rows(pb_, truth, mask, nobj, riders)}
+    ablations["mean_effect"] = _mae_rows(np.broadcast_to(mean, truth.shape), truth, mask, nobj, riders)
     result["ablations"] = ablations
     atomic_write_json(run_dir / "eval.json", result)
     return result
@@ -68,14 +72,18 @@ def evaluate(run_dir: Path, data_dir: Path, baseline_run: Path | None = None) ->
 def format_table(result: dict) -> str:
     """The evaluation as a text table: one row per model, x/y/z MAE in mm, overall and by scene size."""
     sizes = sorted(result["by_objects"])
-    head = f"{'model':<16}{'x':>8}{'y':>8}{'z':>8}" + "".join(f"   k={k} (x, y, z)" for k in sizes)
+    n_riders = result.get("riders", {}).get("count", 0)
+    head = (f"{'model':<16}{'x':>8}{'y':>8}{'z':>8}" + "".join(f"   k={k} (x, y, z)" for k in sizes)
+            + f"   riders, {n_riders} (x, y, z)")
     lines = [head, "-" * len(head)]
 
     def fmt(name, rows):
         o = rows["effect_mae_mm"]
         by = "".join(f"   {rows['by_objects'][k]['x']:5.1f} {rows['by_objects'][k]['y']:5.1f} {rows['by_objects'][k]['z']:5.1f}"
                      if rows["by_objects"].get(k) else "   -" for k in sizes)
-        return f"{name:<16}{o['x']:8.1f}{o['y']:8.1f}{o['z']:8.1f}{by}"
+        r = (rows.get("riders") or {}).get("effect_mae_mm")
+        rid = f"   {r['x']:5.1f} {r['y']:5.1f} {r['z']:5.1f}" if r else "   -"
+        return f"{name:<16}{o['x']:8.1f}{o['y']:8.1f}{o['z']:8.1f}{by}{rid}"
 
     lines.append(fmt("attentive", result))
     for name, rows in result["ablations"].items():
