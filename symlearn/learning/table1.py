@@ -17,6 +17,41 @@ from symlearn.provenance import atomic_write_json
 from symlearn.sim.scenarios import SCENARIO_BY_NAME
 
 CASES = ("table1_case1", "table1_case2", "table1_case3")
+# The paper's Table I (mm), objects in our scenario order (stick, first cube, second cube); the paper's columns are
+# green cube, orange stick, red cube, and its green / red cubes are our first / second cube.
+PAPER_TABLE1 = {
+    "predicted_mm": [[(-2, 192, -2), (3, 6, -2), (4, -9, -1)],
+                     [(-17, 196, 1), (3, 8, 0), (-10, 180, -5)],
+                     [(4, 159, 8), (-3, 210, -45), (-30, 131, -20)]],
+    "truth_mm": [[(0, 180, 0), (0, 0, 0), (0, 0, 0)],
+                 [(0, 180, 0), (0, 0, 0), (-1, 176, 0)],
+                 [(3, 180, 0), (102, 177, -75), (2, 176, 0)]],
+}
+MOVED_MM = 100  # an object "moved" if it went at least this far along y
+STILL_MM = 20  # and "stayed" if its predicted displacement is within this of zero
+RIDER_TOL_MM = 50  # a rider's predicted y within this of the truth
+
+
+def judge_object(obj: dict) -> dict:
+    """The Table I criteria for one object: motion right (moved >= 100 mm in y, or within 20 mm of still),
+    and for a cube that rides, predicted y within 50 mm of the truth."""
+    pred, truth = np.asarray(obj["predicted_mm"]), np.asarray(obj["truth_mm"])
+    moved = abs(truth[1]) >= MOVED_MM
+    motion_ok = bool(np.sign(pred[1]) == np.sign(truth[1]) and abs(pred[1]) >= MOVED_MM) if moved \
+        else bool(np.linalg.norm(pred) <= STILL_MM)
+    out = {"moved": bool(moved), "motion_right": motion_ok}
+    if moved and obj["type"] != "stick":
+        out["rider_y_within_50mm"] = bool(abs(pred[1] - truth[1]) <= RIDER_TOL_MM)
+    return out
+
+
+def summarize_criteria(cases: list[dict]) -> dict:
+    """Whether every object's motion is right and every rider's y is within tolerance, over all cases."""
+    judged = [o["criteria"] for c in cases for o in c["objects"]]
+    riders = [j["rider_y_within_50mm"] for j in judged if "rider_y_within_50mm" in j]
+    return {"motion_right": all(j["motion_right"] for j in judged),
+            "objects_motion_right": f"{sum(j['motion_right'] for j in judged)}/{len(judged)}",
+            "riders_within_50mm": all(riders), "riders_right": f"{sum(riders)}/{len(riders)}"}
 
 
 @torch.no_grad()
@@ -48,20 +83,33 @@ def table1(run_dir: Path) -> dict:
                                       "predicted_mm": [round(float(v) * 1000, 1) for v in p],
                                       "truth_mm": [round(float(v) * 1000, 1) for v in g]}
                                      for t, p, g in zip(sim.types, pred, res.effect)]})
+            for obj in rows[-1]["objects"]:
+                obj["criteria"] = judge_object(obj)
     errors = np.array([[abs(a - b) for a, b in zip(o["predicted_mm"], o["truth_mm"])] for r in rows for o in r["objects"]])
     out = {"run": str(run_dir), **stage_record(Path(run_dir), ck, {"run": str(run_dir), "cases": list(CASES)}),
-           "cases": rows, "mean_abs_error_mm": dict(zip("xyz", np.round(errors.mean(0), 1).tolist()))}
+           "cases": rows, "mean_abs_error_mm": dict(zip("xyz", np.round(errors.mean(0), 1).tolist())),
+           "criteria": summarize_criteria(rows), "paper": PAPER_TABLE1}
     atomic_write_json(Path(run_dir) / "table1.json", out)
     return out
 
 
 def format_table1(result: dict) -> str:
-    """Predictions, then ground truth, one line per case, as in the paper."""
+    """The paper's layout (first cube, stick, second cube): our predictions and the truth, each next to the
+    paper's, then whether the motion and rider criteria hold."""
     fmt = lambda v: "(" + ", ".join(f"{x:.0f}" for x in v) + ")"  # noqa: E731
-    types = [o["type"] for o in result["cases"][0]["objects"]]
-    lines = [f"{'':8}" + "".join(f"{t:>22}" for t in types)]
+    order = (1, 0, 2)  # the paper's columns: green cube, orange stick, red cube
+    lines = [f"{'':9}" + "".join(f"{name:>34}" for name in ("first cube (green)", "stick (orange)", "second cube (red)")),
+             f"{'':9}" + f"{'ours':>18}{'paper':>16}" * 3]
     for key, title in (("predicted_mm", "Predictions"), ("truth_mm", "Ground truth")):
         lines.append(title)
-        for i, r in enumerate(result["cases"], 1):
-            lines.append(f"Case {i}  " + "".join(f"{fmt(o[key]):>22}" for o in r["objects"]))
+        for i, r in enumerate(result["cases"]):
+            paper = PAPER_TABLE1[key][i]
+            lines.append(f"Case {i + 1}   " + "".join(f"{fmt(r['objects'][j][key]):>18}{fmt(paper[j]):>16}"
+                                                    for j in order))
+    c = result.get("criteria")
+    if c:
+        lines.append(f"motion right (moved >= {MOVED_MM} mm in y, or within {STILL_MM} mm of still): "
+                     f"{c['objects_motion_right']} objects, {'met' if c['motion_right'] else 'not met'}; "
+                     f"riders within {RIDER_TOL_MM} mm in y: {c['riders_right']}, "
+                     f"{'met' if c['riders_within_50mm'] else 'not met'}")
     return "\n".join(lines)
