@@ -8,6 +8,10 @@ ValueError / RuntimeError with one-line messages, which the main CLI prints.
     symlearn problems --out problems/p13 --n 50 --objects 1-3 --length 1-4 --seed 0
     symlearn plan --run runs/paper --problem problems/p13/problem_0000.json --planner astar --closed-loop
     symlearn benchmark --run runs/paper --problems problems/p13 --planners astar,astar-ucs --out bench.json
+
+`problems` records its settings in OUT/problems.manifest: the same command again completes an
+interrupted set, other settings are refused unless --overwrite. `benchmark` appends every finished
+row to OUT.rows.jsonl: the same command again after a kill resumes there (other settings are refused).
 """
 from __future__ import annotations
 
