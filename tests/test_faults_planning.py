@@ -191,7 +191,8 @@ def test_problems_into_a_folder_of_other_settings_is_refused(sim, tmp_path):
         assert _contents(out) == first  # nothing replaced, nothing mixed
     generate_problems(out, 2, objects=(1, 1), length=(1, 1), seed=0, sim=sim)  # same settings: idempotent
     assert _contents(out) == first
-    (out / "problem_0001.json").unlink()  # an interrupted generation: resumed, the same problem again
+    (out / "problem_0001.json").unlink()  # an interrupted (killed) generation: resumed, the same problem again
+    (out / ".problem_0001.json.abc123.tmp").write_text('{"half')
     generate_problems(out, 2, objects=(1, 1), length=(1, 1), seed=0, sim=sim)
     assert _contents(out) == first
 

@@ -142,6 +142,9 @@ def prepare_problem_dir(out_dir: Path, settings: dict, overwrite: bool = False) 
             raise ValueError(f"{out_dir} already holds problems of other settings ({diff}); "
                              f"use --overwrite to replace them, or another --out")
     out_dir.mkdir(parents=True, exist_ok=True)
+    for f in _own_files(out_dir):  # temp files of a killed run of the same set
+        if f.name.endswith(".tmp"):
+            f.unlink()
     atomic_write_json(manifest, settings)
 
 
