@@ -8,15 +8,54 @@ ValueError / RuntimeError with one-line messages, which the main CLI prints.
     symlearn problems --out problems/p13 --n 50 --objects 1-3 --length 1-4 --seed 0
     symlearn plan --run runs/paper --problem problems/p13/problem_0000.json --planner astar --closed-loop
     symlearn benchmark --run runs/paper --problems problems/p13 --planners astar,astar-ucs --out bench.json
+
+`problems` records its settings in OUT/problems.manifest: the same command again completes an
+interrupted set, other settings are refused unless --overwrite. `benchmark` appends every finished
+row to OUT.rows.jsonl: the same command again after a kill resumes there (other settings are refused).
 """
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
 from symlearn.cli.args import int_range, planner_list
+
+
+MAX_TIMEOUT_S = 86_400.0  # one day: larger values are typos, and the SAS+ planners need a finite limit
+
+
+def timeout_seconds(text: str) -> float:
+    """argparse type: a finite number of seconds in (0, MAX_TIMEOUT_S]; inf, nan, 0 and negatives are refused."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"timeout {text!r} is not a number of seconds") from None
+    if not (math.isfinite(v) and 0 < v <= MAX_TIMEOUT_S):
+        raise argparse.ArgumentTypeError(f"timeout {text!r} must be a finite number of seconds in (0, {MAX_TIMEOUT_S:g}]")
+    return v
+
+
+def _int_at_least(text: str, least: int) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if v < least:
+        raise argparse.ArgumentTypeError(f"{text!r} must be at least {least}")
+    return v
+
+
+def positive_int(text: str) -> int:
+    """argparse type: an integer >= 1."""
+    return _int_at_least(text, 1)
+
+
+def non_negative_int(text: str) -> int:
+    """argparse type: an integer >= 0."""
+    return _int_at_least(text, 0)
 
 
 def cmd_train_transition(args: argparse.Namespace) -> int:
@@ -41,7 +80,8 @@ def cmd_problems(args: argparse.Namespace) -> int:
 
     print(f"problems: {args.n} problems, objects {args.objects[0]}-{args.objects[1]}, length "
           f"{args.length[0]}-{args.length[1]}, seed {args.seed} -> {args.out}", file=sys.stderr)
-    paths = generate_problems(Path(args.out), args.n, objects=args.objects, length=args.length, seed=args.seed)
+    paths = generate_problems(Path(args.out), args.n, objects=args.objects, length=args.length, seed=args.seed,
+                              overwrite=args.overwrite)
     print(f"wrote {len(paths)} problems to {args.out}")
     return 0
 
@@ -50,12 +90,13 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from symlearn.learning.checkpoint import load_effect_model
     from symlearn.planning.execution import ExecutionConfig, run_problem
     from symlearn.planning.planners import make_planners
+    from symlearn.planning.paths import path_under
     from symlearn.planning.problem import load_problem
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.learned_transition import LearnedTransition
 
     problem = load_problem(Path(args.problem))
-    write_dir = Path(args.run) / "pddl" / "problems" / problem.name
+    write_dir = path_under(Path(args.run) / "pddl" / "problems", problem.name)  # the name is checked at load
     fn = make_planners([args.planner], Path(args.run), write_dir=write_dir)[args.planner]
     encoder, _ = load_effect_model(Path(args.run))
     transition = LearnedTransition.from_run(Path(args.run))
@@ -99,18 +140,22 @@ def add_problems_command(sub) -> None:
     """Add `problems` to the CLI's sub-parsers."""
     p = sub.add_parser("problems", help="generate planning problems (initial scene, goal scene) in the simulator")
     p.add_argument("--out", required=True, help="directory for the problem JSON files")
-    p.add_argument("--n", type=int, default=20, help="number of problems")
+    p.add_argument("--n", type=positive_int, default=20, help="number of problems")
     p.add_argument("--objects", type=int_range, default=(1, 3), help="objects per scene, e.g. 1-3 or 4-5")
     p.add_argument("--length", type=int_range, default=(1, 4), help="generator actions per problem, e.g. 1-4")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=non_negative_int, default=0)
+    p.add_argument("--overwrite", action="store_true",
+                   help="remove the problem files already in --out first (without it, a folder holding problems "
+                        "of other settings is refused; one of the same settings is completed)")
     p.set_defaults(func=cmd_problems)
 
 
 def _add_execution_flags(c: argparse.ArgumentParser) -> None:
     """The execution flags `plan` and `benchmark` share."""
     c.add_argument("--closed-loop", action="store_true", help="replan when the scene departs from the prediction")
-    c.add_argument("--max-replans", type=int, default=3)
-    c.add_argument("--timeout", type=float, default=30.0, help="seconds per planner call")
+    c.add_argument("--max-replans", type=non_negative_int, default=3)
+    c.add_argument("--timeout", type=timeout_seconds, default=30.0,
+                   help=f"seconds per planner call, finite and in (0, {MAX_TIMEOUT_S:g}]")
 
 
 def add_plan_command(sub) -> None:

@@ -10,13 +10,17 @@ ones for the run and refuses unknown names before any work.
 """
 from __future__ import annotations
 
+import json
+import math
+import os
 import statistics
 import time
 from pathlib import Path
 
+from pddl_export.rules_io import PDDL_DIR, RULES_FILE
 from symlearn.planning.execution import ExecutionConfig, ProblemRun, run_problem
 from symlearn.planning.planners import make_planners
-from symlearn.provenance import atomic_write_json, sha256_bytes, versions
+from symlearn.provenance import atomic_write_json, atomic_write_text, sha256_bytes, sha256_file, versions
 
 
 def _rate(rows: list[ProblemRun], key: str) -> float | None:
@@ -59,48 +63,164 @@ def summarize_rows(rows: list[ProblemRun]) -> dict:
     return out
 
 
+ROWS_FORMAT = "symlearn-benchmark-rows"
+ROWS_VERSION = 1
+
+
+def rows_path(out_file: Path) -> Path:
+    """The JSON-lines log of finished rows beside a benchmark's output: OUT.rows.jsonl."""
+    out_file = Path(out_file)
+    return out_file.with_name(out_file.name + ".rows.jsonl")
+
+
+def strict_json(obj):
+    """obj with every non-finite float (NaN, infinities: undefined metrics) replaced by None, for strict JSON."""
+    if isinstance(obj, dict):
+        return {k: strict_json(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [strict_json(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+class RowLog:
+    """Finished rows, one JSON line each, appended and fsynced as they finish; its first line holds the settings.
+
+    Reopening a log of the same settings returns the rows already finished (a torn last line, from a
+    kill during a write, is cut off); a log of other settings is refused, so runs are never mixed.
+    """
+
+    def __init__(self, path: Path, settings: dict) -> None:
+        self.path, self.settings = Path(path), strict_json(settings)
+        self.done: dict[tuple, dict] = {}
+        self._file = None
+
+    def open(self) -> dict[tuple, dict]:
+        """Read (or create) the log; returns key -> finished row JSON."""
+        if not self.path.exists():
+            atomic_write_text(self.path, _line({"format": ROWS_FORMAT, "version": ROWS_VERSION,
+                                                "settings": self.settings}))
+        data = self.path.read_bytes()
+        whole = data[:data.rfind(b"\n") + 1]
+        lines = whole.decode("utf-8", errors="replace").splitlines()
+        try:
+            head, entries = json.loads(lines[0]), [json.loads(x) for x in lines[1:]]
+        except (json.JSONDecodeError, IndexError) as e:
+            raise ValueError(f"{self.path}: not a benchmark row log ({e}); delete it to start over") from None
+        if not isinstance(head, dict) or head.get("format") != ROWS_FORMAT:
+            raise ValueError(f"{self.path}: not a benchmark row log; delete it to start over")
+        if head.get("settings") != self.settings:
+            diff = sorted(k for k in set(self.settings) | set(head.get("settings") or {})
+                          if (head.get("settings") or {}).get(k) != self.settings.get(k))
+            raise ValueError(f"{self.path} holds a partial benchmark with other settings (differing: "
+                             f"{', '.join(diff)}); re-run with the same settings to resume, or delete it")
+        if len(whole) != len(data):
+            with open(self.path, "r+b") as f:  # a row torn by a kill: cut it off
+                f.truncate(len(whole))
+        self.done = {tuple(e["key"]): e["row"] for e in entries}
+        self._file = open(self.path, "a", encoding="utf-8")
+        return self.done
+
+    def append(self, key: tuple, row: dict) -> None:
+        """Record one finished row durably (flush and fsync before returning)."""
+        self._file.write(_line({"key": list(key), "row": row}))
+        self._file.flush()
+        os.fsync(self._file.fileno())
+        self.done[key] = row
+
+    def close(self) -> None:
+        """Close the log file (it stays on disk)."""
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+
+def _line(obj) -> str:
+    return json.dumps(strict_json(obj), allow_nan=False, separators=(",", ":")) + "\n"
+
+
+def _settings(run_dir: Path, problems_dir: Path, problems: list, planners: list[str], closed_loop: bool,
+              timeout_s: float, max_replans: int) -> dict:
+    """What a benchmark's result depends on: a partial run resumes only under the very same settings."""
+    from symlearn.planning.planners import planner_spec
+    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
+
+    rules = run_dir / PDDL_DIR / RULES_FILE
+    needs_rules = any(planner_spec(n).needs_rules for n in planners)
+    return {"run": str(run_dir.resolve()), "problems": str(problems_dir.resolve()), "planners": list(planners),
+            "closed_loop": closed_loop, "timeout_s": timeout_s, "max_replans": max_replans,
+            "transition_sha256": sha256_file(run_dir / TRANSITION_FILE)[:16],
+            "rules_sha256": sha256_file(rules)[:16] if needs_rules else None,
+            "problems_sha256": sha256_bytes(b"".join(sha256_bytes(p.read_bytes()).encode()
+                                                     for p, _ in problems))[:16]}
+
+
+def _run_rows(run_dir: Path, problems: list, fns: dict, log: RowLog, closed_loop: bool, timeout_s: float,
+              max_replans: int, show_progress: bool) -> list[ProblemRun]:
+    """Every (problem, planner, loop) row in order: finished ones from the log, the rest run and logged."""
+    from symlearn.learning.checkpoint import load_effect_model
+    from symlearn.sim.simulator import TabletopSimulator
+    from symlearn.symbolic.learned_transition import LearnedTransition
+
+    loops = [False, True] if closed_loop else [False]
+    todo = [(path, problem, name, loop) for path, problem in problems for name in fns for loop in loops
+            if (path.name, name, loop) not in log.done]
+    rows: dict[tuple, ProblemRun] = {}
+    if todo:
+        encoder, _ = load_effect_model(run_dir)
+        transition = LearnedTransition.from_run(run_dir)
+        with TabletopSimulator() as sim:
+            for path, problem, name, loop in todo:
+                cfg = ExecutionConfig(closed_loop=loop, max_replans=max_replans, timeout_s=timeout_s)
+                row = run_problem(sim, encoder, transition, problem, name, fns[name], cfg)
+                log.append((path.name, name, loop), strict_json(row.to_json()))
+                if show_progress:
+                    print(f"[{len(log.done)}/{len(problems) * len(fns) * len(loops)}] {problem.name} {name}"
+                          f"{' closed-loop' if loop else ''}: {row.status} len {row.plan_length} "
+                          f"success {row.success}", flush=True)
+    elif show_progress:
+        print(f"every row was already in {log.path}", flush=True)
+    return [ProblemRun(**log.done[(path.name, name, loop)])
+            for path, _ in problems for name in fns for loop in loops]
+
+
 def benchmark(run_dir: Path, problems_dir: Path, planners: list[str], out_file: Path,
               closed_loop: bool = False, timeout_s: float = 30.0, max_replans: int = 3,
               show_progress: bool = True) -> dict:
-    """Plan and execute every problem with every planner (closed loop too if asked); write out_file."""
-    from symlearn.learning.checkpoint import load_effect_model
+    """Plan and execute every problem with every planner (closed loop too if asked); write out_file.
+
+    Each finished row is appended to OUT.rows.jsonl at once; a run interrupted (killed) and started
+    again with the same settings resumes there, and its final JSON equals an uninterrupted run's
+    (its timings aside). The log is removed once out_file is written.
+    """
     from symlearn.planning.problem import load_problems
-    from symlearn.sim.simulator import TabletopSimulator
-    from symlearn.symbolic.learned_transition import LearnedTransition
-    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
 
     if not planners:
         raise ValueError("no planners given")
+    if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
+        raise ValueError(f"timeout {timeout_s!r} must be a finite positive number of seconds")
     run_dir, problems_dir, out_file = Path(run_dir), Path(problems_dir), Path(out_file)
-    fns = make_planners(list(planners), run_dir)  # refuses unknown names (and missing rules) before any work
+    fns = make_planners(list(planners), run_dir)  # refuses unknown names (and missing or stale rules) first
     problems = load_problems(problems_dir)
-    encoder, _ = load_effect_model(run_dir)
-    transition = LearnedTransition.from_run(run_dir)
-    open_cfg = ExecutionConfig(closed_loop=False, max_replans=max_replans, timeout_s=timeout_s)
-    closed_cfg = ExecutionConfig(closed_loop=True, max_replans=max_replans, timeout_s=timeout_s)
-    rows: list[ProblemRun] = []
+    settings = _settings(run_dir, problems_dir, problems, list(planners), closed_loop, timeout_s, max_replans)
     t0 = time.perf_counter()
-    with TabletopSimulator() as sim:
-        for i, (path, problem) in enumerate(problems):
-            for name, fn in fns.items():
-                row = run_problem(sim, encoder, transition, problem, name, fn, open_cfg)
-                rows.append(row)
-                if closed_loop:
-                    rows.append(run_problem(sim, encoder, transition, problem, name, fn, closed_cfg))
-                if show_progress:
-                    print(f"[{i + 1}/{len(problems)}] {problem.name} {name}: {row.status} "
-                          f"len {row.plan_length} success {row.success}"
-                          + (f" closed-loop {rows[-1].success}" if closed_loop else ""), flush=True)
+    out_file.parent.mkdir(parents=True, exist_ok=True)
+    log = RowLog(rows_path(out_file), settings)
+    try:
+        log.open()
+        rows = _run_rows(run_dir, problems, fns, log, closed_loop, timeout_s, max_replans, show_progress)
+    finally:
+        log.close()
     result = {"run": str(run_dir), "problems": str(problems_dir), "n_problems": len(problems),
               "planners": list(planners), "closed_loop": closed_loop, "timeout_s": timeout_s,
-              "max_replans": max_replans,
-              "transition_sha256": sha256_bytes((run_dir / TRANSITION_FILE).read_bytes())[:16],
-              "problems_sha256": sha256_bytes(b"".join(sha256_bytes(p.read_bytes()).encode()
-                                                       for p, _ in problems))[:16],
+              "max_replans": max_replans, "transition_sha256": settings["transition_sha256"],
+              "problems_sha256": settings["problems_sha256"],
               "versions": versions(), "wall_time_s": round(time.perf_counter() - t0, 2),
               "summary": summarize_rows(rows), "rows": [r.to_json() for r in rows]}
-    out_file.parent.mkdir(parents=True, exist_ok=True)
+    result = strict_json(result)
     atomic_write_json(out_file, result)
+    log.path.unlink()
     return result
 
 

@@ -30,10 +30,10 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from pddl_export.files import atomic_write_text
+from pddl_export.files import atomic_write_text, sha256_file
 from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl
 from pddl_export.rules import RuleSet
-from pddl_export.rules_io import load_rules
+from pddl_export.rules_io import PDDL_DIR, RULES_FILE, load_rules
 from pddl_export.sas_writer import SASEncoder
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
 from search.classical import solve_pddl
@@ -42,6 +42,7 @@ from search.result import PlanResult, PlanStatus, failed
 from search.sas_planners import solve_sas
 from search.up_problem import strips_problem
 from symlearn.planning.execution import PlannerFn
+from symlearn.planning.paths import path_under
 
 
 @dataclass(frozen=True)
@@ -59,7 +60,22 @@ class PlannerContext:
         if not any(s.needs_rules for s in specs):
             return PlannerContext(write_dir=write_dir)
         rules, model_hash = load_rules(Path(run_dir))
+        check_rules_current(Path(run_dir), model_hash)
         return PlannerContext(rules=rules, model_hash=model_hash, write_dir=write_dir)
+
+
+def check_rules_current(run_dir: Path, model_hash: str) -> None:
+    """Refuse rules exported from another transition.pt than the run's (the sha256 prefix export-pddl records)."""
+    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
+
+    path = Path(run_dir) / TRANSITION_FILE
+    if not path.is_file():
+        raise ValueError(f"no transition model at {path}; run 'symlearn train-transition' first")
+    current = sha256_file(path)[:16]
+    if not model_hash or model_hash != current:
+        raise ValueError(f"{Path(run_dir) / PDDL_DIR / RULES_FILE} was exported from another transition.pt "
+                         f"(model_hash {model_hash or 'missing'}, {path.name} is {current}); "
+                         f"re-run 'symlearn export-pddl --run {run_dir}'")
 
 
 @dataclass(frozen=True)
@@ -161,7 +177,7 @@ class _RulesPlanner:
             return None
         self.calls += 1
         self.write_dir.mkdir(parents=True, exist_ok=True)
-        return self.write_dir / (f"{stem}{suffix}" if self.calls == 1 else f"{stem}_{self.calls}{suffix}")
+        return path_under(self.write_dir, f"{stem}{suffix}" if self.calls == 1 else f"{stem}_{self.calls}{suffix}")
 
     def _checked(self, transition: TransitionFn, res: PlanResult) -> PlanResult:
         extra = dict(res.extra)

@@ -17,13 +17,20 @@ from pathlib import Path
 
 import numpy as np
 
+from symlearn.planning.paths import check_safe_name, is_safe_name
 from symlearn.sim.exploration import MAX_OBJECTS
 from symlearn.provenance import atomic_write_json
-from symlearn.world import N_ACTIONS, N_LOCATIONS, ObjectType, Scene, decode_action
+from symlearn.world import LOCATIONS, N_ACTIONS, N_LOCATIONS, TABLE_TOP_Z, ObjectType, Scene, decode_action
 
 PROBLEM_FORMAT = "symlearn-problem"
 PROBLEM_VERSION = 1
 GOAL_TOLERANCE_M = 0.02  # success: every object within this distance of its goal position
+# The reach of a valid scene: object centres over the table, at most this far from the middle of the
+# location grid (x, y), and between the table top and REACH_Z_MAX; orientations unit quaternions.
+REACH_CENTER_X = (min(x for x, _ in LOCATIONS) + max(x for x, _ in LOCATIONS)) / 2  # 0.65
+REACH_HALF_X, REACH_HALF_Y = 0.5, 0.6
+REACH_Z_MAX = 1.0
+QUATERNION_NORM_TOL = 1e-3
 _KEYS = ("format", "version", "name", "seed", "spec", "initial", "actions", "goal", "generator_length")
 
 
@@ -39,8 +46,7 @@ class Problem:
     goal: Scene  # poses the generator's actions ended in
 
     def __post_init__(self) -> None:
-        if not isinstance(self.name, str) or not self.name:
-            raise ValueError("problem name must be a non-empty string")
+        check_safe_name(self.name, "problem")
         if not _is_int(self.seed):
             raise ValueError(f"problem {self.name}: seed must be an integer, got {self.seed!r}")
         spec = tuple((ObjectType(t), int(loc)) for t, loc in self.spec)
@@ -62,8 +68,7 @@ class Problem:
             if tuple(o.type for o in scene.objects) != types:
                 raise ValueError(f"{p}: {what} scene objects {[o.type.name.lower() for o in scene.objects]} "
                                  f"do not match the spec {[t.name.lower() for t in types]}")
-            if not np.all(np.isfinite(scene.positions())):
-                raise ValueError(f"{p}: {what} scene has non-finite positions")
+            check_scene(scene, f"{p}: {what} scene")
 
     @property
     def k(self) -> int:
@@ -87,8 +92,8 @@ class Problem:
         """Parse and validate; every refusal is a one-line ValueError that names the problem."""
         if not isinstance(d, dict):
             raise ValueError(f"{where}: expected a JSON object, got {type(d).__name__}")
-        name = d.get("name") if isinstance(d.get("name"), str) else where
-        p = f"problem {name}" if name != where else where
+        name = d.get("name") if is_safe_name(d.get("name")) else None
+        p = where if name is None else f"problem {name}" if where == "problem" else f"{where} (problem {name})"
         missing = [k for k in _KEYS if k not in d]
         if missing:
             raise ValueError(f"{p}: missing keys {', '.join(missing)}")
@@ -96,8 +101,7 @@ class Problem:
             raise ValueError(f"{p}: not a symlearn problem (format {d['format']!r})")
         if d["version"] != PROBLEM_VERSION:
             raise ValueError(f"{p}: problem version {d['version']!r}, this symlearn reads version {PROBLEM_VERSION}")
-        if not isinstance(d["name"], str) or not d["name"]:
-            raise ValueError(f"{p}: name must be a non-empty string")
+        check_safe_name(d["name"], where)  # the name becomes a folder (RUN/pddl/problems/NAME)
         if not _is_int(d["seed"]):
             raise ValueError(f"{p}: seed must be an integer, got {d['seed']!r}")
         spec = d["spec"]
@@ -122,8 +126,25 @@ class Problem:
         try:
             return Problem(d["name"], int(d["seed"]), tuple(parsed), scenes["initial"], tuple(actions), scenes["goal"])
         except ValueError as e:
-            msg = str(e)
+            msg = str(e).removeprefix(f"problem {name}: ")
             raise ValueError(msg if msg.startswith(p) else f"{p}: {msg}") from None
+
+
+def check_scene(scene: Scene, where: str) -> None:
+    """Refuse (one-line ValueError) non-finite poses, non-unit quaternions and positions out of the table's reach."""
+    for i, o in enumerate(scene.objects):
+        pos, quat = np.asarray(o.position, np.float64), np.asarray(o.orientation, np.float64)
+        if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(quat))):
+            raise ValueError(f"{where}: object {i} has a non-finite pose")
+        norm = float(np.linalg.norm(quat))
+        if abs(norm - 1.0) > QUATERNION_NORM_TOL:
+            raise ValueError(f"{where}: object {i} orientation {list(o.orientation)} is not a unit quaternion "
+                             f"(norm {norm:.4g})")
+        x, y, z = pos
+        if not (abs(x - REACH_CENTER_X) < REACH_HALF_X and abs(y) < REACH_HALF_Y and TABLE_TOP_Z <= z <= REACH_Z_MAX):
+            raise ValueError(f"{where}: object {i} position {list(o.position)} is out of the table's reach "
+                             f"(|x-{REACH_CENTER_X:.2f}| < {REACH_HALF_X}, |y| < {REACH_HALF_Y}, "
+                             f"{TABLE_TOP_Z} <= z <= {REACH_Z_MAX})")
 
 
 def _is_int(x) -> bool:
@@ -159,10 +180,15 @@ def load_problem(path: Path) -> Problem:
     if not path.exists():
         raise ValueError(f"problem {path.name}: no such file {path}")
     try:
-        d = json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as e:
-        raise ValueError(f"problem {path.name}: not valid JSON ({e})") from None
-    return Problem.from_json(d, where=f"problem {path.name}")
+        d = json.loads(path.read_text(), parse_constant=_refuse_constant)
+    except (json.JSONDecodeError, UnicodeDecodeError, ValueError) as e:
+        raise ValueError(f"problem file {path}: not valid JSON ({str(e).splitlines()[0]})") from None
+    return Problem.from_json(d, where=f"problem file {path}")
+
+
+def _refuse_constant(name: str) -> float:
+    """json.loads hook: NaN and Infinity are not JSON."""
+    raise ValueError(f"{name} is not a JSON number")
 
 
 def load_problems(problems_dir: Path) -> list[tuple[Path, Problem]]:

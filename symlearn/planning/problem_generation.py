@@ -9,12 +9,16 @@ valid plan (its length is a reference for plan lengths).
 """
 from __future__ import annotations
 
+import json
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from symlearn.planning.problem import GOAL_TOLERANCE_M, Problem, save_problem
+from symlearn.planning.paths import path_under
+from symlearn.planning.problem import GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, save_problem
+from symlearn.provenance import atomic_write_json
 from symlearn.sim.exploration import MAX_OBJECTS, ExplorationConfig, sample_action, sample_scene_spec
 from symlearn.world import Action, Scene, decode_action
 
@@ -91,27 +95,101 @@ def generate_problem(sim, rng: np.random.Generator, cfg: ProblemConfig, name: st
     raise RuntimeError(f"problem {name}: no valid action sequence after {cfg.max_scene_tries} scenes")
 
 
+PROBLEMS_MANIFEST = "problems.manifest"  # JSON (not *.json, so load_problems never reads it as a problem)
+MANIFEST_FORMAT = "symlearn-problem-set"
+
+
+def _settings(n: int, cfg: ProblemConfig, seed: int) -> dict:
+    return {"format": MANIFEST_FORMAT, "problem_version": PROBLEM_VERSION, "n": n, "objects": list(cfg.objects),
+            "length": list(cfg.length), "seed": seed}
+
+
+def _own_files(out_dir: Path) -> list[Path]:
+    """The files a problem set of this module consists of: its problems, its manifest, stale temp files."""
+    return [f for f in out_dir.iterdir() if f.is_file() and (
+        re.fullmatch(r"problem_\d{4,}\.json", f.name) or f.name == PROBLEMS_MANIFEST
+        or re.fullmatch(r"\.(problem_\d{4,}\.json|problems\.manifest)\..*\.tmp", f.name))]
+
+
+def prepare_problem_dir(out_dir: Path, settings: dict, overwrite: bool = False) -> None:
+    """Make out_dir ready for a problem set: new, the same settings (resume), or cleared with overwrite.
+
+    A non-empty folder holding anything but a problem set of the same settings is refused, so two
+    generations are never mixed; `overwrite` first removes the old set's files (and only those).
+    """
+    manifest = out_dir / PROBLEMS_MANIFEST
+    if out_dir.exists() and not out_dir.is_dir():
+        raise ValueError(f"--out {out_dir} is a file, not a folder")
+    if out_dir.is_dir() and any(out_dir.iterdir()):
+        old = None
+        if manifest.is_file():
+            try:
+                old = json.loads(manifest.read_text())
+            except (json.JSONDecodeError, UnicodeDecodeError):
+                old = None
+        if overwrite:
+            for f in _own_files(out_dir):
+                f.unlink()
+            others = sorted(f.name for f in out_dir.iterdir())
+            if others:
+                raise ValueError(f"{out_dir} holds files that are not problems of a set ({', '.join(others[:3])}); "
+                                 f"--overwrite removes only problem files: choose an empty --out")
+        elif not isinstance(old, dict):
+            raise ValueError(f"{out_dir} already holds files but no problem manifest ({manifest.name}); "
+                             f"use --overwrite to replace its problems, or another --out")
+        elif old != settings:
+            diff = ", ".join(f"{k} {old.get(k)} (asked {v})" for k, v in settings.items() if old.get(k) != v)
+            raise ValueError(f"{out_dir} already holds problems of other settings ({diff}); "
+                             f"use --overwrite to replace them, or another --out")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for f in _own_files(out_dir):  # temp files of a killed run of the same set
+        if f.name.endswith(".tmp"):
+            f.unlink()
+    atomic_write_json(manifest, settings)
+
+
+def _done(path: Path, name: str) -> bool:
+    """Whether a previous run already wrote a valid problem `name` at path."""
+    if not path.is_file():
+        return False
+    try:
+        return load_problem(path).name == name
+    except ValueError:
+        return False
+
+
 def generate_problems(out_dir: Path, n: int, objects: tuple[int, int] = (1, 3), length: tuple[int, int] = (1, 4),
-                      seed: int = 0, sim=None) -> list[Path]:
-    """Write n problems to out_dir/problem_NNNN.json (problem i drawn from seed (seed, i))."""
+                      seed: int = 0, sim=None, overwrite: bool = False) -> list[Path]:
+    """Write n problems to out_dir/problem_NNNN.json (problem i drawn from seed (seed, i)).
+
+    Everything is validated before anything is created. A folder already holding the same set
+    (same settings, recorded in out_dir/problems.manifest) is completed: problems already written
+    are kept, so an interrupted run resumes. Another non-empty folder is refused unless `overwrite`.
+    """
     from symlearn.sim.simulator import TabletopSimulator
 
-    if n < 1:
-        raise ValueError(f"n={n} must be at least 1")
+    if not _is_count(n):
+        raise ValueError(f"n={n!r} must be an integer of at least 1")
+    if not _is_count(seed, least=0):
+        raise ValueError(f"seed={seed!r} must be a non-negative integer")
     cfg = ProblemConfig(objects=tuple(objects), length=tuple(length))
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    prepare_problem_dir(out_dir, _settings(n, cfg, seed), overwrite)
     own = sim is None
-    sim = sim or TabletopSimulator()
     paths = []
     try:
         for i in range(n):
             name = f"problem_{i:04d}"
-            problem = generate_problem(sim, np.random.default_rng([seed, i]), cfg, name, seed)
-            path = out_dir / f"{name}.json"
-            save_problem(path, problem)
+            path = path_under(out_dir, f"{name}.json")
+            if not _done(path, name):
+                sim = sim or TabletopSimulator()
+                save_problem(path, generate_problem(sim, np.random.default_rng([seed, i]), cfg, name, seed))
             paths.append(path)
     finally:
-        if own:
+        if own and sim is not None:
             sim.close()
     return paths
+
+
+def _is_count(x, least: int = 1) -> bool:
+    return isinstance(x, (int, np.integer)) and not isinstance(x, bool) and x >= least
