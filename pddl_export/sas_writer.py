@@ -26,6 +26,11 @@ reads it too):
   search. Fast Downward's heuristics derive how that default value is reached themselves
   (their `axioms=approximate_negative_cycles` option computes these negated axioms exactly
   here: the axioms have no cycles).
+  With `negation=Negation.EFFECTS` there are no axioms: each has-X(z) is an ordinary binary
+  variable, set in the initial state from z's code and updated by every effect that changes z
+  (same condition, value 1 if the new code is X_j, else 0). The states and plans are the same;
+  what changes is which heuristics accept the task: Fast Downward's merge-and-shrink and
+  landmark heuristics refuse axioms but take conditional effects.
 * Goal: the fixed objects' codes. Metric 0 (unit costs).
 
 The encoding is exact for any number of objects: a step of a plan is a step of the rules
@@ -90,6 +95,14 @@ class _Body:
     n_operators: int
     n_effects: int
     n_axioms: int
+    tracked: tuple[tuple[int, int], ...] = ()  # (object, code) of each has-X(z) variable, in variable order
+
+
+class Negation(str, Enum):
+    """How "object z does not hold code X" is encoded (str-valued: compares equal to its name)."""
+
+    AXIOMS = "axioms"  # a derived variable with one axiom, read at its default value (the smallest task)
+    EFFECTS = "effects"  # a state variable kept up to date by the effects that change z (no axioms)
 
 
 class TermKind(str, Enum):
@@ -143,12 +156,24 @@ def context_terms(intervals: tuple[tuple[int, int], ...], k: int) -> tuple[tuple
 class SASEncoder:
     """SAS+ tasks over one rule set; the operators for n objects are built once and reused."""
 
-    def __init__(self, rules: RuleSet, max_effects: int = MAX_EFFECTS) -> None:
+    def __init__(self, rules: RuleSet, max_effects: int = MAX_EFFECTS, negation: Negation | str = Negation.AXIOMS) -> None:
         self.rules = rules
         self.max_effects = int(max_effects)
+        self.negation = Negation(negation)
         self.codes = rules.codes
         self.value = {c: i for i, c in enumerate(self.codes)}  # code -> value index of an object variable
         self._bodies: dict[int, _Body] = {}
+
+    def with_negation(self, negation: Negation | str) -> "SASEncoder":
+        """This encoder if it writes `negation` already, else a sibling over the same rules that does (cached)."""
+        negation = Negation(negation)
+        if negation is self.negation:
+            return self
+        if not hasattr(self, "_siblings"):
+            self._siblings: dict[Negation, SASEncoder] = {}
+        if negation not in self._siblings:
+            self._siblings[negation] = SASEncoder(self.rules, self.max_effects, negation)
+        return self._siblings[negation]
 
     def task(self, init: Sequence[int], goal: SymbolicGoal | Sequence[int | None]) -> SASTask:
         """The SAS+ task from init codes to goal codes (ValueError on unknown codes or shapes)."""
@@ -157,7 +182,8 @@ class SASEncoder:
         body = self._bodies.get(n)
         if body is None:
             body = self._bodies[n] = self._body(n)
-        state = [str(self.value[c]) for c in init_t] + ["0"] * body.n_derived
+        state = [str(self.value[c]) for c in init_t] + [str(int(init_t[z] == x)) if self.negation is Negation.EFFECTS
+                                                         else "0" for z, x in body.tracked]
         goals = [(i, self.value[c]) for i, c in enumerate(goal_g.codes) if c is not None]
         text = "\n".join([
             "begin_version", str(SAS_FILE_VERSION), "end_version", "begin_metric", "0", "end_metric",
@@ -175,7 +201,7 @@ class SASEncoder:
         def has_var(z: int, x: int) -> int:
             return has.setdefault((z, x), n + len(has))
 
-        ops, n_effects = [], 0
+        per_action, n_effects = [], 0
         for a in self.rules.actions:
             effects: set[tuple[tuple[tuple[int, int], ...], int, int]] = set()
             for rule in (r for r in self.rules.rules if r.action == a):
@@ -195,13 +221,17 @@ class SASEncoder:
                             else:
                                 cond += [(has_var(z, xs[j]), 0) for j in js]
                         effects.add((tuple(sorted(cond)), o, self.value[rule.code_to]))
-                        if n_effects + len(effects) > self.max_effects:
-                            raise TaskTooLargeError(
-                                f"the SAS+ task for {n} objects needs more than {self.max_effects} conditional "
-                                "effects; plan with fewer objects or use the PDDL planners")
-            if not effects:
-                continue
-            n_effects += len(effects)
+                        self._check_size(n, n_effects + len(effects))
+            if effects:
+                n_effects += len(effects)
+                per_action.append((a, effects))
+        ops = []
+        for a, effects in per_action:  # has-X(z) variables are all known only now
+            if self.negation is Negation.EFFECTS:
+                tracking = self._tracking_effects(effects, has)
+                n_effects += len(tracking)
+                self._check_size(n, n_effects)
+                effects = effects | tracking
             lines = ["begin_operator", action_name(a), "0", str(len(effects))]
             for cond, var, post in sorted(effects):
                 lines.append(f"{len(cond)} {' '.join(f'{v} {x}' for v, x in cond)} {var} -1 {post}")
@@ -212,11 +242,29 @@ class SASEncoder:
             names = [f"Atom {code_predicate(c, bits)}({object_name(o)})" for c in self.codes]
             variables += ["begin_variable", object_name(o), "-1", str(len(self.codes)), *names, "end_variable"]
         axioms = []
+        derived = self.negation is Negation.AXIOMS
         for (z, x), var in sorted(has.items(), key=lambda kv: kv[1]):
             fact = f"has-{code_predicate(x, bits)}({object_name(z)})"
-            variables += ["begin_variable", f"has-{code_predicate(x, bits)}-{object_name(z)}", "0", "2",
-                          f"NegatedAtom {fact}", f"Atom {fact}", "end_variable"]
-            axioms.append(f"begin_rule\n1\n{z} {self.value[x]}\n{var} 0 1\nend_rule")
+            variables += ["begin_variable", f"has-{code_predicate(x, bits)}-{object_name(z)}", "0" if derived else "-1",
+                          "2", f"NegatedAtom {fact}", f"Atom {fact}", "end_variable"]
+            if derived:
+                axioms.append(f"begin_rule\n1\n{z} {self.value[x]}\n{var} 0 1\nend_rule")
         return _Body(variables="\n".join(variables), operators="\n".join([str(len(ops)), *ops]),
                      axioms="\n".join([str(len(axioms)), *axioms]), n_variables=n + len(has),
-                     n_derived=len(has), n_operators=len(ops), n_effects=n_effects, n_axioms=len(axioms))
+                     n_derived=len(has) if derived else 0, n_operators=len(ops), n_effects=n_effects,
+                     n_axioms=len(axioms), tracked=tuple(sorted(has, key=has.__getitem__)))
+
+    def _check_size(self, n: int, n_effects: int) -> None:
+        if n_effects > self.max_effects:
+            raise TaskTooLargeError(f"the SAS+ task for {n} objects needs more than {self.max_effects} conditional "
+                                    "effects; plan with fewer objects or use the PDDL planners")
+
+    def _tracking_effects(self, effects: set, has: dict[tuple[int, int], int]) -> set:
+        """For Negation.EFFECTS: with each effect o := Y, set every tracked has-X(o) to [Y == X] (same condition)."""
+        code_of = {v: c for c, v in self.value.items()}
+        out = set()
+        for cond, o, post in effects:
+            for (z, x), var in has.items():
+                if z == o:
+                    out.add((cond, var, int(code_of[post] == x)))
+        return out

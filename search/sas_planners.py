@@ -31,7 +31,7 @@ import numpy as np
 from pddl_export.files import atomic_write_text
 from pddl_export.pddl_writer import action_id_from_name
 from pddl_export.rules import apply_rules
-from pddl_export.sas_writer import SASEncoder, TaskTooLargeError
+from pddl_export.sas_writer import Negation, SASEncoder, TaskTooLargeError
 from search.result import PlanResult, PlanStatus, failed
 from pddl_export.symbolic import SymbolicGoal
 
@@ -43,6 +43,7 @@ class SASPlanner:
     package: str  # the Python package that ships the binary
     search: str  # the --search argument
     optimal: bool  # guarantees a shortest plan (unit costs)
+    negation: Negation = Negation.AXIOMS  # the task form its heuristics accept (see pddl_export.sas_writer)
 
 
 SAS_PLANNERS = {
@@ -51,6 +52,19 @@ SAS_PLANNERS = {
     "fast-downward-sas": SASPlanner("up_fast_downward", "let(hff, ff(), eager_greedy([hff], preferred=[hff]))", False),
     "fast-downward-sas-opt": SASPlanner("up_fast_downward", "astar(blind())", True),
     "symk-sas": SASPlanner("up_symk", "sym_bd()", True),  # symbolic bidirectional uniform-cost search
+    # optimal A* with a merge-and-shrink abstraction (bisimulation, DFP merging): the strong admissible heuristic
+    # that takes conditional effects; it refuses axioms, so the task tracks "z does not hold X" in effects
+    "fast-downward-sas-ms": SASPlanner(
+        "up_fast_downward",
+        "astar(merge_and_shrink(shrink_strategy=shrink_bisimulation(greedy=false), merge_strategy=merge_sccs("
+        "order_of_sccs=topological, merge_selector=score_based_filtering(scoring_functions=[goal_relevance(), "
+        "dfp(), total_order()])), label_reduction=exact(before_shrinking=true, before_merging=false), "
+        "max_states=50000, threshold_before_merge=1))", True, Negation.EFFECTS),
+    # LAMA's first iteration: lazy greedy search with FF and landmark-sum heuristics and preferred operators
+    "fast-downward-sas-lama": SASPlanner(
+        "up_fast_downward",
+        "let(hlm, landmark_sum(lm_factory=lm_reasonable_orders_hps(lm_rhw()), pref=false), let(hff, ff(), "
+        "lazy_greedy([hff, hlm], preferred=[hff, hlm], reopen_closed=false)))", False, Negation.EFFECTS),
 }
 _BINARY_DIRS = {"up_fast_downward": "downward", "up_symk": "symk"}
 MEMORY_LIMIT_MB = 4096
@@ -166,6 +180,7 @@ def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Seq
     if binary is None:
         return failed(planner, PlanStatus.ERROR, t0, f"the search binary of {spec.package} was not found "
                       f"(pip install {spec.package.replace('_', '-')})")
+    encoder = encoder.with_negation(spec.negation)
     try:
         task = encoder.task(init, goal)
     except (ValueError, TaskTooLargeError) as e:

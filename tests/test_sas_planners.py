@@ -194,3 +194,29 @@ def test_effects_reproduce_the_rules_on_every_joint_state(rules):  # noqa: F811
             want = apply_rules_batch(rules, np.array([[codes[s] for s in state]]), np.array([a]))[0]
             got = [codes[fired.get(o, state[o])] for o in range(3)]
             assert got == want.tolist(), (state, lines[0])
+
+
+def test_effects_negation_has_no_axioms_and_same_optimal_lengths(random_nets):  # noqa: F811
+    """Negation.EFFECTS: no axioms, has-X(z) state variables set from the start codes; blind A* finds the same lengths."""
+    from pddl_export.sas_writer import Negation
+    rng = np.random.default_rng(1)
+    compared = 0
+    for _, _, rs in random_nets:
+        ax, ef = SASEncoder(rs), SASEncoder(rs, negation=Negation.EFFECTS)
+        assert ax.with_negation("effects") is ax.with_negation(Negation.EFFECTS)  # one cached sibling
+        for n in (2, 3):
+            init = [int(c) for c in rng.choice(rs.vocabulary, n)]
+            goal = [int(c) for c in rng.choice(rs.vocabulary, n)]
+            ta, te = ax.task(init, goal), ef.task(init, goal)
+            assert te.n_axioms == 0 and te.n_derived == 0 and "begin_rule" not in te.text
+            assert te.n_variables == ta.n_variables and te.n_effects >= ta.n_effects
+            state = te.text.split("begin_state\n", 1)[1].split("\nend_state", 1)[0].split("\n")
+            for (z, x), value in zip(ef._bodies[n].tracked, state[n:]):
+                assert int(value) == int(init[z] == x)
+            want = _bfs_length(rs, init, SymbolicGoal(tuple(goal)))
+            if search_binary("up_fast_downward") is None:
+                continue
+            res = solve_sas(ef, init, goal, "fast-downward-sas-opt", timeout_s=20)
+            assert (len(res.plan) if res.status is PlanStatus.SOLVED else -1) == want, (init, goal, res.message)
+            compared += 1
+    assert compared >= 4 or search_binary("up_fast_downward") is None
