@@ -32,12 +32,15 @@ for r in paper_s0 paper_s1 paper_s2 quick_s0 quick_s1 quick_s2; do
   base=${r%_s*}_noattn
   ( $S evaluate --run "$RUNS/$r" --data "$DATA" --baseline-run "$RUNS/$base" > "$DEST/eval_$r.log" 2>&1
     stamp "evaluate $r rc=$?"
+    $S table1 --run "$RUNS/$r" > "$DEST/table1_$r.log" 2>&1; stamp "table1 $r rc=$?"
+    OMP_NUM_THREADS=2 $S symbols --run "$RUNS/$r" --data "$DATA" > "$DEST/symbols_$r.log" 2>&1; stamp "symbols $r rc=$?"
     preset=${r%_s*}
     OMP_NUM_THREADS=2 $S train-transition --run "$RUNS/$r" --data "$DATA" --preset "$preset" --quiet > "$DEST/transition_$r.log" 2>&1
     stamp "train-transition $r rc=$?" ) &
 done
 for r in paper_noattn quick_noattn; do
-  ( $S evaluate --run "$RUNS/$r" --data "$DATA" > "$DEST/eval_$r.log" 2>&1; stamp "evaluate $r rc=$?" ) &
+  ( $S evaluate --run "$RUNS/$r" --data "$DATA" > "$DEST/eval_$r.log" 2>&1; stamp "evaluate $r rc=$?"
+    $S table1 --run "$RUNS/$r" > "$DEST/table1_$r.log" 2>&1; stamp "table1 $r rc=$?" ) &
 done
 wait
 stamp "done"
