@@ -16,6 +16,7 @@ from pathlib import Path
 
 from symlearn.planning.execution import ExecutionConfig, ProblemRun, run_problem
 from symlearn.planning.planners import make_planners
+from symlearn.planning.recording import PlanRecorder
 from symlearn.provenance import atomic_write_json, sha256_bytes, versions
 
 
@@ -61,8 +62,10 @@ def summarize_rows(rows: list[ProblemRun]) -> dict:
 
 def benchmark(run_dir: Path, problems_dir: Path, planners: list[str], out_file: Path,
               closed_loop: bool = False, timeout_s: float = 30.0, max_replans: int = 3,
-              show_progress: bool = True) -> dict:
-    """Plan and execute every problem with every planner (closed loop too if asked); write out_file."""
+              show_progress: bool = True, record_dir: Path | None = None) -> dict:
+    """Plan and execute every problem with every planner (closed loop too if asked); write out_file.
+
+    With record_dir, each failed open-loop run is saved as record_dir/<problem>_<planner>.gif."""
     from symlearn.learning.checkpoint import load_effect_model
     from symlearn.planning.problem import load_problems
     from symlearn.sim.simulator import TabletopSimulator
@@ -83,7 +86,10 @@ def benchmark(run_dir: Path, problems_dir: Path, planners: list[str], out_file: 
     with TabletopSimulator() as sim:
         for i, (path, problem) in enumerate(problems):
             for name, fn in fns.items():
-                row = run_problem(sim, encoder, transition, problem, name, fn, open_cfg)
+                rec = None if record_dir is None else PlanRecorder()
+                row = run_problem(sim, encoder, transition, problem, name, fn, open_cfg, recorder=rec)
+                if rec is not None and not row.success:
+                    rec.save_gif(Path(record_dir) / f"{problem.name}_{name}.gif")
                 rows.append(row)
                 if closed_loop:
                     rows.append(run_problem(sim, encoder, transition, problem, name, fn, closed_cfg))
