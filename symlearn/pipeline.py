@@ -182,6 +182,8 @@ def _run_commands(argv: list[list[str]], log: Path) -> None:
         for cmd in argv:
             print(f"$ symlearn {' '.join(cmd)}", flush=True)
             rc = main(cmd)
+            if rc == 130:  # the command caught Ctrl-C: stop here too; the next run resumes
+                raise KeyboardInterrupt
             if rc != 0:
                 raise RuntimeError(f"'symlearn {cmd[0]}' exited {rc}; see {log}")
 
