@@ -19,6 +19,10 @@ def plot_png(plot: Plot, width_in: float = 5.0, height_in: float = 3.2, dpi: int
         ax.plot(x, y, marker="o", markersize=3, label=label)
     if plot.log_y:
         ax.set_yscale("log")
+    if plot.xlabel == "epoch":
+        from matplotlib.ticker import MaxNLocator
+
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_title(plot.title)
     ax.set_xlabel(plot.xlabel)
     ax.set_ylabel(plot.ylabel)
