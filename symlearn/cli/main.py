@@ -12,7 +12,9 @@ import time
 from pathlib import Path
 
 from symlearn.cli.args import int_range
+from symlearn.cli.pipeline import add_pipeline_command
 from symlearn.cli.planning import add_planning_commands
+from symlearn.cli.report import add_report_command
 
 
 def cmd_collect(args: argparse.Namespace) -> int:
@@ -233,6 +235,8 @@ def build_parser() -> argparse.ArgumentParser:
     add_analysis_commands(sub)
     add_export_pddl_command(sub)
     add_planning_commands(sub)
+    add_report_command(sub)
+    add_pipeline_command(sub)
     return p
 
 

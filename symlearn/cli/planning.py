@@ -101,8 +101,16 @@ def cmd_plan(args: argparse.Namespace) -> int:
     encoder, _ = load_effect_model(Path(args.run))
     transition = LearnedTransition.from_run(Path(args.run))
     cfg = ExecutionConfig(closed_loop=args.closed_loop, max_replans=args.max_replans, timeout_s=args.timeout)
+    recorder = None
+    if args.record:
+        from symlearn.planning.recording import PlanRecorder
+
+        recorder = PlanRecorder(width=args.record_size[0], height=args.record_size[1])
     with TabletopSimulator() as sim:
-        row = run_problem(sim, encoder, transition, problem, args.planner, fn, cfg)
+        row = run_problem(sim, encoder, transition, problem, args.planner, fn, cfg, recorder=recorder)
+    if recorder is not None:
+        print(f"wrote {recorder.save_gif(Path(args.record))} ({len(recorder.frames)} frames) and "
+              f"{recorder.save_filmstrip(Path(args.record).with_suffix('.png'))}")
     if write_dir.exists():
         print(f"wrote {write_dir / 'problem.pddl'}")
     print(f"{problem.name} [{args.planner}{', closed loop' if row.closed_loop else ''}]: found {row.found} "
@@ -117,10 +125,22 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
     from symlearn.planning.benchmark import benchmark, format_table
 
     res = benchmark(Path(args.run), Path(args.problems), args.planners, Path(args.out), closed_loop=args.closed_loop,
-                    timeout_s=args.timeout, max_replans=args.max_replans, show_progress=not args.quiet)
+                    timeout_s=args.timeout, max_replans=args.max_replans, show_progress=not args.quiet,
+                    record_dir=Path(args.record) if args.record else None)
     print(format_table(res))
     print(f"wrote {args.out}")
     return 0
+
+
+def _size(text: str) -> tuple[int, int]:
+    """'320x240' -> (320, 240), for argparse."""
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"size {text!r} is not WIDTHxHEIGHT, e.g. 320x240") from None
+    if not (16 <= w <= 4096 and 16 <= h <= 4096):
+        raise argparse.ArgumentTypeError(f"size {text!r} must be between 16x16 and 4096x4096")
+    return w, h
 
 
 def add_train_transition_command(sub) -> None:
@@ -164,6 +184,8 @@ def add_plan_command(sub) -> None:
     c.add_argument("--run", required=True, help="run directory with best.pt and transition.pt")
     c.add_argument("--problem", required=True, help="problem JSON file")
     c.add_argument("--planner", default="astar")
+    c.add_argument("--record", help="save the executed plan as this animated GIF (and a filmstrip .png beside it)")
+    c.add_argument("--record-size", type=_size, default=(320, 240), help="recorded frame size WxH (default 320x240)")
     _add_execution_flags(c)
     c.set_defaults(func=cmd_plan)
 
@@ -177,6 +199,7 @@ def add_benchmark_command(sub) -> None:
                    help="comma-separated planner names")
     c.add_argument("--out", required=True, help="benchmark JSON file")
     c.add_argument("--quiet", action="store_true")
+    c.add_argument("--record", help="directory for GIFs of failed plans (<problem>_<planner>.gif)")
     _add_execution_flags(c)
     c.set_defaults(func=cmd_benchmark)
 

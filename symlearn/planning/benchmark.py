@@ -20,6 +20,7 @@ from pathlib import Path
 from pddl_export.rules_io import PDDL_DIR, RULES_FILE
 from symlearn.planning.execution import ExecutionConfig, ProblemRun, run_problem
 from symlearn.planning.planners import make_planners
+from symlearn.planning.recording import PlanRecorder
 from symlearn.provenance import atomic_write_json, atomic_write_text, sha256_bytes, sha256_file, versions
 
 
@@ -157,7 +158,7 @@ def _settings(run_dir: Path, problems_dir: Path, problems: list, planners: list[
 
 
 def _run_rows(run_dir: Path, problems: list, fns: dict, log: RowLog, closed_loop: bool, timeout_s: float,
-              max_replans: int, show_progress: bool) -> list[ProblemRun]:
+              max_replans: int, show_progress: bool, record_dir: Path | None = None) -> list[ProblemRun]:
     """Every (problem, planner, loop) row in order: finished ones from the log, the rest run and logged."""
     from symlearn.learning.checkpoint import load_effect_model
     from symlearn.sim.simulator import TabletopSimulator
@@ -166,14 +167,16 @@ def _run_rows(run_dir: Path, problems: list, fns: dict, log: RowLog, closed_loop
     loops = [False, True] if closed_loop else [False]
     todo = [(path, problem, name, loop) for path, problem in problems for name in fns for loop in loops
             if (path.name, name, loop) not in log.done]
-    rows: dict[tuple, ProblemRun] = {}
     if todo:
         encoder, _ = load_effect_model(run_dir)
         transition = LearnedTransition.from_run(run_dir)
         with TabletopSimulator() as sim:
             for path, problem, name, loop in todo:
                 cfg = ExecutionConfig(closed_loop=loop, max_replans=max_replans, timeout_s=timeout_s)
-                row = run_problem(sim, encoder, transition, problem, name, fns[name], cfg)
+                rec = None if record_dir is None or loop else PlanRecorder()
+                row = run_problem(sim, encoder, transition, problem, name, fns[name], cfg, recorder=rec)
+                if rec is not None and not row.success:
+                    rec.save_gif(Path(record_dir) / f"{problem.name}_{name}.gif")
                 log.append((path.name, name, loop), strict_json(row.to_json()))
                 if show_progress:
                     print(f"[{len(log.done)}/{len(problems) * len(fns) * len(loops)}] {problem.name} {name}"
@@ -187,12 +190,13 @@ def _run_rows(run_dir: Path, problems: list, fns: dict, log: RowLog, closed_loop
 
 def benchmark(run_dir: Path, problems_dir: Path, planners: list[str], out_file: Path,
               closed_loop: bool = False, timeout_s: float = 30.0, max_replans: int = 3,
-              show_progress: bool = True) -> dict:
+              show_progress: bool = True, record_dir: Path | None = None) -> dict:
     """Plan and execute every problem with every planner (closed loop too if asked); write out_file.
 
     Each finished row is appended to OUT.rows.jsonl at once; a run interrupted (killed) and started
     again with the same settings resumes there, and its final JSON equals an uninterrupted run's
-    (its timings aside). The log is removed once out_file is written.
+    (its timings aside). The log is removed once out_file is written. With record_dir, each failed
+    open-loop run is saved as record_dir/<problem>_<planner>.gif.
     """
     from symlearn.planning.problem import load_problems
 
@@ -209,7 +213,8 @@ def benchmark(run_dir: Path, problems_dir: Path, planners: list[str], out_file: 
     log = RowLog(rows_path(out_file), settings)
     try:
         log.open()
-        rows = _run_rows(run_dir, problems, fns, log, closed_loop, timeout_s, max_replans, show_progress)
+        rows = _run_rows(run_dir, problems, fns, log, closed_loop, timeout_s, max_replans, show_progress,
+                        record_dir)
     finally:
         log.close()
     result = {"run": str(run_dir), "problems": str(problems_dir), "n_problems": len(problems),

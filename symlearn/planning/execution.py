@@ -118,15 +118,18 @@ def _codes(sim, encoder) -> tuple[int, ...]:
 def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: np.ndarray,
                  config: ExecutionConfig = ExecutionConfig(),
                  replan: Callable[[np.ndarray], PlanResult] | None = None,
-                 record: Callable[[tuple, int, tuple], None] | None = None) -> ExecutionResult:
+                 record: Callable[[tuple, int, tuple], None] | None = None, recorder=None) -> ExecutionResult:
     """Run plan.plan from the problem's initial poses; closed loop replans with `replan(observed_codes)`.
 
-    `record(state, action, observed_next)` hears every executed step (ObservedTransitions.record).
+    `record(state, action, observed_next)` hears every executed step (ObservedTransitions.record);
+    `recorder` (a symlearn.planning.recording.PlanRecorder) takes a camera frame at the start and after each step.
     """
     if config.closed_loop and replan is None:
         raise ValueError("closed-loop execution needs a replan function")
     goal = tuple(int(c) for c in goal)
     place_scene(sim, problem.initial)
+    if recorder is not None:
+        recorder.start(sim)
     codes = _codes(sim, encoder)
     observed, executed = [codes], []
     actions, predicted = list(plan.plan), list(plan.predicted_states)
@@ -135,6 +138,8 @@ def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: np.ndar
         res = sim.step(decode_action(actions[t]))
         off_table |= res.off_table
         executed.append(actions[t])
+        if recorder is not None:
+            recorder.step(sim, actions[t])
         before, codes = codes, _codes(sim, encoder)
         observed.append(codes)
         if record is not None:
@@ -219,8 +224,9 @@ def safe_plan(planner: str, planner_fn: PlannerFn, transition: TransitionFn, sta
 
 
 def run_problem(sim, encoder, transition: TransitionFn, problem: Problem, planner: str, planner_fn: PlannerFn,
-                config: ExecutionConfig = ExecutionConfig(), initial_plan: PlanResult | None = None) -> ProblemRun:
-    """Encode start and goal, plan (or reuse initial_plan), execute, and report one row."""
+                config: ExecutionConfig = ExecutionConfig(), initial_plan: PlanResult | None = None,
+                recorder=None) -> ProblemRun:
+    """Encode start and goal, plan (or reuse initial_plan), execute, and report one row (frames into `recorder`)."""
     goal = goal_codes(sim, encoder, problem)
     place_scene(sim, problem.initial)
     start = encode_observation(encoder, sim.observe())
@@ -232,7 +238,10 @@ def run_problem(sim, encoder, transition: TransitionFn, problem: Problem, planne
         ex = execute_plan(sim, problem, plan, encoder, goal, config,
                           replan=lambda codes: safe_plan(planner, planner_fn, memory, codes, sym_goal,
                                                          config.timeout_s),
-                          record=memory.record if config.closed_loop else None)
+                          record=memory.record if config.closed_loop else None, recorder=recorder)
+    elif recorder is not None:  # nothing to execute: the start scene alone
+        place_scene(sim, problem.initial)
+        recorder.start(sim)
     return ProblemRun(
         problem=problem.name, planner=planner, found=plan.found, status=plan.status.value,
         plan_length=len(plan.plan) if plan.found else None, planning_time_s=plan.planning_time_s,

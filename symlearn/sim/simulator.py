@@ -264,6 +264,22 @@ class TabletopSimulator:
         crops = cut_crops(depth, seg, ids, origins, self.cfg.crop)
         return Observation(depth, seg, crops, origins, pixels)
 
+    def rgb_camera(self, width: int, height: int, fov_deg: float | None = None) -> tuple[tuple, tuple]:
+        """(view, projection) matrices, column-major 4x4 as pybullet gives them, of the RGB view: the depth camera's."""
+        cam = self.cfg.camera
+        proj = pb.computeProjectionMatrixFOV(fov_deg or cam.fov_deg, width / height, cam.near, cam.far,
+                                             physicsClientId=self.cid)
+        return tuple(self._view), tuple(proj)
+
+    def render_rgb(self, width: int = 320, height: int = 240, fov_deg: float | None = None) -> np.ndarray:
+        """(height, width, 3) uint8 colour image from the depth camera's viewpoint (tiny renderer: headless)."""
+        if width <= 0 or height <= 0:
+            raise ValueError(f"image size {width}x{height} must be positive")
+        view, proj = self.rgb_camera(width, height, fov_deg)
+        _, _, rgba, _, _ = pb.getCameraImage(width, height, view, proj, renderer=pb.ER_TINY_RENDERER,
+                                             flags=pb.ER_NO_SEGMENTATION_MASK, physicsClientId=self.cid)
+        return np.reshape(np.asarray(rgba, np.uint8), (height, width, 4))[..., :3].copy()
+
     # ---------------------------------------------------------------- acting
     def step(self, action: Action) -> StepResult:
         """Execute one pick-and-release with the arm and report every object's displacement."""

@@ -1,0 +1,35 @@
+"""`symlearn pipeline`: every stage from collection to the report, resumable (logic in symlearn.pipeline).
+
+    symlearn pipeline --preset quick --out pipe --n 2000 --seed 0
+"""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def cmd_pipeline(args: argparse.Namespace) -> int:
+    from symlearn.pipeline import PipelineSettings, run_pipeline
+
+    s = PipelineSettings(preset=args.preset, out=Path(args.out), n=args.n, seed=args.seed, epochs=args.epochs,
+                         transition_epochs=args.transition_epochs, problems=args.problems, workers=args.workers,
+                         shard_size=args.shard_size, stop_after=args.stop_after)
+    run_pipeline(s, echo=lambda line: print(line, flush=True))
+    print(f"wrote {s.out / 'pipeline.json'}; report at {s.out / 'run' / 'report.html'}")
+    return 0
+
+
+def add_pipeline_command(sub) -> None:
+    """Add `pipeline` to the CLI's sub-parsers."""
+    p = sub.add_parser("pipeline", help="run every stage (collect ... report) into one folder; resumes")
+    p.add_argument("--preset", default="quick", choices=["quick", "paper"])
+    p.add_argument("--out", required=True, help="folder for data/, run/, problems/, logs/ and pipeline.json")
+    p.add_argument("--n", type=int, help="samples to collect (preset's if unset: quick 1000, paper 12000)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--epochs", type=int, help="effect model epochs (preset's if unset)")
+    p.add_argument("--transition-epochs", type=int, help="transition network epochs (preset's if unset)")
+    p.add_argument("--problems", type=int, help="planning problems to benchmark (quick 5, paper 20)")
+    p.add_argument("--workers", type=int, default=1, help="collection worker processes")
+    p.add_argument("--shard-size", type=int, default=250, help="samples per data shard")
+    p.add_argument("--stop-after", help=argparse.SUPPRESS)  # tests: simulate an interruption after a stage
+    p.set_defaults(func=cmd_pipeline)

@@ -1,0 +1,213 @@
+"""From a run's own outputs to report sections: pure functions of the loaded JSON, plus one reader.
+
+Each `*_section` takes what a stage wrote (a dict, or None when the stage has not run) and returns a
+Section; `gather_report` reads the files of a run directory and hands them over. A missing or
+unreadable input becomes a "not run" section naming the file and the command that writes it.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from symlearn.report.model import Image, Mark, Plot, Report, Section, Table, not_run
+from symlearn.report.render import fmt
+
+PAPER_EFFECT_MAE_MM = {"x": 8.6, "y": 15.0, "z": 6.0}  # the paper's test error of the attentive model
+PAPER_SYMBOLS_95 = 35  # the paper: 35 symbols cover 95% of the objects
+OBJECT_ORDER = (1, 0, 2)  # Table I's columns: first cube (green), stick (orange), second cube (red)
+OBJECT_NAMES = ("first cube", "stick", "second cube")
+SYMBOL_IMAGES = (("symbols.png", "Symbol prototypes (the paper's Fig. 4)"),
+                 ("symbol_examples.png", "Examples of one symbol (the paper's Fig. 5)"))
+
+
+def read_json(path: Path) -> tuple[dict | None, str]:
+    """(document, '') or (None, one-line reason): missing, unreadable or not a JSON object."""
+    path = Path(path)
+    if not path.is_file():
+        return None, f"{path} not found"
+    try:
+        doc = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        return None, f"{path} cannot be read ({type(e).__name__}: {str(e).splitlines()[0][:100]})"
+    if not isinstance(doc, dict):
+        return None, f"{path} is not a JSON object"
+    return doc, ""
+
+
+def data_section(summary: dict | None, shares: dict | None, why: str = "") -> Section:
+    """Data set counts (manifest), effect statistics and object shares."""
+    title = "Data set"
+    if summary is None:
+        return not_run("data", title, why or "no data set given (--data) or recorded in RUN/config.json")
+    counts = summary.get("counts", {})
+    rows = [("path", summary.get("path")), *((f"{k} samples", v) for k, v in counts.items()),
+            *((k, summary.get(k)) for k in ("samples", "objects", "objects_per_sample", "shards",
+                                            "dropped_samples", "size_mb", "moved_fraction", "grasp_fraction"))]
+    mae = summary.get("mean_abs_effect_mm") or {}
+    rows += [(f"mean |effect| {a} (mm)", mae.get(a)) for a in "xyz"]
+    s = Section("data", title, tables=[Table("Counts and effect statistics", ("quantity", "value"),
+                                             tuple(rows), key="data")])
+    if shares:
+        keys = ("objects", "sticks", "stick_share", "stacked", "stacked_share", "riders", "rider_share",
+                "riders_on_stick")
+        s.tables.append(Table("Object shares (symlearn.data.statistics.object_shares)", ("quantity", "value"),
+                              tuple((k, shares.get(k)) for k in keys), key="shares"))
+    return s
+
+
+def effect_section(ev: dict | None, why: str = "") -> Section:
+    """Test-split effect MAE per axis next to the paper's 8.6 / 15 / 6 mm, with the ablation rows."""
+    title = "Effect prediction error (test split)"
+    if ev is None:
+        return not_run("effect", title, why or "RUN/eval.json missing: run 'symlearn evaluate'")
+    ours = ev.get("effect_mae_mm") or {}
+    marks = [Mark(f"effect MAE {a} (mm)", ours.get(a), PAPER_EFFECT_MAE_MM[a], "below the paper's",
+                  None if ours.get(a) is None else ours[a] < PAPER_EFFECT_MAE_MM[a]) for a in "xyz"]
+    rows = [("attentive (ours)", *(ours.get(a) for a in "xyz")),
+            ("paper", *(PAPER_EFFECT_MAE_MM[a] for a in "xyz"))]
+    for name, r in (ev.get("ablations") or {}).items():
+        m = r.get("effect_mae_mm") or {}
+        rows.append((name, *(m.get(a) for a in "xyz")))
+    mean = ev.get("mean_abs_effect_mm") or {}
+    rows.append(("mean |effect|", *(mean.get(a) for a in "xyz")))
+    riders = ev.get("riders") or {}
+    text = [f"{ev.get('n_test_samples')} test samples; riders (objects carried by the held one): "
+            f"{riders.get('count')}, MAE (mm) {fmt(riders.get('effect_mae_mm'))}"]
+    return Section("effect", title, text=text, marks=marks,
+                   tables=[Table("Mean absolute error per axis (mm)", ("model", "x", "y", "z"), tuple(rows),
+                                 key="effect")])
+
+
+def _vec(v) -> str:
+    return "(" + ", ".join(f"{x:.0f}" for x in v) + ")" if v is not None else "-"
+
+
+def table1_section(t1: dict | None, why: str = "") -> Section:
+    """Table I: predicted and true effects in the three stick cases, ours beside the paper's, and the criteria."""
+    title = "Table I: the three stick cases"
+    if t1 is None:
+        return not_run("table1", title, why or "RUN/table1.json missing: run 'symlearn table1'")
+    paper = t1.get("paper") or {}
+    rows = []
+    for key, label in (("predicted_mm", "predicted"), ("truth_mm", "truth")):
+        for i, case in enumerate(t1.get("cases", [])):
+            objs = case.get("objects", [])
+            ref = (paper.get(key) or [[]] * 3)[i] if i < len(paper.get(key) or []) else []
+            cells = []
+            for j in OBJECT_ORDER:
+                cells.append(_vec(objs[j][key]) if j < len(objs) else "-")
+                cells.append(_vec(ref[j]) if j < len(ref) else "-")
+            rows.append((f"case {i + 1} {label}", *cells))
+    header = ("row",) + tuple(f"{n} {w}" for n in OBJECT_NAMES for w in ("ours", "paper"))
+    c = t1.get("criteria") or {}
+    marks = []
+    if "motion_right" in c:
+        marks.append(Mark("Table I: every object's motion right", c.get("objects_motion_right"), "all objects",
+                          "moved >= 100 mm in y the right way, or within 20 mm of still", bool(c["motion_right"])))
+    if "riders_within_50mm" in c:
+        marks.append(Mark("Table I: riders' y within 50 mm of the truth", c.get("riders_right"), "all riders",
+                          "|predicted y - true y| <= 50 mm", bool(c["riders_within_50mm"])))
+    mae = t1.get("mean_abs_error_mm") or {}
+    return Section("table1", title, marks=marks, text=[f"mean absolute error over the cases (mm): {fmt(mae or None)}"],
+                   tables=[Table("Effects (mm), ours next to the paper's", header, tuple(rows), key="table1")])
+
+
+def symbols_section(sy: dict | None, run: Path, why: str = "") -> Section:
+    """Symbol counts next to the paper's '35 symbols cover 95%', the frequent symbols, and the figures."""
+    title = "Symbols"
+    if sy is None:
+        return not_run("symbols", title, why or "RUN/symbols.json missing: run 'symlearn symbols'")
+    n95 = sy.get("n_symbols_for_95pct")
+    marks = [Mark("symbols covering 95% of objects", n95, PAPER_SYMBOLS_95, "at most the paper's 35",
+                  None if n95 is None else n95 <= PAPER_SYMBOLS_95)]
+    rows = tuple((k, sy.get(k)) for k in ("n_objects", "n_distinct", "n_symbols_for_95pct", "weighted_type_purity",
+                                          "weighted_moved_purity", "example_symbol"))
+    top = tuple((r.get("code"), r.get("count"), r.get("cube_fraction"), r.get("times_picked"),
+                 r.get("moved_when_picked")) for r in (sy.get("symbols") or [])[:15])
+    images = [Image(Path(name).stem, cap, Path(run) / name) for name, cap in SYMBOL_IMAGES if (Path(run) / name).is_file()]
+    return Section("symbols", title, marks=marks, images=images,
+                   tables=[Table("Symbol statistics", ("quantity", "value"), rows, key="symbols"),
+                           Table("Most frequent symbols", ("code", "count", "cube fraction", "times picked",
+                                                           "moved when picked"), top, key="symbol_list")])
+
+
+def _series(history: list, keys: tuple[str, ...]) -> dict:
+    out = {}
+    for k in keys:
+        pts = [(r.get("epoch", i + 1), r[k]) for i, r in enumerate(history) if isinstance(r.get(k), (int, float))]
+        if pts:
+            out[k] = ([p[0] for p in pts], [p[1] for p in pts])
+    return out
+
+
+def curves_section(effect_history: list | None, transition_history: list | None) -> Section:
+    """Learning curves of the effect model and the transition network."""
+    title = "Learning curves"
+    if not effect_history and not transition_history:
+        return not_run("curves", title, "no training history: RUN/metrics.json (or best.pt) and "
+                                        "RUN/transition_metrics.json missing")
+    s = Section("curves", title)
+    if effect_history:
+        s.plots.append(Plot("effect_loss", "Effect model", "epoch", "loss",
+                            _series(effect_history, ("train_loss", "val_loss"))))
+        mae = {f"val MAE {a}": ([r.get("epoch", i + 1) for i, r in enumerate(effect_history) if r.get("val_mae_mm")],
+                                [r["val_mae_mm"][a] for r in effect_history if r.get("val_mae_mm")]) for a in "xyz"}
+        if any(v[0] for v in mae.values()):
+            s.plots.append(Plot("effect_val_mae", "Effect model: validation MAE", "epoch", "mm", mae))
+    else:
+        s.text.append("effect model: not run (no history in RUN/metrics.json or RUN/best.pt)")
+    if transition_history:
+        s.plots.append(Plot("transition_loss", "Transition network", "epoch", "loss",
+                            _series(transition_history, ("train_loss", "val_loss"))))
+    else:
+        s.text.append("transition network: not run (RUN/transition_metrics.json missing: run 'symlearn train-transition')")
+    return s
+
+
+def benchmark_section(bench: dict | None, why: str = "") -> Section:
+    """Per-planner success, found rate and median planning time."""
+    title = "Planning benchmark"
+    if bench is None:
+        return not_run("benchmark", title, why or "no benchmark JSON given (--benchmark) or at RUN/benchmark.json")
+    rows = tuple((name, s.get("n_problems"), s.get("success_rate"), s.get("found_rate"), s.get("median_time_s"),
+                  s.get("success_rate_closed_loop"), s.get("mean_plan_length"))
+                 for name, s in (bench.get("summary") or {}).items())
+    text = [f"{bench.get('n_problems')} problems from {bench.get('problems')}, timeout {bench.get('timeout_s')} s"]
+    return Section("benchmark", title, text=text,
+                   tables=[Table("Success per planner", ("planner", "problems", "success", "found", "median time (s)",
+                                                         "closed-loop success", "mean plan length"), rows,
+                                 key="benchmark")])
+
+
+def plan_section(filmstrip: Path | None, gif: Path | None) -> Section:
+    """One executed plan as a filmstrip (start, then after each action)."""
+    title = "An executed plan"
+    if filmstrip is None:
+        return not_run("plan", title, "no recorded plan: run 'symlearn plan ... --record RUN/plan.gif' or "
+                                      "'symlearn benchmark ... --record RUN/recordings'")
+    return Section("plan", title, text=[f"recorded in {gif}: start, then the scene after each action "
+                                        "(arrow: pick -> release)"],
+                   images=[Image("plan_filmstrip", f"Filmstrip of {Path(gif).name}", filmstrip)])
+
+
+def scorecard_section(report: Report) -> Section:
+    """Every number the paper has, ours beside it, met or not met."""
+    rows = tuple((m.claim, m.ours, m.paper, m.criterion, m.verdict) for m in report.marks())
+    return Section("scorecard", "Against the paper",
+                   tables=[Table("Every number the paper reports", ("claim", "ours", "paper", "criterion", "verdict"),
+                                 rows, key="scorecard")])
+
+
+def history_from_checkpoint(run: Path) -> list | None:
+    """The effect model's per-epoch history from RUN/metrics.json, else from RUN/best.pt; None without either."""
+    doc, _ = read_json(Path(run) / "metrics.json")
+    if doc and isinstance(doc.get("history"), list):
+        return doc["history"]
+    if (Path(run) / "best.pt").is_file():
+        from symlearn.learning.checkpoint import CheckpointError, load_checkpoint
+
+        try:
+            return load_checkpoint(Path(run) / "best.pt").history
+        except CheckpointError:
+            return None
+    return None
