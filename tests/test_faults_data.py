@@ -192,6 +192,7 @@ MANIFEST_DAMAGE = {
 @pytest.mark.parametrize("command", ["train", "collect"])
 @pytest.mark.parametrize("damage", list(MANIFEST_DAMAGE))
 def test_damaged_manifest_is_one_line_error(data_copy, tmp_path, capsys, damage, command):
+    """A manifest whose shard list is missing or malformed: one line naming manifest.json, nothing written."""
     from conftest import TINY_DATA_ARGS
 
     mpath = data_copy / "manifest.json"
@@ -302,6 +303,20 @@ def test_collect_config_refuses_bad_values(kw):
 
     with pytest.raises(CollectError, match=f"{next(iter(kw))}="):
         CollectConfig(**{"n": 24, "shard_size": 2, **kw})
+
+
+@pytest.mark.parametrize("command", ["train", "collect"])
+def test_manifest_not_an_object_is_one_line_error(data_copy, tmp_path, capsys, command):
+    from conftest import TINY_DATA_ARGS
+
+    (data_copy / "manifest.json").write_text("[1, 2]")
+    if command == "train":
+        rc, _ = cli("train", "--data", data_copy, "--out", tmp_path / "run", *RUN_ARGS)
+    else:
+        rc, _ = cli("collect", "--out", data_copy, *TINY_DATA_ARGS, "--quiet")
+    line = _error_line(capsys, command, rc)
+    assert "manifest.json" in line and str(data_copy) in line, line
+    assert (data_copy / "manifest.json").read_text() == "[1, 2]" and not (tmp_path / "run").exists()
 
 
 def test_diverging_training_is_refused_and_leaves_no_run_folder(tiny_data, tmp_path, capsys):

@@ -74,7 +74,7 @@ def load_manifest(root: Path, require_complete: bool = True) -> dict:
     except (json.JSONDecodeError, UnicodeDecodeError) as e:
         raise DataError(f"{path} is not valid JSON: {e}") from None
     if not isinstance(m, dict) or m.get("kind") != DATA_KIND:
-        raise DataError(f"{root} is not a symlearn interaction data set")
+        raise DataError(f"{root} is not a symlearn interaction data set ({path} has no kind {DATA_KIND!r})")
     if m.get("format_version") != FORMAT_VERSION:
         raise DataError(f"{root} has data format version {m.get('format_version')!r}, "
                         f"this symlearn reads version {FORMAT_VERSION}")

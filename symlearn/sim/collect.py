@@ -4,8 +4,10 @@ Each shard is an independent run of whole episodes from its own seed `(seed, sha
 a fresh simulator, so the arrays do not depend on how many worker processes ran. Shards are
 written atomically (temp file, then rename); `manifest.json` records the settings, each
 finished shard's checksum, and the train / val / test split by shards. Re-running with the same
-settings resumes: finished shards whose checksum matches are skipped. The format is described
-in docs/DATA_FORMAT.md and read back by `symlearn.data.dataset`.
+settings resumes: finished shards whose checksum matches are skipped, and temp files a killed run
+left are removed. SIGINT or SIGTERM of the collecting process ends its workers (which also end on
+their own when their parent dies) and leaves no temp file. The format is described in
+docs/DATA_FORMAT.md and read back by `symlearn.data.dataset`.
 
     >>> cfg = CollectConfig(n=40, seed=1)          # doctest: +SKIP
     >>> collect(Path("data/tiny"), cfg, workers=2)  # doctest: +SKIP
@@ -248,6 +250,8 @@ def _resume_state(out: Path, cfg: CollectConfig) -> dict[int, dict]:
         old = json.loads(mpath.read_text())
     except (json.JSONDecodeError, UnicodeDecodeError) as e:
         raise CollectError(f"{mpath} is not valid JSON ({e}); remove it or choose another --out")
+    if not isinstance(old, dict):
+        raise CollectError(f"{mpath} is not a data set manifest (a JSON {type(old).__name__}); choose another --out")
     if old.get("kind") != DATA_KIND or old.get("format_version") != FORMAT_VERSION:
         raise CollectError(f"{out} holds a foreign data set or format version "
                            f"{old.get('format_version')!r} (expected {FORMAT_VERSION})")
