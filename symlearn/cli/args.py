@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 
 
 def int_range(text: str) -> tuple[int, int]:
@@ -22,3 +23,44 @@ def planner_list(text: str) -> list[str]:
     if not names:
         raise argparse.ArgumentTypeError("give at least one planner, e.g. astar,astar-ucs")
     return names
+
+
+def _integer(text: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+
+
+def positive_int(text: str) -> int:
+    """'3' -> 3; zero, negatives and non-integers are argparse errors naming the text."""
+    value = _integer(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} must be a positive integer")
+    return value
+
+
+def non_negative_int(text: str) -> int:
+    """'0' -> 0; negatives and non-integers are argparse errors naming the text."""
+    value = _integer(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r} must be a non-negative integer")
+    return value
+
+
+def positive_finite_float(text: str) -> float:
+    """'5e-4' -> 0.0005; zero, negatives, inf and nan are argparse errors naming the text."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value) or value <= 0:
+        raise argparse.ArgumentTypeError(f"{text!r} must be a positive finite number")
+    return value
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """An ArgumentParser whose refusals are one line, 'PROG: error: MESSAGE (see PROG --help)', exit code 2."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")

@@ -11,7 +11,7 @@ import sys
 import time
 from pathlib import Path
 
-from symlearn.cli.args import int_range
+from symlearn.cli.args import OneLineParser, int_range, non_negative_int, positive_finite_float, positive_int
 from symlearn.cli.pipeline import add_pipeline_command
 from symlearn.cli.planning import add_planning_commands
 from symlearn.cli.report import add_report_command
@@ -30,7 +30,7 @@ def cmd_collect(args: argparse.Namespace) -> int:
     collect(Path(args.out), cfg, workers=args.workers, show_progress=not args.quiet)
     summary = summarize(Path(args.out))
     summary["wall_s"] = round(time.time() - t0, 1)
-    print(json.dumps(summary, indent=2))
+    print(json.dumps(summary, indent=2, allow_nan=False))
     return 0
 
 
@@ -45,7 +45,7 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
     with TabletopSimulator(gui=args.gui) as sim:
         results = [run_scenario(sim, SCENARIO_BY_NAME[n]).to_json() for n in names]
     if args.json:
-        print(json.dumps(results, indent=2))
+        print(json.dumps(results, indent=2, allow_nan=False))
         return 0
     for r in results:
         print(f"{r['name']}  (pick {r['action'][0]} -> release {r['action'][1]}): {r['description']}")
@@ -85,7 +85,8 @@ def cmd_train(args: argparse.Namespace) -> int:
           f"-> {args.out}", file=sys.stderr)
     out = train(Path(args.data), Path(args.out), cfg, resume=not args.no_resume, show_progress=not args.quiet)
     last = out["history"][-1] if out["history"] else {}
-    print(json.dumps({"run": args.out, "best_val_loss": out["best_val_loss"], "last_epoch": last}, indent=2))
+    print(json.dumps({"run": args.out, "best_val_loss": out["best_val_loss"], "last_epoch": last}, indent=2,
+                     allow_nan=False))
     return 0
 
 
@@ -147,12 +148,12 @@ def add_collect_command(sub) -> None:
     """Add `collect` to the CLI's sub-parsers."""
     c = sub.add_parser("collect", help="collect interaction data in the simulator")
     c.add_argument("--out", required=True, help="data set directory (created, or resumed)")
-    c.add_argument("--n", type=int, default=12000, help="number of samples (actions)")
-    c.add_argument("--workers", type=int, default=1, help="worker processes")
-    c.add_argument("--seed", type=int, default=0)
+    c.add_argument("--n", type=positive_int, default=12000, help="number of samples (actions)")
+    c.add_argument("--workers", type=positive_int, default=1, help="worker processes")
+    c.add_argument("--seed", type=non_negative_int, default=0)
     c.add_argument("--objects", type=int_range, default=None,
                    help="objects per scene, e.g. 4-5 (default: the paper's mix of 1-3)")
-    c.add_argument("--shard-size", type=int, default=250, help="samples per shard")
+    c.add_argument("--shard-size", type=positive_int, default=250, help="samples per shard")
     c.add_argument("--quiet", action="store_true", help="no progress bar")
     c.set_defaults(func=cmd_collect)
 
@@ -172,17 +173,17 @@ def add_train_command(sub) -> None:
     t.add_argument("--data", required=True)
     t.add_argument("--out", required=True, help="run directory (resumed if it holds the same run)")
     t.add_argument("--preset", default="paper", choices=["paper", "quick"])
-    t.add_argument("--epochs", type=int)
-    t.add_argument("--batch-size", type=int)
-    t.add_argument("--lr", type=float)
-    t.add_argument("--seed", type=int)
-    t.add_argument("--max-train-samples", type=int, help="train on the first N samples only")
+    t.add_argument("--epochs", type=positive_int)
+    t.add_argument("--batch-size", type=positive_int)
+    t.add_argument("--lr", type=positive_finite_float)
+    t.add_argument("--seed", type=non_negative_int)
+    t.add_argument("--max-train-samples", type=positive_int, help="train on the first N samples only")
     t.add_argument("--no-attention", action="store_true", help="the DeepSym baseline without attention")
     t.add_argument("--constant-lr", action="store_true", help="no cosine decay of the learning rate")
     t.add_argument("--no-bf16", action="store_true", help="plain float32 (bf16 autocast is the default)")
     t.add_argument("--compile", action="store_true", help="torch.compile the model")
     t.add_argument("--no-resume", action="store_true", help="start over even if RUN/last.pt exists")
-    t.add_argument("--threads", type=int, help="CPU threads; use 1 per process when the cores are shared "
+    t.add_argument("--threads", type=positive_int, help="CPU threads; use 1 per process when the cores are shared "
                    "(OpenMP threads that wait for busy cores slow training several-fold)")
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=cmd_train)
@@ -226,8 +227,8 @@ def add_export_pddl_command(sub) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The `symlearn` parser with every sub-command, in the order `symlearn --help` lists them."""
-    p = argparse.ArgumentParser(prog="symlearn", description="Learn planning symbols from robot interaction.")
+    """The `symlearn` parser with every sub-command, in the order `symlearn --help` lists them; refusals are one line."""
+    p = OneLineParser(prog="symlearn", description="Learn planning symbols from robot interaction.")
     sub = p.add_subparsers(dest="command", required=True)
     add_collect_command(sub)
     add_scenarios_command(sub)
@@ -247,9 +248,9 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, RuntimeError, OSError) as e:
         print(f"symlearn {args.command}: error: {e}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as e:  # Ctrl-C, or SIGINT / SIGTERM turned into CollectInterrupted
         print(f"symlearn {args.command}: interrupted; re-run the same command to resume", file=sys.stderr)
-        return 130
+        return 128 + getattr(e, "signum", 2)
 
 
 if __name__ == "__main__":

@@ -74,13 +74,40 @@ def load_manifest(root: Path, require_complete: bool = True) -> dict:
     except (json.JSONDecodeError, UnicodeDecodeError) as e:
         raise DataError(f"{path} is not valid JSON: {e}") from None
     if not isinstance(m, dict) or m.get("kind") != DATA_KIND:
-        raise DataError(f"{root} is not a symlearn interaction data set")
+        raise DataError(f"{root} is not a symlearn interaction data set ({path} has no kind {DATA_KIND!r})")
     if m.get("format_version") != FORMAT_VERSION:
         raise DataError(f"{root} has data format version {m.get('format_version')!r}, "
                         f"this symlearn reads version {FORMAT_VERSION}")
+    check_shard_entries(path, m)
     if require_complete and not m.get("complete"):
         raise DataError(f"{root} is an unfinished collection; re-run the same 'symlearn collect' to finish it")
     return m
+
+
+def check_shard_entries(path: Path, m: dict) -> None:
+    """Refuse a manifest (read from `path`) whose `shards` list is missing or has a malformed entry."""
+    shards = m.get("shards")
+    if not isinstance(shards, list):
+        raise DataError(f"{path} has no list of shards ('shards' is {type(shards).__name__})")
+    for i, e in enumerate(shards):
+        problem = _shard_entry_problem(e)
+        if problem:
+            raise DataError(f"{path}: shard entry {i} {problem}")
+
+
+def _shard_entry_problem(e) -> str | None:
+    """What is wrong with one manifest shard entry, or None."""
+    if not isinstance(e, dict):
+        return f"is a {type(e).__name__}, not an object"
+    for key, kind in (("name", str), ("sha256", str), ("index", int), ("split", str), ("n_samples", int)):
+        if not isinstance(e.get(key), kind) or isinstance(e.get(key), bool):
+            return f"has no valid {key!r} (found {e.get(key)!r})"
+    name = e["name"]
+    if name != Path(name).name or not name.endswith(".npz") or name.startswith("."):
+        return f"names {name!r}, not a shard file in the data set folder"
+    if e["split"] not in SPLITS:
+        return f"has split {e['split']!r}, expected one of {', '.join(SPLITS)}"
+    return None
 
 
 def _load_shard(root: Path, entry: dict, verify: bool) -> dict[str, np.ndarray]:

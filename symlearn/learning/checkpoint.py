@@ -44,11 +44,11 @@ def save_checkpoint(path: Path, *, model, optimizer=None, epoch: int = 0, best_v
     """Write atomically: a crash never leaves half a checkpoint behind."""
     blob = {
         "kind": CHECKPOINT_KIND, "format_version": CHECKPOINT_FORMAT,
-        "config": json.dumps(model.cfg.to_json()),
+        "config": json.dumps(model.cfg.to_json(), allow_nan=False),
         "model": model.state_dict(),
         "optimizer": optimizer.state_dict() if optimizer is not None else {},
         "epoch": int(epoch), "best_val": float(best_val),
-        "history": json.dumps(history or []), "meta": json.dumps(meta or {}),
+        "history": json.dumps(history or [], allow_nan=False), "meta": json.dumps(meta or {}, allow_nan=False),
         "rng_states": dict(rng_states or {}),
         "effect_mean": torch.as_tensor(np.asarray(effect_mean if effect_mean is not None else np.zeros(3), np.float32)),
         "effect_std": torch.as_tensor(np.asarray(effect_std if effect_std is not None else np.ones(3), np.float32)),
@@ -59,33 +59,71 @@ def save_checkpoint(path: Path, *, model, optimizer=None, epoch: int = 0, best_v
 
 
 def load_checkpoint(path: Path, expect_config: ModelConfig | None = None) -> Checkpoint:
-    """A checkpoint file's record; refuses missing, foreign, other-format or other-config files."""
+    """A checkpoint file's record; refuses missing, foreign, other-format, malformed or other-config files."""
     path = Path(path)
     if not path.exists():
         raise CheckpointError(f"no checkpoint at {path}; train a model first ('symlearn train')")
     try:
         blob = torch.load(path, map_location="cpu", weights_only=True)
-    except Exception as e:  # torch raises several types for foreign or truncated files
-        raise CheckpointError(f"{path} is not a readable checkpoint ({type(e).__name__}: {str(e).splitlines()[0][:120]})") from None
+    except Exception as e:  # torch raises several types for foreign, empty or truncated files
+        raise CheckpointError(f"{path} is not a readable checkpoint ({_first_line(e)})") from None
     if not isinstance(blob, dict) or blob.get("kind") != CHECKPOINT_KIND:
         raise CheckpointError(f"{path} is not a symlearn effect-model checkpoint")
     if blob.get("format_version") != CHECKPOINT_FORMAT:
         raise CheckpointError(f"{path} has checkpoint format {blob.get('format_version')!r}, expected {CHECKPOINT_FORMAT}")
-    cfg = ModelConfig.from_json(json.loads(blob["config"]))
-    if expect_config is not None and cfg != expect_config:
+    try:
+        ck = _record(blob)
+    except (KeyError, TypeError, ValueError, AttributeError, json.JSONDecodeError) as e:
+        raise CheckpointError(f"{path} is a damaged checkpoint ({_first_line(e)})") from None
+    if expect_config is not None and ck.config != expect_config:
         raise CheckpointError(f"{path} was trained with another model config; use a new run directory")
+    return ck
+
+
+_FIELDS = {"config": str, "model": dict, "optimizer": dict, "epoch": int, "best_val": float, "history": str,
+           "meta": str, "rng_states": dict, "effect_mean": torch.Tensor, "effect_std": torch.Tensor}
+
+
+def _record(blob: dict) -> Checkpoint:
+    """The Checkpoint in a loaded blob; KeyError or TypeError names a missing or mistyped field."""
+    for key, kind in _FIELDS.items():
+        if key not in blob:
+            raise KeyError(f"field {key!r} missing")
+        if not isinstance(blob[key], kind):
+            raise TypeError(f"field {key!r} is {type(blob[key]).__name__}, expected {kind.__name__}")
+    cfg = ModelConfig.from_json(json.loads(blob["config"]))
     return Checkpoint(cfg, blob["model"], blob["optimizer"] or None, blob["epoch"], blob["best_val"],
                       json.loads(blob["history"]), blob["rng_states"],
                       blob["effect_mean"].numpy(), blob["effect_std"].numpy(), json.loads(blob["meta"]))
+
+
+def _first_line(e: BaseException) -> str:
+    """'Type: first line of the message' (at most 120 characters), also for an empty message."""
+    lines = str(e).strip().splitlines()
+    return f"{type(e).__name__}: {lines[0][:120]}" if lines else type(e).__name__
+
+
+def load_weights(model: torch.nn.Module, state: dict, path: Path) -> None:
+    """Load `state` into `model`, or one line naming `path` and the first keys that do not fit."""
+    own = model.state_dict()
+    missing = [k for k in own if k not in state]
+    unexpected = [k for k in state if k not in own]
+    shapes = [k for k in own if k in state and getattr(state[k], "shape", None) != own[k].shape]
+    if missing or unexpected or shapes:
+        parts = [f"{what} {', '.join(keys[:3])}{' ...' if len(keys) > 3 else ''} ({len(keys)})"
+                 for what, keys in (("missing", missing), ("unexpected", unexpected), ("shape differs", shapes)) if keys]
+        raise CheckpointError(f"{path}: the weights do not fit the model config stored with them: {'; '.join(parts)}")
+    model.load_state_dict(state)
 
 
 def load_effect_model(run_dir: Path, which: str = "best") -> tuple[AttentiveDeepSym, Checkpoint]:
     """The trained model of a run, in eval mode, with its checkpoint record."""
     if which not in ("best", "last"):
         raise CheckpointError(f"unknown checkpoint {which!r}: expected best or last")
-    ck = load_checkpoint(Path(run_dir) / f"{which}.pt")
+    path = Path(run_dir) / f"{which}.pt"
+    ck = load_checkpoint(path)
     model = AttentiveDeepSym(ck.config)
-    model.load_state_dict(ck.model_state)
+    load_weights(model, ck.model_state, path)
     return model.eval(), ck
 
 

@@ -22,7 +22,7 @@ import numpy as np
 import torch
 import torch.distributed as dist
 
-from symlearn.learning.checkpoint import load_checkpoint, save_checkpoint
+from symlearn.learning.checkpoint import load_checkpoint, load_weights, save_checkpoint
 from symlearn.data.dataset import InteractionData, data_fingerprint, load_split
 from symlearn.data.model_input import model_inputs
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig, masked_mse
@@ -50,6 +50,12 @@ class TrainConfig:
     compile: bool = False  # torch.compile the model
     max_train_samples: int | None = None  # a subset, for quick runs and tests
 
+    def __post_init__(self) -> None:
+        """Refuse settings that would train nothing, on a wrong subset, or into NaN."""
+        problem = _config_problem(self)
+        if problem:
+            raise ValueError(f"train config: {problem}")
+
     @staticmethod
     def from_preset(name: str, **overrides) -> "TrainConfig":
         """A named preset (paper, quick); model fields among the overrides go to the model config."""
@@ -64,7 +70,7 @@ class TrainConfig:
         """The config as plain JSON, as stored in checkpoints and config.json."""
         d = dataclasses.asdict(self)
         d["model"] = self.model.to_json()
-        return json.loads(json.dumps(d))  # tuples as lists, as read back from disk
+        return json.loads(json.dumps(d, allow_nan=False))  # tuples as lists, as read back from disk
 
     @staticmethod
     def from_json(d: dict) -> "TrainConfig":
@@ -72,6 +78,29 @@ class TrainConfig:
         d = dict(d)
         d["model"] = ModelConfig.from_json(d["model"])
         return TrainConfig(**d)
+
+
+def _is_int(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _is_real(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _config_problem(c: TrainConfig) -> str | None:
+    """What is wrong with a TrainConfig's values, or None."""
+    checks = [
+        (_is_int(c.epochs) and c.epochs >= 1, f"epochs={c.epochs!r} must be a positive integer"),
+        (_is_int(c.batch_size) and c.batch_size >= 1, f"batch_size={c.batch_size!r} must be a positive integer"),
+        (_is_real(c.lr) and c.lr > 0, f"lr={c.lr!r} must be a positive finite number"),
+        (_is_real(c.weight_decay) and c.weight_decay >= 0, f"weight_decay={c.weight_decay!r} must be finite and >= 0"),
+        (_is_real(c.lr_min_ratio) and 0 <= c.lr_min_ratio <= 1, f"lr_min_ratio={c.lr_min_ratio!r} must be in [0, 1]"),
+        (_is_int(c.seed) and c.seed >= 0, f"seed={c.seed!r} must be a non-negative integer"),
+        (c.max_train_samples is None or (_is_int(c.max_train_samples) and c.max_train_samples >= 1),
+         f"max_train_samples={c.max_train_samples!r} must be a positive integer (or None: all)"),
+    ]
+    return next((msg for ok, msg in checks if not ok), None)
 
 
 @dataclass(frozen=True)
@@ -167,6 +196,7 @@ def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, 
     """Train (or resume training) an effect model; returns the metrics written to RUN/metrics.json."""
     rank, world = _dist_info()
     run_dir = Path(run_dir)
+    check_run_dir(run_dir, Path(data_dir))
     device = torch.device("cuda", rank % torch.cuda.device_count()) if torch.cuda.is_available() else torch.device("cpu")
     fingerprint = data_fingerprint(data_dir)
     tr, va, mean, std = _load_training_splits(data_dir, cfg)
@@ -179,6 +209,7 @@ def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, 
     meta = {"train_config": cfg.to_json(), "data": str(data_dir), "data_fingerprint": fingerprint}
     if resume and (run_dir / "last.pt").exists():
         start_epoch, best, history = _resume(run_dir, cfg, fingerprint, model, opt, gen, noise_gen)
+    created = not run_dir.exists()
     if rank == 0:
         run_dir.mkdir(parents=True, exist_ok=True)
         atomic_write_json(run_dir / "config.json", {**meta, "seed": cfg.seed, "versions": versions(),
@@ -188,13 +219,52 @@ def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, 
         net = torch.nn.parallel.DistributedDataParallel(model, device_ids=[device.index] if device.type == "cuda" else None)
     loop = _Loop(cfg, run_dir, model, torch.compile(net) if cfg.compile else net, opt, gen, noise_gen, device,
                  rank, world, mean, std, meta, show_progress)
-    for epoch in range(start_epoch, cfg.epochs):
+    try:
+        best = _run_epochs(loop, tr, va, start_epoch, best, history)
+    except BaseException:
+        if rank == 0 and created:
+            _remove_unstarted_run(run_dir)
+        raise
+    return _finish(loop, history, best)
+
+
+def _run_epochs(loop: _Loop, tr: SplitTensors, va: SplitTensors, start_epoch: int, best: float,
+                history: list) -> float:
+    """Epochs start_epoch.. of the run (rank 0 saves each); appends to history, returns the best val loss."""
+    for epoch in range(start_epoch, loop.cfg.epochs):
         train_loss, seen, train_time = _train_epoch(loop, tr, epoch)
         row, val_loss = _validate(loop, va, epoch, train_loss, seen, train_time)
         history.append(row)
-        if rank == 0:
+        if loop.rank == 0:
             best = _save_epoch(loop, epoch, row, val_loss, best, history)
-    return _finish(loop, history, best)
+    return best
+
+
+def _remove_unstarted_run(run_dir: Path) -> None:
+    """A run folder this call created, failed before its first checkpoint: remove its config.json and the folder."""
+    if (run_dir / "last.pt").exists():
+        return
+    (run_dir / "config.json").unlink(missing_ok=True)
+    try:
+        run_dir.rmdir()  # only when nothing else is in it
+    except OSError:
+        pass
+
+
+def check_run_dir(run_dir: Path, data_dir: Path) -> None:
+    """Refuse a run folder that is the data set, or any data set folder: checkpoints would mix into it."""
+    from symlearn.data.dataset import DATA_KIND
+
+    if run_dir.resolve() == data_dir.resolve():
+        raise TrainingError(f"--out {run_dir} is the data set folder itself; choose a separate run folder")
+    manifest = run_dir / "manifest.json"
+    if manifest.exists():
+        try:
+            kind = json.loads(manifest.read_text()).get("kind")
+        except (ValueError, UnicodeDecodeError, AttributeError):
+            kind = None
+        what = "a symlearn data set" if kind == DATA_KIND else "a folder with a manifest.json"
+        raise TrainingError(f"--out {run_dir} holds {what} ({manifest}); choose a separate run folder")
 
 
 def _load_training_splits(data_dir: Path, cfg: TrainConfig) -> tuple[SplitTensors, SplitTensors, np.ndarray, np.ndarray]:
@@ -217,7 +287,7 @@ def _resume(run_dir: Path, cfg: TrainConfig, fingerprint: str, model: AttentiveD
     if (_resumable(ck.meta.get("train_config", {})) != _resumable(cfg.to_json())
             or ck.meta.get("data_fingerprint") != fingerprint):
         raise TrainingError(f"{run_dir} holds a run with other settings or data; use a new --out or --no-resume")
-    model.load_state_dict(ck.model_state)
+    load_weights(model, ck.model_state, run_dir / "last.pt")
     opt.load_state_dict(ck.optimizer_state)
     gen.set_state(ck.rng_states["shuffle"])
     noise_gen.set_state(ck.rng_states["noise"])
@@ -264,6 +334,9 @@ def _validate(loop: _Loop, va: SplitTensors, epoch: int, train_loss: float, seen
     cfg = loop.cfg
     pred = predict_effects(loop.model, va, bf16=cfg.bf16)
     val_loss = float(masked_mse(pred, va.effect, va.mask))
+    if not math.isfinite(val_loss):
+        raise TrainingError(f"validation loss became {val_loss} at epoch {epoch + 1}; "
+                            "lower the learning rate or check the data")
     row = {"epoch": epoch + 1, "train_loss": round(train_loss, 5), "val_loss": round(val_loss, 5),
            "val_mae_mm": mae_mm(pred, va, loop.std), "lr": round(epoch_lr(cfg, epoch), 7),
            "crops_per_s": round(seen * loop.world / train_time, 1), "epoch_time_s": round(train_time, 1)}
@@ -281,7 +354,7 @@ def _save_epoch(loop: _Loop, epoch: int, row: dict, val_loss: float, best: float
     save_checkpoint(loop.run_dir / "last.pt", **state)
     if improved:
         save_checkpoint(loop.run_dir / "best.pt", **state)
-    atomic_write_json(loop.run_dir / "metrics.json", {"history": history, "best_val_loss": best,
+    atomic_write_json(loop.run_dir / "metrics.json", {"history": history, "best_val_loss": finite_or_none(best),
                                                       "data_fingerprint": loop.meta["data_fingerprint"]})
     if loop.show_progress:
         print(f"epoch {epoch + 1}: train {row['train_loss']:.4f} val {val_loss:.4f} "
@@ -291,13 +364,18 @@ def _save_epoch(loop: _Loop, epoch: int, row: dict, val_loss: float, best: float
 
 def _finish(loop: _Loop, history: list, best: float) -> dict:
     """The run's result; with several ranks, also whether they ended with identical weights."""
-    result = {"history": history, "best_val_loss": best}
+    result = {"history": history, "best_val_loss": finite_or_none(best)}
     if loop.world > 1:
         result["ranks_identical"] = _ranks_identical(loop.model)
         if loop.rank == 0:
             atomic_write_json(loop.run_dir / "metrics.json", {**result, "data_fingerprint": loop.meta["data_fingerprint"],
                                                               "world_size": loop.world})
     return result
+
+
+def finite_or_none(x: float) -> float | None:
+    """x, or None (JSON null) when it is NaN or infinite: strict JSON has no such numbers."""
+    return float(x) if math.isfinite(x) else None
 
 
 def epoch_lr(cfg: TrainConfig, epoch: int) -> float:

@@ -4,36 +4,51 @@ Each shard is an independent run of whole episodes from its own seed `(seed, sha
 a fresh simulator, so the arrays do not depend on how many worker processes ran. Shards are
 written atomically (temp file, then rename); `manifest.json` records the settings, each
 finished shard's checksum, and the train / val / test split by shards. Re-running with the same
-settings resumes: finished shards whose checksum matches are skipped. The format is described
-in docs/DATA_FORMAT.md and read back by `symlearn.data.dataset`.
+settings resumes: finished shards whose checksum matches are skipped, and temp files a killed run
+left are removed. SIGINT or SIGTERM of the collecting process ends its workers (which also end on
+their own when their parent dies) and leaves no temp file. The format is described in
+docs/DATA_FORMAT.md and read back by `symlearn.data.dataset`.
 
     >>> cfg = CollectConfig(n=40, seed=1)          # doctest: +SKIP
     >>> collect(Path("data/tiny"), cfg, workers=2)  # doctest: +SKIP
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import math
 import multiprocessing as mp
 import os
+import signal
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterator
 
 import numpy as np
 
 from symlearn.sim.exploration import ExplorationConfig, sample_action, sample_scene_spec
-from symlearn.data.dataset import DATA_KIND, FORMAT_VERSION, SPLITS
-from symlearn.provenance import atomic_write_json, sha256_file, versions
+from symlearn.data.dataset import DATA_KIND, FORMAT_VERSION, SPLITS, DataError, check_shard_entries
+from symlearn.provenance import atomic_write_bytes, atomic_write_json, sha256_file, versions
 from symlearn.sim.simulator import SimConfig, TabletopSimulator
 
 MAX_FAILED_EPISODES = 1000  # consecutive episodes without a sample before collect_shard gives up
+PARENT_POLL_S = 0.5  # how often a worker checks that the collecting process is still alive
+TEMP_PATTERNS = (".manifest.json.tmp*", ".manifest.json.*.tmp", ".shard_*.tmp*.npz", ".shard_*.npz.*.tmp")
 
 
 class CollectError(RuntimeError):
     """A collection request that cannot be honoured (bad settings, foreign or mismatched DIR)."""
+
+
+class CollectInterrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM reached the collecting process; the workers are ended and resuming finishes the job."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(f"signal {signal.Signals(signum).name}")
+        self.signum = signum
 
 
 @dataclass(frozen=True)
@@ -47,10 +62,12 @@ class CollectConfig:
     sim: SimConfig = field(default_factory=SimConfig)
 
     def __post_init__(self) -> None:
-        if not isinstance(self.n, int) or self.n < 3:
+        if not _is_int(self.n) or self.n < 3:
             raise CollectError(f"n={self.n!r}: need at least 3 samples (one shard per split)")
-        if self.shard_size < 1:
-            raise CollectError(f"shard_size={self.shard_size} must be positive")
+        if not _is_int(self.shard_size) or self.shard_size < 1:
+            raise CollectError(f"shard_size={self.shard_size!r} must be a positive integer")
+        if not _is_int(self.seed) or self.seed < 0:
+            raise CollectError(f"seed={self.seed!r} must be a non-negative integer")
 
     @property
     def max_objects(self) -> int:
@@ -69,7 +86,12 @@ class CollectConfig:
         return ["train"] * (n_shards - 2 * n_hold) + ["val"] * n_hold + ["test"] * n_hold
 
     def to_json(self) -> dict:
-        return json.loads(json.dumps(dataclasses.asdict(self)))
+        """The settings as strict JSON (tuples as lists), as recorded in manifest.json."""
+        return json.loads(json.dumps(dataclasses.asdict(self), allow_nan=False))
+
+
+def _is_int(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
 
 
 def _empty_arrays(size: int, k: int, s: int) -> dict[str, np.ndarray]:
@@ -155,21 +177,53 @@ def collect_shard(cfg: CollectConfig, index: int, size: int,
 
 
 def shard_name(index: int) -> str:
+    """File name of shard `index`."""
     return f"shard_{index:05d}.npz"
 
 
 def _write_shard(out: Path, index: int, arrays: dict[str, np.ndarray]) -> dict:
+    """Write one shard atomically (pddl_export.files: temp file, fsync, rename); returns its manifest entry."""
+    import io
+
     final = out / shard_name(index)
-    tmp = out / f".{final.stem}.tmp{os.getpid()}.npz"
-    np.savez_compressed(tmp, **arrays)
-    os.replace(tmp, final)
+    buf = io.BytesIO()
+    np.savez_compressed(buf, **arrays)
+    atomic_write_bytes(final, buf.getvalue())
     return {"name": final.name, "index": index, "n_samples": int(arrays["action"].shape[0]),
             "episodes": int(arrays["episode"].max()) + 1 if arrays["episode"].size else 0,
             "dropped_samples": int(arrays["dropped"]), "sha256": sha256_file(final)}
 
 
+_progress_queue = None  # a worker's queue of progress counts, set by _worker_init
+
+
+def _worker_init(q, parent_pid: int) -> None:
+    """In each worker: ignore SIGINT (the parent decides), end cleanly on SIGTERM, and end when the parent dies."""
+    global _progress_queue
+    _progress_queue = q
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, _exit_on_sigterm)
+    threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True, name="watch-parent").start()
+
+
+def _exit_on_sigterm(signum, frame) -> None:
+    """SIGTERM in a worker: unwind (a shard being written removes its temp file) and exit."""
+    raise SystemExit(128 + signum)
+
+
+def _watch_parent(parent_pid: int) -> None:
+    """Poll the parent; once it is gone, SIGTERM this worker, and after a grace period end it hard."""
+    while os.getppid() == parent_pid:
+        time.sleep(PARENT_POLL_S)
+    os.kill(os.getpid(), signal.SIGTERM)
+    time.sleep(10)
+    os._exit(1)
+
+
 def _worker(args) -> dict:
-    cfg, out, index, size, q = args
+    """One shard in a pool worker: collect it, write it, return its manifest entry."""
+    cfg, out, index, size = args
+    q = _progress_queue
     arrays = collect_shard(cfg, index, size, progress=(lambda n: q.put(n)) if q is not None else None)
     return _write_shard(Path(out), index, arrays)
 
@@ -196,6 +250,8 @@ def _resume_state(out: Path, cfg: CollectConfig) -> dict[int, dict]:
         old = json.loads(mpath.read_text())
     except (json.JSONDecodeError, UnicodeDecodeError) as e:
         raise CollectError(f"{mpath} is not valid JSON ({e}); remove it or choose another --out")
+    if not isinstance(old, dict):
+        raise CollectError(f"{mpath} is not a data set manifest (a JSON {type(old).__name__}); choose another --out")
     if old.get("kind") != DATA_KIND or old.get("format_version") != FORMAT_VERSION:
         raise CollectError(f"{out} holds a foreign data set or format version "
                            f"{old.get('format_version')!r} (expected {FORMAT_VERSION})")
@@ -203,8 +259,12 @@ def _resume_state(out: Path, cfg: CollectConfig) -> dict[int, dict]:
         diff = _first_difference(old.get("settings"), cfg.to_json())
         raise CollectError(f"{out} was collected with different settings ({diff}); "
                            "use the same arguments to resume or choose another --out")
+    try:
+        check_shard_entries(mpath, old)
+    except DataError as e:
+        raise CollectError(f"{e}; remove it or choose another --out") from None
     done = {}
-    for d in old.get("shards", []):
+    for d in old["shards"]:
         p = out / d["name"]
         if p.exists() and sha256_file(p) == d["sha256"]:
             done[int(d["index"])] = {k: v for k, v in d.items() if k != "split"}
@@ -219,15 +279,90 @@ def _first_difference(a, b, path: str = "") -> str:
     return f"{path}: {a!r} there, {b!r} now"
 
 
+def remove_temp_files(out: Path) -> list[str]:
+    """Delete what a killed collection can leave in `out`: temp files of the manifest and of shards."""
+    removed = []
+    for pattern in TEMP_PATTERNS:
+        for p in out.glob(pattern):
+            p.unlink(missing_ok=True)
+            removed.append(p.name)
+    return removed
+
+
+def _refuse_run_folder(out: Path) -> None:
+    """Refuse to collect into a training run's folder (it holds checkpoints or a run's config.json)."""
+    if (out / "manifest.json").exists():
+        return
+    if any((out / name).exists() for name in ("best.pt", "last.pt", "transition.pt", "metrics.json")):
+        raise CollectError(f"{out} is a training run folder (it holds checkpoints); choose another --out for data")
+
+
+@contextlib.contextmanager
+def _interruptible() -> Iterator[None]:
+    """Turn SIGTERM (and SIGINT) into CollectInterrupted in the main thread, so cleanup runs; later ones are ignored."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    sigs = (signal.SIGINT, signal.SIGTERM)
+    old = {s: signal.getsignal(s) for s in sigs}
+
+    def handler(signum, frame):
+        for s in sigs:  # a second signal must not interrupt the cleanup of the first
+            signal.signal(s, signal.SIG_IGN)
+        raise CollectInterrupted(signum)
+
+    for s in sigs:
+        signal.signal(s, handler)
+    try:
+        yield
+    finally:
+        for s in sigs:
+            signal.signal(s, old[s])
+
+
+def _collect_parallel(out: Path, cfg: CollectConfig, todo: list[int], workers: int,
+                      finish: Callable[[dict], None], update: Callable[[int], None]) -> None:
+    """Collect shards `todo` in a pool of spawned workers; ending the pool ends every worker."""
+    sizes = cfg.shard_sizes()
+    ctx = mp.get_context("spawn")
+    q = ctx.SimpleQueue()  # progress counts; pipes only: no manager process, no temp folder
+    pool = ctx.Pool(min(workers, len(todo)), initializer=_worker_init, initargs=(q, os.getpid()))
+    try:
+        results = pool.imap_unordered(_worker, [(cfg, str(out), i, sizes[i]) for i in todo])
+        remaining = len(todo)
+        while remaining:
+            while not q.empty():
+                update(q.get())
+            try:
+                finish(results.next(timeout=0.1))
+                remaining -= 1
+            except mp.TimeoutError:
+                pass
+        while not q.empty():
+            update(q.get())
+        pool.close()  # the workers take the end-of-work sentinel and exit
+    except BaseException:
+        pool.terminate()  # SIGTERM to every worker: each unwinds, removing a half-written shard
+        raise
+    finally:
+        pool.join()
+        q.close()
+        remove_temp_files(out)
+
+
 def collect(out: Path, cfg: CollectConfig, workers: int = 1, show_progress: bool = True) -> dict:
-    """Collect (or finish collecting) a data set into `out`; returns the final manifest."""
+    """Collect (or finish collecting) a data set into `out`; returns the final manifest.
+
+    SIGINT or SIGTERM ends the workers, removes temp files and raises CollectInterrupted;
+    re-running the same call resumes.
+    """
     out = Path(out)
-    if workers < 1:
-        raise CollectError(f"workers={workers} must be at least 1")
+    if not _is_int(workers) or workers < 1:
+        raise CollectError(f"workers={workers!r} must be at least 1")
+    _refuse_run_folder(out)
     done = _resume_state(out, cfg)
     out.mkdir(parents=True, exist_ok=True)
-    for stale in out.glob(".*.tmp*.npz"):
-        stale.unlink()
+    remove_temp_files(out)
     sizes = cfg.shard_sizes()
     todo = [i for i in range(len(sizes)) if i not in done]
     from tqdm import tqdm
@@ -239,28 +374,16 @@ def collect(out: Path, cfg: CollectConfig, workers: int = 1, show_progress: bool
         done[info["index"]] = info
         atomic_write_json(out / "manifest.json", _manifest(cfg, done))
 
-    atomic_write_json(out / "manifest.json", _manifest(cfg, done))
-    if workers == 1 or len(todo) <= 1:
-        for i in todo:
-            finish(_write_shard(out, i, collect_shard(cfg, i, sizes[i], progress=bar.update)))
-    else:
-        ctx = mp.get_context("spawn")
-        with ctx.Manager() as manager:
-            q = manager.Queue()
-            with ctx.Pool(min(workers, len(todo))) as pool:
-                results = pool.imap_unordered(_worker, [(cfg, str(out), i, sizes[i], q) for i in todo])
-                remaining = len(todo)
-                while remaining:
-                    while not q.empty():
-                        bar.update(q.get())
-                    try:
-                        finish(results.next(timeout=0.1))
-                        remaining -= 1
-                    except mp.TimeoutError:
-                        pass
-                while not q.empty():
-                    bar.update(q.get())
-    bar.close()
+    with _interruptible():
+        try:
+            atomic_write_json(out / "manifest.json", _manifest(cfg, done))
+            if workers == 1 or len(todo) <= 1:
+                for i in todo:
+                    finish(_write_shard(out, i, collect_shard(cfg, i, sizes[i], progress=bar.update)))
+            else:
+                _collect_parallel(out, cfg, todo, workers, finish, bar.update)
+        finally:
+            bar.close()
     manifest = _manifest(cfg, done)
     atomic_write_json(out / "manifest.json", manifest)
     return manifest
