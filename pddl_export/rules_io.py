@@ -38,14 +38,32 @@ def rules_from_json(d: dict) -> RuleSet:
                            tuple((c(x), int(n)) for x, n in r["fewer_than"])) for r in d["rules"])
         return RuleSet(int(d["bits"]), tuple(map(c, d["vocabulary"])), int(d["max_objects"]), rules,
                        int(d["n_rules_before_generalization"]))
-    except (KeyError, TypeError, ValueError) as e:
+    except KeyError as e:
+        raise ValueError(f"malformed rules file: missing field {e}") from None
+    except (TypeError, ValueError, AttributeError) as e:
         raise ValueError(f"malformed rules file: {type(e).__name__}: {e}") from None
 
 
 def load_rules(run_dir: Path) -> tuple[RuleSet, str]:
-    """RUN/pddl/rules.json and the model hash recorded with it."""
+    """RUN/pddl/rules.json and the model hash recorded with it; ValueError (one line, naming the file) if unreadable."""
     path = Path(run_dir) / PDDL_DIR / RULES_FILE
     if not path.exists():
         raise ValueError(f"no exported rules at {path}; run 'symlearn export-pddl --run {run_dir}' first")
-    d = json.loads(path.read_text())
-    return rules_from_json(d), d.get("model_hash", "")
+    try:
+        d = json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{path}: not valid JSON (line {e.lineno}, column {e.colno}: {e.msg}); "
+                         f"re-run 'symlearn export-pddl --run {run_dir}'") from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise ValueError(f"{path}: cannot be read: {type(e).__name__}: {e}") from None
+    if not isinstance(d, dict):
+        raise ValueError(f"{path}: not a rules file (a JSON {type(d).__name__}, expected an object with "
+                         f"'bits', 'vocabulary', 'max_objects' and 'rules')")
+    try:
+        rules = rules_from_json(d)
+    except ValueError as e:
+        raise ValueError(f"{path}: {e}") from None
+    model_hash = d.get("model_hash", "")
+    if not isinstance(model_hash, str):
+        raise ValueError(f"{path}: malformed rules file: model_hash must be a string, got {model_hash!r}")
+    return rules, model_hash

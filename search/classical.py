@@ -5,12 +5,13 @@
     >>> r.status, r.plan, r.extra["planner_time_s"]                                      # doctest: +SKIP
     (<PlanStatus.SOLVED: 'solved'>, (3, 22), 0.41)
 
-The whole call (parse, compile, plan, map back, validate, simulate) runs in a child process
-that the caller kills if it does not answer within timeout_s + grace_s, so no planner can
-hang the caller; the planner itself gets the time left of timeout_s. Pyperplan has no time
-limit of its own: a run that ends after timeout_s is reported as TIMEOUT. Fast Downward and
-SymK run as subprocesses in their own session, killed by unified-planning at the time left;
-grace_s leaves room for that before the guard fires.
+The whole call (parse, compile, plan, map back, validate, simulate) runs in a worker process
+that leads its own process group, with the planner subprocesses unified-planning starts kept
+in that group and its temporary files in a symlearn-up-* folder (search.processes). The caller
+kills the whole group if no answer came within timeout_s + grace_s (a TIMEOUT), and on a kill
+of the caller; the planner itself gets the time left of timeout_s. Pyperplan has no time limit
+of its own: a run that ends after timeout_s is reported as TIMEOUT. With cache_domain, the
+domain is parsed in the caller (once, cached) under the same time limit.
 
 When the chosen engine does not accept the problem as written, unified-planning compilers
 are applied in the order given in docs/DESIGN.md ("Encoding learned rules for the planners":
@@ -29,13 +30,19 @@ from __future__ import annotations
 
 import math
 import multiprocessing as mp
+import os
 import re
+import signal
+import subprocess
+import tempfile
 import time
 import warnings
 from dataclasses import dataclass
 from typing import Any
 
 from pddl_export.pddl_writer import action_id_from_name
+from search.processes import (DeadlineExceeded, forget_inherited, kill_group, planner_guard, register_group,
+                              temp_dir, unregister_group, within)
 from search.result import PlanResult, PlanStatus, failed, one_line
 from search.up_problem import parsed_domain, predicted_states, problem_on_domain, with_only_actions
 
@@ -277,8 +284,30 @@ def _solve_here(domain_text: str, problem_text: str, planner: str, timeout_s: fl
     return _validated_plan(original, res.plan, comp.chain, planner, t0, expansions, extra)
 
 
-def _worker(conn: Any, *args: Any) -> None:
+class _SameGroupPopen(subprocess.Popen):
+    """Popen that keeps the planner in the worker's process group (unified-planning starts it in a new session)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs["start_new_session"] = False
+        super().__init__(*args, **kwargs)
+
+
+def _enter_own_group(tmp: str) -> None:
+    """In the worker: lead a new process group that keeps the planners, with temp files and cwd in tmp."""
+    forget_inherited()
+    os.setsid()
+    # unified-planning stops a planner at its time limit with SIGTERM to the planner's group, which is
+    # now this one: the worker outlives it (a handler, unlike SIG_IGN, is not inherited across exec)
+    signal.signal(signal.SIGTERM, lambda signum, frame: None)
+    subprocess.Popen = _SameGroupPopen  # type: ignore[misc] - this process only runs planner calls
+    tempfile.tempdir = tmp
+    os.environ["TMPDIR"] = tmp
+    os.chdir(tmp)
+
+
+def _worker(conn: Any, tmp: str, *args: Any) -> None:
     try:
+        _enter_own_group(tmp)
         result = _solve_here(*args).to_json()
     except BaseException as e:  # noqa: BLE001 - the parent must hear about anything
         result = {"error": one_line(f"{type(e).__name__}: {e}")}
@@ -301,11 +330,8 @@ def _check_limits(timeout_s: float, grace_s: float) -> None:
         raise ValueError(f"grace_s must be >= 0, got {grace_s!r}")
 
 
-def _prepare(name: str, domain_text: str, cache_domain: bool, t0: float) -> Any:
-    """Load unified-planning (so a forked child starts with it) and, with cache_domain, the parsed domain.
-
-    Returns the domain (None without cache_domain) or a failed PlanResult.
-    """
+def _prepare(name: str, t0: float) -> PlanResult | None:
+    """Load unified-planning (so a forked child starts with it): None, or a failed PlanResult."""
     if name not in PLANNERS:
         return failed(name or "unknown", PlanStatus.ERROR, t0, f"unknown planner {name!r}; known: {', '.join(PLANNERS)}",
                       total_time_s=time.perf_counter() - t0)
@@ -317,37 +343,49 @@ def _prepare(name: str, domain_text: str, cache_domain: bool, t0: float) -> Any:
     except ImportError as e:
         return failed(name, PlanStatus.ERROR, t0, f"unified-planning is not installed: {e}",
                       total_time_s=time.perf_counter() - t0)
-    if not cache_domain:
-        return None
-    try:
-        return parsed_domain(domain_text)
-    except Exception as e:  # noqa: BLE001
-        return failed(name, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}",
-                      total_time_s=time.perf_counter() - t0)
+    return None
 
 
 def _run_guarded(args: tuple, wait_s: float) -> tuple[Any, int | None]:
-    """_solve_here(*args) in a child process: (its JSON answer, None if it died, or "late"; the child's exit code)."""
+    """_solve_here(*args) in a child process group: (its JSON answer, None if it died, or "late"; its exit code).
+
+    The group (the worker and the planner it started) is killed when the answer is in, at wait_s,
+    and on a kill of this process; its temporary files live in a symlearn-up-* folder removed on return.
+    """
     ctx = _context()
-    recv, send = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_worker, args=(send, *args), daemon=True)
-    answer: Any = None  # stays None if the child dies (or on an exception here); "late" on the guard
-    proc.start()
-    send.close()
-    try:
-        if recv.poll(wait_s):
-            try:
-                answer = recv.recv()
-            except EOFError:
-                answer = None
-        else:
-            answer = "late"
-    finally:
-        recv.close()
-        if not isinstance(answer, dict):
-            proc.kill()
-        proc.join(5.0)
+    answer: Any = None  # stays None if the child dies (or on an exception here); "late" at the deadline
+    with planner_guard(), temp_dir("symlearn-up-") as tmp:
+        recv, send = ctx.Pipe(duplex=False)
+        proc = ctx.Process(target=_worker, args=(send, str(tmp), *args), daemon=True)
+        proc.start()
+        register_group(proc.pid)
+        send.close()
+        try:
+            if recv.poll(max(wait_s, 0.0)):
+                try:
+                    answer = recv.recv()
+                except EOFError:
+                    answer = None
+            else:
+                answer = "late"
+        finally:
+            recv.close()
+            kill_group(proc.pid)
+            proc.join(5.0)
+            unregister_group(proc.pid)
     return answer, proc.exitcode
+
+
+def _cached_domain(name: str, domain_text: str, timeout_s: float, t0: float) -> Any:
+    """The parsed domain (cached across calls), parsed within the call's time limit: the domain or a failed PlanResult."""
+    try:
+        return within(lambda: parsed_domain(domain_text), timeout_s - (time.perf_counter() - t0))
+    except DeadlineExceeded:
+        return failed(name, PlanStatus.TIMEOUT, t0, f"time limit of {timeout_s:g} s reached while parsing the domain",
+                      total_time_s=time.perf_counter() - t0, planner_time_s=0.0)
+    except Exception as e:  # noqa: BLE001
+        return failed(name, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}",
+                      total_time_s=time.perf_counter() - t0)
 
 
 def solve_pddl(
@@ -357,7 +395,7 @@ def solve_pddl(
     timeout_s: float,
     *,
     compile_conditional_effects: bool = False,
-    grace_s: float = 3.0,
+    grace_s: float = 0.5,
     cache_domain: bool = False,
     problem: Any = None,
 ) -> PlanResult:
@@ -365,23 +403,32 @@ def solve_pddl(
 
     Planners: "fast-downward" (satisficing, lama-first), "fast-downward-opt" (LM-cut; no conditional
     effects), "fast-downward-blind" (blind A*, optimal, takes conditional effects), "symk", "symk-opt",
-    "pyperplan". The call takes at most about timeout_s + grace_s seconds. With cache_domain, the domain
-    is parsed once in this process (parsed_domain; the first call's time includes it, outside
-    the guard) and each call reads only the problem. With `problem` (a unified-planning Problem
-    equal to the texts, e.g. search.up_problem.strips_problem), nothing is parsed.
+    "pyperplan". The call takes at most about timeout_s + grace_s seconds (plus loading unified-planning
+    once per process); past timeout_s it is a TIMEOUT. With cache_domain, the domain is parsed once in
+    this process (parsed_domain; within the first call's time limit) and each call reads only the problem.
+    With `problem` (a unified-planning Problem equal to the texts, e.g. search.up_problem.strips_problem),
+    nothing is parsed.
     """
     t0 = time.perf_counter()
     _check_limits(timeout_s, grace_s)
     name = str(planner)
-    domain = _prepare(name, domain_text, cache_domain, t0)
+    refused = _prepare(name, t0)
+    if refused is not None:
+        return refused
+    domain = _cached_domain(name, domain_text, timeout_s, t0) if cache_domain and problem is None else None
     if isinstance(domain, PlanResult):
         return domain
-    answer, exitcode = _run_guarded((domain_text, problem_text, name, float(timeout_s), compile_conditional_effects,
-                                     domain, problem), timeout_s + grace_s)
+    left = timeout_s - (time.perf_counter() - t0)
+    if left <= 0:
+        return failed(name, PlanStatus.TIMEOUT, t0, f"time limit of {timeout_s:g} s reached before planning",
+                      total_time_s=time.perf_counter() - t0, planner_time_s=0.0)
+    answer, exitcode = _run_guarded((domain_text, problem_text, name, left, compile_conditional_effects,
+                                     domain, problem), left + grace_s)
     total = time.perf_counter() - t0
     if answer == "late":
-        return failed(name, PlanStatus.TIMEOUT, t0, f"no answer within {timeout_s:g} s + {grace_s:g} s grace; "
-                      "planner process killed", total_time_s=total)
+        return failed(name, PlanStatus.TIMEOUT, t0, f"{name} hit the {timeout_s:g} s time limit "
+                      f"(no answer after {total:.2f} s; planner process group killed)",
+                      total_time_s=total, planner_time_s=total)
     if answer is None:
         return failed(name, PlanStatus.ERROR, t0, f"planner process died (exit code {exitcode})", total_time_s=total)
     if "error" in answer:

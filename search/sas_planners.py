@@ -19,8 +19,6 @@ from __future__ import annotations
 import importlib.util
 import math
 import re
-import subprocess
-import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +30,7 @@ from pddl_export.files import atomic_write_text
 from pddl_export.pddl_writer import action_id_from_name
 from pddl_export.rules import apply_rules
 from pddl_export.sas_writer import Negation, SASEncoder, TaskTooLargeError
+from search.processes import planner_guard, run_group, temp_dir
 from search.result import PlanResult, PlanStatus, failed
 from pddl_export.symbolic import SymbolicGoal
 
@@ -111,29 +110,28 @@ def _read_log(log: str, extra: dict) -> int | None:
 
 def _run_search(binary: Path, spec: SASPlanner, task_text: str, planner: str, timeout_s: float, write_s: float,
                 memory_mb: int, t0: float, extra: dict) -> tuple[list[str], int | None] | PlanResult:
-    """Run the search binary on the task (standard input): the plan's operator names and expansions, or a failure."""
-    with tempfile.TemporaryDirectory(prefix="symlearn-fd-") as tmp:  # for the plan file
-        plan_path = Path(tmp) / "plan"
+    """Run the search binary on the task (standard input): the plan's operator names and expansions, or a failure.
+
+    The binary runs in its own process group in a symlearn-fd-* folder; the group is killed at the time
+    limit, and both the group and the folder go on a kill of this process (search.processes).
+    """
+    with planner_guard(), temp_dir("symlearn-fd-") as tmp:  # for the plan file
+        plan_path = tmp / "plan"
         args = [str(binary), "--search", spec.search, "--internal-plan-file", str(plan_path)]
         t1 = time.perf_counter()
         try:
-            proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                    text=True, cwd=tmp, start_new_session=True)
+            code, log, err, timed_out = run_group(
+                args, task_text, max(timeout_s - write_s, 1e-3), cwd=tmp,
+                after_start=(lambda pid: _limit_memory(pid, memory_mb)) if memory_mb else None)
         except OSError as e:
             return failed(planner, PlanStatus.ERROR, t0, f"could not run {planner}: {e}", **extra)
-        if memory_mb:
-            _limit_memory(proc.pid, memory_mb)
-        try:
-            log, err = proc.communicate(task_text, timeout=max(timeout_s - write_s, 1e-3))
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.communicate()
+        if timed_out:
             return failed(planner, PlanStatus.TIMEOUT, t0, f"{planner} hit the {timeout_s:g} s time limit "
-                          "(process killed)", planner_time_s=time.perf_counter() - t1, **extra)
+                          "(process group killed)", planner_time_s=time.perf_counter() - t1, **extra)
         extra["planner_time_s"] = time.perf_counter() - t1
         expansions = _read_log(log, extra)
-        if proc.returncode != 0 or not plan_path.is_file():
-            status, why = _EXIT.get(proc.returncode, (PlanStatus.ERROR, f"exited with code {proc.returncode}"))
+        if code != 0 or not plan_path.is_file():
+            status, why = _EXIT.get(code, (PlanStatus.ERROR, f"exited with code {code}"))
             why = why if status is PlanStatus.UNSOLVABLE else f"{planner} {why}"
             tail = (err.strip().splitlines() or [""])[-1]
             return failed(planner, status, t0, f"{why}{': ' + tail if status is PlanStatus.ERROR and tail else ''}",
