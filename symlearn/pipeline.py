@@ -114,8 +114,9 @@ def _stages() -> list[Stage]:
                                          str(s.get("fidelity_cases")), "--seed", str(s.seed)]],
               (f"{D}/manifest.json", f"{R}/best.pt", f"{R}/transition.pt"),
               (f"{R}/pddl/domain.pddl", f"{R}/pddl/rules.json")),
+        # a stage runs again only when its settings changed, so the old problem set is replaced, never mixed
         Stage("problems", lambda s: [["problems", "--out", p(s, P), "--n", str(s.get("problems")), "--seed",
-                                      str(s.seed)]], (), (P,)),
+                                      str(s.seed), "--overwrite"]], (), (P,)),
         Stage("benchmark", lambda s: [["benchmark", "--run", p(s, R), "--problems", p(s, P), "--planners",
                                        s.get("planners"), "--out", p(s, f"{R}/benchmark.json"), "--record",
                                        p(s, f"{R}/recordings"), "--quiet"],
