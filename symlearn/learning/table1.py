@@ -20,12 +20,12 @@ CASES = ("table1_case1", "table1_case2", "table1_case3")
 # The paper's Table I (mm), objects in our scenario order (stick, first cube, second cube); the paper's columns are
 # green cube, orange stick, red cube, and its green / red cubes are our first / second cube.
 PAPER_TABLE1 = {
-    "predicted_mm": [[(-2, 192, -2), (3, 6, -2), (4, -9, -1)],
-                     [(-17, 196, 1), (3, 8, 0), (-10, 180, -5)],
-                     [(4, 159, 8), (-3, 210, -45), (-30, 131, -20)]],
-    "truth_mm": [[(0, 180, 0), (0, 0, 0), (0, 0, 0)],
-                 [(0, 180, 0), (0, 0, 0), (-1, 176, 0)],
-                 [(3, 180, 0), (102, 177, -75), (2, 176, 0)]],
+    "predicted_mm": [[[-2, 192, -2], [3, 6, -2], [4, -9, -1]],
+                     [[-17, 196, 1], [3, 8, 0], [-10, 180, -5]],
+                     [[4, 159, 8], [-3, 210, -45], [-30, 131, -20]]],
+    "truth_mm": [[[0, 180, 0], [0, 0, 0], [0, 0, 0]],
+                 [[0, 180, 0], [0, 0, 0], [-1, 176, 0]],
+                 [[3, 180, 0], [102, 177, -75], [2, 176, 0]]],
 }
 MOVED_MM = 100  # an object "moved" if it went at least this far along y
 STILL_MM = 20  # and "stayed" if its predicted displacement is within this of zero
