@@ -1,0 +1,42 @@
+"""The shipped pretrained run: small, safely loadable, and it solves its problem in simulation right away."""
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from conftest import cli
+from pddl_export.files import sha256_file
+from pddl_export.rules_io import load_rules
+
+PRETRAINED = Path(__file__).resolve().parents[1] / "pretrained" / "quick-authors12k"
+PROBLEM = PRETRAINED / "problems" / "three_objects_two_actions.json"
+
+
+def test_pretrained_run_is_small_and_consistent():
+    size = sum(p.stat().st_size for p in PRETRAINED.rglob("*") if p.is_file())
+    assert size <= 10.5e6, size
+    from symlearn.learning.checkpoint import load_effect_model
+    from symlearn.symbolic.learned_transition import LearnedTransition
+    model, ck = load_effect_model(PRETRAINED)
+    assert ck.config.crop == 32 and ck.config.bits == 8  # the quick preset
+    LearnedTransition.from_run(PRETRAINED)  # refuses a transition network of another effect model
+    rules, model_hash = load_rules(PRETRAINED)
+    assert model_hash == sha256_file(PRETRAINED / "transition.pt")[:16]  # the export is not stale
+    assert len(rules.rules) > 100 and len(rules.codes) > 20
+    ev = json.loads((PRETRAINED / "eval.json").read_text())
+    assert ev["effect_model_sha256"] == sha256_file(PRETRAINED / "best.pt")[:16]
+    assert all(ev["effect_mae_mm"][a] < lim for a, lim in zip("xyz", (8.6, 15, 6)))  # the paper's errors
+
+
+@pytest.mark.parametrize("planner", ["astar", "fast-downward-sas-opt"])
+def test_pretrained_run_solves_its_problem_in_simulation(tmp_path, planner):
+    run = tmp_path / "run"  # planning writes its task files into the run: use a copy, not the repository
+    shutil.copytree(PRETRAINED, run)
+    rc, text = cli("plan", "--run", run, "--problem", PROBLEM, "--planner", planner, "--record", tmp_path / "p.gif")
+    assert rc == 0, text
+    line = [ln for ln in text.splitlines() if ln.startswith("problem_0008")][-1]
+    assert "success True" in line and "length 2" in line, line
+    from PIL import Image
+    with Image.open(tmp_path / "p.gif") as gif:
+        assert gif.n_frames == 3  # the start and one frame per action
