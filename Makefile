@@ -22,7 +22,8 @@ $(VENV)/.installed: pyproject.toml | $(BIN)/python
 
 # The whole pipeline at the quick preset on a small data set (about 10 minutes on 2 cores), ending with the
 # learned-net A* next to Fast Downward and SymK on the exported rules (their SAS+ route; the PDDL route through
-# unified-planning takes seconds per task and runs in `make test` and examples/).
+# unified-planning takes seconds per task and runs in `make test` and examples/), the same problems on the
+# shipped pretrained run (copied to runs/pretrained), and RUN/report.html.
 demo: $(VENV)/.installed
 	$(BIN)/symlearn scenarios
 	$(BIN)/symlearn collect --out data/demo --n 3000 --workers 2 --seed 0 --quiet
@@ -35,6 +36,11 @@ demo: $(VENV)/.installed
 	$(BIN)/symlearn problems --out problems/demo --n 10 --objects 1-3 --length 1-2 --seed 0
 	$(BIN)/symlearn benchmark --run runs/demo --problems problems/demo --planners astar,astar-ucs,fast-downward-sas-opt,symk-sas --closed-loop \
 		--out runs/demo/benchmark.json --quiet
+	$(BIN)/symlearn plan --run runs/demo --problem problems/demo/problem_0000.json --planner astar --record runs/demo/plan.gif
+	rm -rf runs/pretrained && cp -r pretrained/quick-authors12k runs/pretrained
+	$(BIN)/symlearn benchmark --run runs/pretrained --problems problems/demo --planners astar,fast-downward-sas-opt --closed-loop \
+		--out runs/pretrained/benchmark.json --quiet
+	$(BIN)/symlearn report --run runs/demo --data data/demo --benchmark runs/demo/benchmark.json --recording runs/demo/plan.gif
 
 test: $(VENV)/.installed
 	$(BIN)/python -m pytest -q
@@ -46,4 +52,4 @@ bench: $(VENV)/.installed
 	$(BIN)/python bench/collect.py --out bench/results/collect.json
 
 clean:
-	rm -rf $(VENV) data/demo runs/demo problems/demo .pytest_cache
+	rm -rf $(VENV) data/demo runs/demo runs/pretrained problems/demo .pytest_cache
