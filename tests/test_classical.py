@@ -15,7 +15,8 @@ import pytest
 from pddl_export.enumeration import enumerate_transitions
 from pddl_export.pddl_writer import PddlForm, conditional_domain, problem_pddl, strips_pddl
 from pddl_export.distil import distil_rules
-from search.classical import PLANNERS, PlannerSpec, solve_pddl
+from search.classical import PLANNERS, solve_pddl
+from search.up_solve import PlannerSpec
 from search.up_problem import strips_problem
 from search.result import PlanStatus
 from pddl_export.symbolic import SymbolicGoal
