@@ -53,3 +53,18 @@ def test_pretrained_run_builds_structures_in_simulation(tmp_path, name):
     assert rc == 0, text
     line = [ln for ln in text.splitlines() if ln.startswith(name)][-1]
     assert "success True" in line and "failure None" in line, line
+
+
+def test_plan_sets_torch_threads_one_by_default(tmp_path):
+    """Search-time inference runs on one thread unless --threads asks for more (small batches on 2 busy cores crawl)."""
+    import torch
+    run = tmp_path / "run"
+    shutil.copytree(PRETRAINED, run)
+    before = torch.get_num_threads()
+    try:
+        assert cli("plan", "--run", run, "--problem", PROBLEM, "--threads", "2")[0] == 0
+        assert torch.get_num_threads() == 2
+        assert cli("plan", "--run", run, "--problem", PROBLEM)[0] == 0
+        assert torch.get_num_threads() == 1
+    finally:
+        torch.set_num_threads(before)

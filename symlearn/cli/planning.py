@@ -21,7 +21,7 @@ import math
 import sys
 from pathlib import Path
 
-from symlearn.cli.args import int_range, planner_list
+from symlearn.cli.args import int_range, non_negative_int, planner_list, positive_int
 
 
 MAX_TIMEOUT_S = 86_400.0  # one day: larger values are typos, and the SAS+ planners need a finite limit
@@ -36,26 +36,6 @@ def timeout_seconds(text: str) -> float:
     if not (math.isfinite(v) and 0 < v <= MAX_TIMEOUT_S):
         raise argparse.ArgumentTypeError(f"timeout {text!r} must be a finite number of seconds in (0, {MAX_TIMEOUT_S:g}]")
     return v
-
-
-def _int_at_least(text: str, least: int) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if v < least:
-        raise argparse.ArgumentTypeError(f"{text!r} must be at least {least}")
-    return v
-
-
-def positive_int(text: str) -> int:
-    """argparse type: an integer >= 1."""
-    return _int_at_least(text, 1)
-
-
-def non_negative_int(text: str) -> int:
-    """argparse type: an integer >= 0."""
-    return _int_at_least(text, 0)
 
 
 def cmd_train_transition(args: argparse.Namespace) -> int:
@@ -86,6 +66,12 @@ def cmd_problems(args: argparse.Namespace) -> int:
     return 0
 
 
+def _set_threads(args: argparse.Namespace) -> None:
+    import torch
+
+    torch.set_num_threads(args.threads)
+
+
 def cmd_plan(args: argparse.Namespace) -> int:
     from symlearn.learning.checkpoint import load_effect_model
     from symlearn.planning.execution import ExecutionConfig, run_problem
@@ -95,6 +81,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.learned_transition import LearnedTransition
 
+    _set_threads(args)
     problem = load_problem(Path(args.problem))
     write_dir = path_under(Path(args.run) / "pddl" / "problems", problem.name)  # the name is checked at load
     fn = make_planners([args.planner], Path(args.run), write_dir=write_dir)[args.planner]
@@ -124,6 +111,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
 def cmd_benchmark(args: argparse.Namespace) -> int:
     from symlearn.planning.benchmark import benchmark, format_table
 
+    _set_threads(args)
     res = benchmark(Path(args.run), Path(args.problems), args.planners, Path(args.out), closed_loop=args.closed_loop,
                     timeout_s=args.timeout, max_replans=args.max_replans, show_progress=not args.quiet,
                     record_dir=Path(args.record) if args.record else None)
@@ -176,6 +164,9 @@ def _add_execution_flags(c: argparse.ArgumentParser) -> None:
     c.add_argument("--max-replans", type=non_negative_int, default=3)
     c.add_argument("--timeout", type=timeout_seconds, default=30.0,
                    help=f"seconds per planner call, finite and in (0, {MAX_TIMEOUT_S:g}]")
+    # search-time inference runs the networks on small batches, many times slower on 2 threads than on 1 when
+    # another busy process shares the cores (docs/BENCHMARKS.md), so one thread unless asked for more
+    c.add_argument("--threads", type=positive_int, default=1, help="torch CPU threads for the networks (default 1)")
 
 
 def add_plan_command(sub) -> None:
