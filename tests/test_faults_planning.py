@@ -296,7 +296,7 @@ def test_valid_problem_scenes_pass_the_reach_check(problems):
 
 
 def test_strict_json_replaces_non_finite_floats():
-    from symlearn.planning.benchmark import strict_json
+    from pddl_export.files import finite_or_null as strict_json
 
     d = strict_json({"a": float("nan"), "b": [1.0, float("inf"), {"c": -float("inf")}], "d": 2, "e": "NaN"})
     assert d == {"a": None, "b": [1.0, None, {"c": None}], "d": 2, "e": "NaN"}

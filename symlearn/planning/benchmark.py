@@ -17,6 +17,7 @@ import statistics
 import time
 from pathlib import Path
 
+from pddl_export.files import finite_or_null
 from pddl_export.rules_io import PDDL_DIR, RULES_FILE
 from symlearn.planning.execution import ExecutionConfig, ProblemRun, run_problem
 from symlearn.planning.planners import make_planners
@@ -74,17 +75,6 @@ def rows_path(out_file: Path) -> Path:
     return out_file.with_name(out_file.name + ".rows.jsonl")
 
 
-def strict_json(obj):
-    """obj with every non-finite float (NaN, infinities: undefined metrics) replaced by None, for strict JSON."""
-    if isinstance(obj, dict):
-        return {k: strict_json(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [strict_json(v) for v in obj]
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
-
-
 class RowLog:
     """Finished rows, one JSON line each, appended and fsynced as they finish; its first line holds the settings.
 
@@ -93,7 +83,7 @@ class RowLog:
     """
 
     def __init__(self, path: Path, settings: dict) -> None:
-        self.path, self.settings = Path(path), strict_json(settings)
+        self.path, self.settings = Path(path), finite_or_null(settings)
         self.done: dict[tuple, dict] = {}
         self._file = None
 
@@ -138,7 +128,7 @@ class RowLog:
 
 
 def _line(obj) -> str:
-    return json.dumps(strict_json(obj), allow_nan=False, separators=(",", ":")) + "\n"
+    return json.dumps(finite_or_null(obj), allow_nan=False, separators=(",", ":")) + "\n"
 
 
 def _settings(run_dir: Path, problems_dir: Path, problems: list, planners: list[str], closed_loop: bool,
@@ -177,7 +167,7 @@ def _run_rows(run_dir: Path, problems: list, fns: dict, log: RowLog, closed_loop
                 row = run_problem(sim, encoder, transition, problem, name, fns[name], cfg, recorder=rec)
                 if rec is not None and not row.success:
                     rec.save_gif(Path(record_dir) / f"{problem.name}_{name}.gif")
-                log.append((path.name, name, loop), strict_json(row.to_json()))
+                log.append((path.name, name, loop), finite_or_null(row.to_json()))
                 if show_progress:
                     print(f"[{len(log.done)}/{len(problems) * len(fns) * len(loops)}] {problem.name} {name}"
                           f"{' closed-loop' if loop else ''}: {row.status} len {row.plan_length} "
@@ -223,7 +213,7 @@ def benchmark(run_dir: Path, problems_dir: Path, planners: list[str], out_file: 
               "problems_sha256": settings["problems_sha256"],
               "versions": versions(), "wall_time_s": round(time.perf_counter() - t0, 2),
               "summary": summarize_rows(rows), "rows": [r.to_json() for r in rows]}
-    result = strict_json(result)
+    result = finite_or_null(result)
     atomic_write_json(out_file, result)
     log.path.unlink()
     return result

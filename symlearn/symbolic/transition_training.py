@@ -17,6 +17,7 @@ import torch
 from symlearn.data.dataset import data_fingerprint, load_split
 from symlearn.learning.checkpoint import effect_model_sha256, load_effect_model
 from symlearn.learning.models import AttentiveDeepSym
+from pddl_export.files import finite_or_null
 from symlearn.provenance import atomic_write_json, versions
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, save_transition
 from symlearn.symbolic.transition_data import TransitionData, build_transition_data
@@ -45,7 +46,7 @@ def train_transition(run_dir: Path, data_dir: Path, cfg: TransitionConfig, seed:
     metrics = {**meta, "history": history, "n_samples": {s: len(d) for s, d in splits.items()},
                "test": evaluate_transition(net, splits["test"]), "val": evaluate_transition(net, splits["val"]),
                "encode_time_s": round(encode_s, 2), "wall_time_s": round(time.perf_counter() - t_start, 2)}
-    metrics = _json_safe(metrics)
+    metrics = finite_or_null(metrics)  # NaN metrics of empty selections become null
     atomic_write_json(run_dir / METRICS_FILE, metrics)
     return metrics
 
@@ -107,14 +108,3 @@ def _train_epoch(net: TransitionNet, opt: torch.optim.Optimizer, gen: torch.Gene
         opt.step()
         total += float(loss.detach())
     return total / n_batches
-
-
-def _json_safe(obj):
-    """NaN (metrics of empty selections) becomes null so the file stays strict JSON."""
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, dict):
-        return {k: _json_safe(v) for k, v in obj.items()}
-    if isinstance(obj, list):
-        return [_json_safe(v) for v in obj]
-    return obj
