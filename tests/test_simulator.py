@@ -38,3 +38,23 @@ def test_effect_is_pose_difference_and_occupancy(sim):
     assert res.grasped == 0 and not res.off_table
     assert sim.occupied().tolist() == [False, False, True, False, False, False]
     assert abs(res.after.positions()[0, 2] - (TABLE_TOP_Z + 0.05)) < 2e-3
+
+
+def test_urdf_temp_file_never_outlives_loading(tmp_path, monkeypatch):
+    """The UR10's URDF goes through a temp file; it is gone after loading, and after a failed load too."""
+    import tempfile
+
+    import pytest
+
+    from symlearn.sim import simulator as simmod
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    with simmod.TabletopSimulator():
+        pass
+    assert list(tmp_path.iterdir()) == []
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("cannot parse")
+    monkeypatch.setattr(simmod.pb, "loadURDF", broken)
+    with pytest.raises(RuntimeError, match="cannot parse"):
+        simmod._load_urdf_text("<robot/>", (0, 0, 0), 0)
+    assert list(tmp_path.iterdir()) == []

@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import os
 import sys
+import signal
 import tempfile
 import time
 from dataclasses import dataclass, field
@@ -54,6 +55,23 @@ DOWN = (1.0, 0.0, 0.0, 0.0)  # tool z axis pointing at the table
 N_ARM_JOINTS = 6
 TOOL_LINK = 6
 REST_POSE = (0.0, -1.6, -1.6, 1.6, -1.57, 0.0)  # elbow up, wrist over the table
+
+
+def _load_urdf_text(text: str, base: tuple[float, float, float], client: int) -> int:
+    """Load a URDF given as text (pybullet reads files only) through a temp file that never outlives the call:
+    SIGTERM and SIGINT are held back from writing it to removing it, so a kill cannot strand it."""
+    held = {signal.SIGTERM, signal.SIGINT}
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        fd, path = tempfile.mkstemp(suffix=".urdf", prefix="symlearn-ur10-")
+        try:
+            with os.fdopen(fd, "w") as f:
+                f.write(text)
+            return pb.loadURDF(path, base, useFixedBase=True, physicsClientId=client)
+        finally:
+            os.unlink(path)
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 @dataclass(frozen=True)
@@ -155,13 +173,7 @@ class TabletopSimulator:
         self.table = pb.createMultiBody(0, col, vis, (0.70, 0.0, TABLE_TOP_Z / 2), physicsClientId=c)
         pb.changeDynamics(self.table, -1, lateralFriction=self.cfg.friction, physicsClientId=c)
         self.table_extent = ((0.70 - half[0], 0.70 + half[0]), (-half[1], half[1]))
-        with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
-            f.write(ur10_urdf())
-            path = f.name
-        try:
-            self.robot = pb.loadURDF(path, self.cfg.robot_base, useFixedBase=True, physicsClientId=c)
-        finally:
-            os.unlink(path)
+        self.robot = _load_urdf_text(ur10_urdf(), self.cfg.robot_base, c)
         self._shapes = {}
         for t, size in OBJECT_SIZE.items():
             he = [s / 2 for s in size]
