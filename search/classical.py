@@ -194,6 +194,10 @@ def solve_pddl(
     if "error" in answer:
         return failed(name, PlanStatus.ERROR, t0, answer["error"], total_time_s=total)
     inner = PlanResult.from_json(answer)
+    if total > timeout_s:  # an answer inside the grace period still came after the limit
+        return failed(name, PlanStatus.TIMEOUT, t0, f"{name} hit the {timeout_s:g} s time limit (answered "
+                      f"{inner.status.value} after {total:.2f} s)", total_time_s=total,
+                      planner_time_s=inner.extra.get("planner_time_s", total))
     extra = dict(inner.extra)
     extra["total_time_s"] = total
     extra.setdefault("planner_time_s", 0.0)
