@@ -7,6 +7,7 @@ location lands on actually moved).
 """
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +15,7 @@ import numpy as np
 from pddl_export.symbolic import code_str, codes_from_bits
 from symlearn.data.dataset import InteractionData, data_fingerprint, load_split
 from symlearn.learning.checkpoint import load_effect_model, stage_record
-from symlearn.provenance import atomic_write_json
+from symlearn.provenance import atomic_write_bytes, atomic_write_json
 from symlearn.symbolic.transition_data import encode_crops
 from symlearn.world import LOCATIONS, N_LOCATIONS, OBJECT_SIZE, ObjectType
 
@@ -112,9 +113,8 @@ def _plot_prototypes(path: Path, data, codes, frequent, bits) -> None:
         ax.set_title(f"{r['code']}\nn={r['count']} x={r['mean_x_px']:.0f} y={r['mean_y_px']:.0f}", fontsize=7)
     fig.suptitle("Average depth crop per frequent symbol (height above the far plane)")
     fig.tight_layout()
-    fig.savefig(_tmp(path), dpi=110, format="png")
+    _save_png(fig, path, dpi=110)
     plt.close(fig)
-    _tmp(path).replace(path)
 
 
 def _plot_examples(path: Path, data, codes, symbol: str, bits: int, n: int = 12) -> None:
@@ -135,10 +135,12 @@ def _plot_examples(path: Path, data, codes, symbol: str, bits: int, n: int = 12)
         ax.set_title(f"{t}, {data.pre_pixels[i, k]} px", fontsize=8)
     fig.suptitle(f"Examples of symbol {symbol} ({len(np.argwhere(codes == int(symbol, 2)))} objects)")
     fig.tight_layout()
-    fig.savefig(_tmp(path), dpi=100, format="png")
+    _save_png(fig, path, dpi=100)
     plt.close(fig)
-    _tmp(path).replace(path)
 
 
-def _tmp(path: Path) -> Path:
-    return path.with_name(f".{path.stem}.tmp.png")
+def _save_png(fig, path: Path, dpi: int) -> None:
+    """A matplotlib figure as PNG, written through the one atomic writer (no stray temp file on failure)."""
+    buf = io.BytesIO()
+    fig.savefig(buf, dpi=dpi, format="png")
+    atomic_write_bytes(path, buf.getvalue())
