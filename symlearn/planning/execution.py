@@ -26,7 +26,7 @@ import numpy as np
 from search.result import PlanResult, PlanStatus, failed
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
 from symlearn.planning.problem import GOAL_TOLERANCE_M, Problem
-from symlearn.planning.scenes import goal_codes, max_goal_distance, place_scene
+from symlearn.planning.scenes import max_goal_distance, place_scene, symbolic_goal
 from symlearn.symbolic.transition_data import encode_observation
 from symlearn.world import decode_action
 
@@ -115,7 +115,7 @@ def _codes(sim, encoder) -> tuple[int, ...]:
     return tuple(int(c) for c in encode_observation(encoder, sim.observe()))
 
 
-def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: np.ndarray,
+def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: SymbolicGoal | np.ndarray,
                  config: ExecutionConfig = ExecutionConfig(),
                  replan: Callable[[np.ndarray], PlanResult] | None = None,
                  record: Callable[[tuple, int, tuple], None] | None = None, recorder=None) -> ExecutionResult:
@@ -126,7 +126,7 @@ def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: np.ndar
     """
     if config.closed_loop and replan is None:
         raise ValueError("closed-loop execution needs a replan function")
-    goal = tuple(int(c) for c in goal)
+    goal = goal if isinstance(goal, SymbolicGoal) else SymbolicGoal(tuple(int(c) for c in goal))
     place_scene(sim, problem.initial)
     if recorder is not None:
         recorder.start(sim)
@@ -156,9 +156,10 @@ def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: np.ndar
                 continue
         t += 1
     if not predicted:  # a planner without predictions: judge the end state only
-        segment_ok = codes == goal
-    dist = max_goal_distance(sim.get_scene(), problem.goal)
-    return ExecutionResult(success=dist <= config.tolerance_m and not off_table, symbolic_match=codes == goal,
+        segment_ok = bool(goal.satisfied(np.asarray(codes, np.int64))[0])
+    dist = max_goal_distance(sim.get_scene(), problem.goal, problem.free)
+    return ExecutionResult(success=dist <= config.tolerance_m and not off_table,
+                           symbolic_match=bool(goal.satisfied(np.asarray(codes, np.int64))[0]),
                            max_distance_m=dist, executed=tuple(executed), observed_states=tuple(observed),
                            diverged=diverged, on_prediction=segment_ok and not replan_failed, replans=replans,
                            replan_failed=replan_failed, off_table=off_table)
@@ -185,6 +186,9 @@ class ProblemRun:
     message: str = ""
     n_objects: int = 0
     timings: dict = field(default_factory=dict)  # planner-specific, e.g. pddl_write_time_s, planner_time_s
+    task: str = "random-walk"  # the problem's task (Problem.task)
+    failure_cause: str | None = None  # the attributed cause of a failure (see failure attribution), None on success
+    attribution: dict = field(default_factory=dict)  # per-step failure attribution details
 
     def __post_init__(self) -> None:
         if self.failure_stage is not None:
@@ -227,15 +231,14 @@ def run_problem(sim, encoder, transition: TransitionFn, problem: Problem, planne
                 config: ExecutionConfig = ExecutionConfig(), initial_plan: PlanResult | None = None,
                 recorder=None) -> ProblemRun:
     """Encode start and goal, plan (or reuse initial_plan), execute, and report one row (frames into `recorder`)."""
-    goal = goal_codes(sim, encoder, problem)
+    sym_goal = symbolic_goal(sim, encoder, problem)
     place_scene(sim, problem.initial)
     start = encode_observation(encoder, sim.observe())
-    sym_goal = SymbolicGoal(tuple(int(c) for c in goal))
     plan = initial_plan or safe_plan(planner, planner_fn, transition, start, sym_goal, config.timeout_s)
     ex = None
     if plan.found:
         memory = ObservedTransitions(transition)
-        ex = execute_plan(sim, problem, plan, encoder, goal, config,
+        ex = execute_plan(sim, problem, plan, encoder, sym_goal, config,
                           replan=lambda codes: safe_plan(planner, planner_fn, memory, codes, sym_goal,
                                                          config.timeout_s),
                           record=memory.record if config.closed_loop else None, recorder=recorder)
@@ -249,4 +252,4 @@ def run_problem(sim, encoder, transition: TransitionFn, problem: Problem, planne
         max_distance_m=None if ex is None else round(ex.max_distance_m, 5), closed_loop=config.closed_loop,
         replans=0 if ex is None else ex.replans, failure_stage=failure_stage(plan, ex),
         generator_length=problem.generator_length, message=plan.message, n_objects=problem.k,
-        timings={k: v for k, v in plan.extra.items() if k.endswith("_s")})
+        timings={k: v for k, v in plan.extra.items() if k.endswith("_s")}, task=problem.task)

@@ -23,7 +23,9 @@ from symlearn.provenance import atomic_write_json
 from symlearn.world import LOCATIONS, N_ACTIONS, N_LOCATIONS, TABLE_TOP_Z, ObjectType, Scene, decode_action
 
 PROBLEM_FORMAT = "symlearn-problem"
-PROBLEM_VERSION = 1
+PROBLEM_VERSION = 2  # 2 added "task" and "free"; version 1 files (neither) still load
+READABLE_VERSIONS = (1, 2)
+RANDOM_WALK = "random-walk"  # the task of problems drawn by random actions
 GOAL_TOLERANCE_M = 0.02  # success: every object within this distance of its goal position
 # The reach of a valid scene: object centres over the table, at most this far from the middle of the
 # location grid (x, y), and between the table top and REACH_Z_MAX; orientations unit quaternions.
@@ -44,9 +46,16 @@ class Problem:
     initial: Scene  # poses after building and settling
     actions: tuple[int, ...]  # the generator's action ids: a known valid plan
     goal: Scene  # poses the generator's actions ended in
+    task: str = RANDOM_WALK  # what made it: "random-walk", or a structure suite's task name ("tower-2", ...)
+    free: tuple[int, ...] = ()  # objects the goal leaves free: their goal poses and codes are not judged
 
     def __post_init__(self) -> None:
         check_safe_name(self.name, "problem")
+        if not isinstance(self.task, str) or not self.task:
+            raise ValueError(f"problem {self.name}: task must be a non-empty string, got {self.task!r}")
+        if not all(_is_int(i) for i in self.free):
+            raise ValueError(f"problem {self.name}: free must list object indices, got {list(self.free)!r}")
+        object.__setattr__(self, "free", tuple(sorted(set(int(i) for i in self.free))))
         if not _is_int(self.seed):
             raise ValueError(f"problem {self.name}: seed must be an integer, got {self.seed!r}")
         spec = tuple((ObjectType(t), int(loc)) for t, loc in self.spec)
@@ -61,6 +70,11 @@ class Problem:
         bad = [a for a in self.actions if not 0 <= a < N_ACTIONS]
         if bad:
             raise ValueError(f"{p}: action id {bad[0]} is out of range 0..{N_ACTIONS - 1}")
+        bad = [i for i in self.free if not 0 <= i < len(spec)]
+        if bad:
+            raise ValueError(f"{p}: free object {bad[0]} is out of range 0..{len(spec) - 1}")
+        if len(self.free) == len(spec):
+            raise ValueError(f"{p}: the goal leaves every object free")
         types = tuple(t for t, _ in spec)
         for what, scene in (("initial", self.initial), ("goal", self.goal)):
             if not isinstance(scene, Scene):
@@ -76,8 +90,13 @@ class Problem:
 
     @property
     def generator_length(self) -> int:
-        """Length of the generator's own plan."""
+        """Length of the generator's own plan (the reference plan): an upper bound on the optimum."""
         return len(self.actions)
+
+    @property
+    def fixed(self) -> tuple[int, ...]:
+        """Objects whose goal pose is judged (all but the free ones)."""
+        return tuple(i for i in range(self.k) if i not in self.free)
 
     def to_json(self) -> dict:
         return {"format": PROBLEM_FORMAT, "version": PROBLEM_VERSION, "name": self.name, "seed": self.seed,
@@ -85,7 +104,8 @@ class Problem:
                 "actions": list(self.actions),
                 "actions_readable": [f"pick {decode_action(a).pick} -> release {decode_action(a).release}"
                                      for a in self.actions],
-                "goal": self.goal.to_json(), "generator_length": self.generator_length}
+                "goal": self.goal.to_json(), "generator_length": self.generator_length,
+                "task": self.task, "free": list(self.free)}
 
     @staticmethod
     def from_json(d: dict, where: str = "problem") -> "Problem":
@@ -99,8 +119,14 @@ class Problem:
             raise ValueError(f"{p}: missing keys {', '.join(missing)}")
         if d["format"] != PROBLEM_FORMAT:
             raise ValueError(f"{p}: not a symlearn problem (format {d['format']!r})")
-        if d["version"] != PROBLEM_VERSION:
-            raise ValueError(f"{p}: problem version {d['version']!r}, this symlearn reads version {PROBLEM_VERSION}")
+        if d["version"] not in READABLE_VERSIONS:
+            raise ValueError(f"{p}: problem version {d['version']!r}, this symlearn reads versions "
+                             f"{', '.join(map(str, READABLE_VERSIONS))}")
+        task, free = d.get("task", RANDOM_WALK), d.get("free", [])
+        if not isinstance(task, str) or not task:
+            raise ValueError(f"{p}: task must be a non-empty string, got {task!r}")
+        if not isinstance(free, list) or not all(_is_int(i) for i in free):
+            raise ValueError(f"{p}: free must be a list of object indices, got {free!r}")
         check_safe_name(d["name"], where)  # the name becomes a folder (RUN/pddl/problems/NAME)
         if not _is_int(d["seed"]):
             raise ValueError(f"{p}: seed must be an integer, got {d['seed']!r}")
@@ -124,7 +150,8 @@ class Problem:
         for key in ("initial", "goal"):
             scenes[key] = _scene(d[key], f"{p}: {key} scene")
         try:
-            return Problem(d["name"], int(d["seed"]), tuple(parsed), scenes["initial"], tuple(actions), scenes["goal"])
+            return Problem(d["name"], int(d["seed"]), tuple(parsed), scenes["initial"], tuple(actions), scenes["goal"],
+                           task, tuple(free))
         except ValueError as e:
             msg = str(e).removeprefix(f"problem {name}: ")
             raise ValueError(msg if msg.startswith(p) else f"{p}: {msg}") from None

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from pddl_export.symbolic import SymbolicGoal
 from symlearn.planning.problem import Problem
 from symlearn.world import Scene
 
@@ -30,8 +31,17 @@ def goal_codes(sim, encoder, problem: Problem) -> np.ndarray:
     return scene_codes(sim, encoder, problem.goal)
 
 
-def max_goal_distance(scene: Scene, goal: Scene) -> float:
-    """Largest distance (m) between an object's position and its goal position."""
+def symbolic_goal(sim, encoder, problem: Problem) -> SymbolicGoal:
+    """The problem's goal in codes: the goal scene's codes, None for the objects the goal leaves free."""
+    codes = goal_codes(sim, encoder, problem)
+    return SymbolicGoal(tuple(None if i in problem.free else int(c) for i, c in enumerate(codes)))
+
+
+def max_goal_distance(scene: Scene, goal: Scene, free: tuple[int, ...] = ()) -> float:
+    """Largest distance (m) between an object's position and its goal position, free objects not counted."""
     if scene.k != goal.k:
         raise ValueError(f"scene has {scene.k} objects, goal {goal.k}")
-    return float(np.linalg.norm(scene.positions() - goal.positions(), axis=1).max()) if scene.k else 0.0
+    fixed = [i for i in range(scene.k) if i not in free]
+    if not fixed:
+        return 0.0
+    return float(np.linalg.norm(scene.positions()[fixed] - goal.positions()[fixed], axis=1).max())
