@@ -76,6 +76,8 @@ class PlanResult:
     planning_time_s: float  # wall clock of the whole planner call
     message: str = ""  # one-line reason for ERROR / TIMEOUT / NODE_LIMIT / UNSOLVABLE
     extra: Mapping[str, ExtraValue] = field(default_factory=dict, hash=False)  # small metrics
+    # further plans of a top-k planner, best first, each (plan, predicted_states); the main plan not among them
+    alternatives: tuple[tuple[tuple[int, ...], tuple[tuple[int, ...], ...]], ...] = field(default=(), hash=False)
 
     def __post_init__(self) -> None:
         set_ = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
@@ -113,6 +115,19 @@ class PlanResult:
         if not isinstance(self.message, str) or "\n" in self.message:
             raise ValueError("message must be a one-line str")
         set_("extra", _freeze_extra(self.extra))
+        alts = []
+        for alt in self.alternatives:
+            if self.status is not PlanStatus.SOLVED:
+                raise ValueError("alternatives are only allowed with status solved")
+            a_plan, a_states = alt
+            a_plan = tuple(_as_int(a, "action id") for a in a_plan)
+            a_states = tuple(tuple(_as_int(c, "state code") for c in s) for s in a_states)
+            if any(not 0 <= a < N_ACTIONS for a in a_plan):
+                raise ValueError(f"alternative plan action ids must lie in 0..{N_ACTIONS - 1}")
+            if a_states and len(a_states) != len(a_plan) + 1:
+                raise ValueError("an alternative's predicted states must hold start + one state per action")
+            alts.append((a_plan, a_states))
+        set_("alternatives", tuple(alts))
 
     @property
     def found(self) -> bool:
@@ -130,6 +145,7 @@ class PlanResult:
             "planning_time_s": self.planning_time_s,
             "message": self.message,
             "extra": dict(self.extra),
+            "alternatives": [[list(p), [list(x) for x in st]] for p, st in self.alternatives],
         }
 
     @classmethod
@@ -144,6 +160,7 @@ class PlanResult:
             planning_time_s=d["planning_time_s"],
             message=d.get("message", ""),
             extra=dict(d.get("extra", {})),
+            alternatives=tuple((tuple(p), tuple(tuple(x) for x in st)) for p, st in d.get("alternatives", ())),
         )
 
     def __reduce__(self):
