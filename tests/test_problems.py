@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import copy
 import json
+import re
 
 import numpy as np
 import pytest
@@ -65,6 +66,23 @@ def test_four_to_five_objects(tmp_path, sim):
         pr = load_problem(p)
         assert pr.k in (4, 5) and sum(t == ObjectType.STICK for t, _ in pr.spec) <= 1
         assert max_goal_distance(_replay(sim, pr), pr.goal) <= GOAL_TOLERANCE_M
+
+
+def test_stratified_sets_fill_every_cell(tmp_path, sim):
+    paths = generate_problems(tmp_path / "grid", 1, objects=(2, 3), length=(2, 5), seed=4, sim=sim, stratify=True)
+    cells = {}
+    for p in paths:
+        pr = load_problem(p)
+        k, lo, hi = map(int, re.fullmatch(r"k(\d)_len(\d+)-(\d+)_0000", pr.name).groups())
+        assert pr.k == k and lo <= pr.generator_length <= hi and pr.task == "random-walk", pr.name
+        assert max_goal_distance(_replay(sim, pr), pr.goal) <= GOAL_TOLERANCE_M, pr.name
+        cells[(k, lo, hi)] = p.name
+    # buckets 1-2, 3-4, 5-6 cut to the asked length range 2-5, for 2 and 3 objects
+    assert sorted(cells) == [(k, lo, hi) for k in (2, 3) for lo, hi in ((2, 2), (3, 4), (5, 5))]
+    again = generate_problems(tmp_path / "grid", 1, objects=(2, 3), length=(2, 5), seed=4, sim=sim, stratify=True)
+    assert again == paths  # the same command completes (here: keeps) the set
+    with pytest.raises(ValueError, match="other settings"):
+        generate_problems(tmp_path / "grid", 1, objects=(2, 3), length=(2, 5), seed=4, sim=sim)
 
 
 @pytest.mark.parametrize("objects, length", [((0, 2), (1, 2)), ((3, 6), (1, 2)), ((2, 1), (1, 2)),

@@ -58,10 +58,11 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
 def cmd_problems(args: argparse.Namespace) -> int:
     from symlearn.planning.problem_generation import generate_problems
 
-    print(f"problems: {args.n} problems, objects {args.objects[0]}-{args.objects[1]}, length "
+    per = " per cell" if args.stratify else ""
+    print(f"problems: {args.n} problems{per}, objects {args.objects[0]}-{args.objects[1]}, length "
           f"{args.length[0]}-{args.length[1]}, seed {args.seed} -> {args.out}", file=sys.stderr)
     paths = generate_problems(Path(args.out), args.n, objects=args.objects, length=args.length, seed=args.seed,
-                              overwrite=args.overwrite)
+                              overwrite=args.overwrite, stratify=args.stratify)
     print(f"wrote {len(paths)} problems to {args.out}")
     return 0
 
@@ -152,6 +153,9 @@ def add_problems_command(sub) -> None:
     p.add_argument("--objects", type=int_range, default=(1, 3), help="objects per scene, e.g. 1-3 or 4-5")
     p.add_argument("--length", type=int_range, default=(1, 4), help="generator actions per problem, e.g. 1-4")
     p.add_argument("--seed", type=non_negative_int, default=0)
+    p.add_argument("--stratify", action="store_true",
+                   help="--n problems per cell of object count x horizon bucket (1-2, 3-4, 5-6, 7-8 actions) "
+                        "within --objects and --length, named by cell (k3_len5-6_0007)")
     p.add_argument("--overwrite", action="store_true",
                    help="remove the problem files already in --out first (without it, a folder holding problems "
                         "of other settings is refused; one of the same settings is completed)")

@@ -22,6 +22,7 @@ from symlearn.provenance import atomic_write_json
 from symlearn.sim.exploration import MAX_OBJECTS, ExplorationConfig, sample_action, sample_scene_spec
 from symlearn.world import Action, Scene, decode_action
 
+HORIZON_BUCKETS = ((1, 2), (3, 4), (5, 6), (7, 8))  # reference-length buckets of the depth benchmark
 MOVE_EPS_M = 0.01  # an action "changes something" when some object moves farther than this
 MAX_ACTION_DRAWS = 10_000  # draws of a random action before _changing_action gives up
 
@@ -99,16 +100,35 @@ PROBLEMS_MANIFEST = "problems.manifest"  # JSON (not *.json, so load_problems ne
 MANIFEST_FORMAT = "symlearn-problem-set"
 
 
-def _settings(n: int, cfg: ProblemConfig, seed: int) -> dict:
-    return {"format": MANIFEST_FORMAT, "problem_version": PROBLEM_VERSION, "n": n, "objects": list(cfg.objects),
-            "length": list(cfg.length), "seed": seed}
+def _settings(n: int, cfg: ProblemConfig, seed: int, stratify: bool = False) -> dict:
+    d = {"format": MANIFEST_FORMAT, "problem_version": PROBLEM_VERSION, "n": n, "objects": list(cfg.objects),
+         "length": list(cfg.length), "seed": seed}
+    if stratify:
+        d["stratify"] = True
+    return d
+
+
+def stratified_cells(cfg: ProblemConfig) -> list[tuple[int, tuple[int, int]]]:
+    """(objects, length range) cells of a stratified set: every object count x every horizon bucket in range."""
+    lo, hi = cfg.length
+    buckets = [(max(a, lo), min(b, hi)) for a, b in HORIZON_BUCKETS if a <= hi and b >= lo]
+    buckets += [(max(9, lo), hi)] if hi > HORIZON_BUCKETS[-1][1] else []
+    return [(k, b) for k in range(cfg.objects[0], cfg.objects[1] + 1) for b in buckets]
+
+
+def cell_name(k: int, length: tuple[int, int], i: int) -> str:
+    """Problem name of a stratified set: objects, length range and index, e.g. k3_len5-6_0007."""
+    return f"k{k}_len{length[0]}-{length[1]}_{i:04d}"
 
 
 def _own_files(out_dir: Path) -> list[Path]:
     """The files a problem set of this module consists of: its problems, its manifest, stale temp files."""
     return [f for f in out_dir.iterdir() if f.is_file() and (
-        re.fullmatch(r"problem_\d{4,}\.json", f.name) or f.name == PROBLEMS_MANIFEST
-        or re.fullmatch(r"\.(problem_\d{4,}\.json|problems\.manifest)\..*\.tmp", f.name))]
+        re.fullmatch(_OWN_PROBLEM, f.name) or f.name == PROBLEMS_MANIFEST
+        or re.fullmatch(rf"\.({_OWN_PROBLEM}|problems\.manifest)\..*\.tmp", f.name))]
+
+
+_OWN_PROBLEM = r"(problem_\d{4,}|k\d_len\d+-\d+_\d{4,})\.json"
 
 
 def prepare_problem_dir(out_dir: Path, settings: dict, overwrite: bool = False) -> None:
@@ -159,8 +179,11 @@ def _done(path: Path, name: str) -> bool:
 
 
 def generate_problems(out_dir: Path, n: int, objects: tuple[int, int] = (1, 3), length: tuple[int, int] = (1, 4),
-                      seed: int = 0, sim=None, overwrite: bool = False) -> list[Path]:
+                      seed: int = 0, sim=None, overwrite: bool = False, stratify: bool = False) -> list[Path]:
     """Write n problems to out_dir/problem_NNNN.json (problem i drawn from seed (seed, i)).
+
+    With `stratify`, n problems per cell of object count x horizon bucket (HORIZON_BUCKETS cut to the
+    length range) instead, named by cell (cell_name) and drawn from seed (seed, k, lo, hi, i).
 
     Everything is validated before anything is created. A folder already holding the same set
     (same settings, recorded in out_dir/problems.manifest) is completed: problems already written
@@ -174,16 +197,20 @@ def generate_problems(out_dir: Path, n: int, objects: tuple[int, int] = (1, 3), 
         raise ValueError(f"seed={seed!r} must be a non-negative integer")
     cfg = ProblemConfig(objects=tuple(objects), length=tuple(length))
     out_dir = Path(out_dir)
-    prepare_problem_dir(out_dir, _settings(n, cfg, seed), overwrite)
+    prepare_problem_dir(out_dir, _settings(n, cfg, seed, stratify), overwrite)
+    if stratify:
+        jobs = [(cell_name(k, b, i), ProblemConfig(objects=(k, k), length=b), [seed, k, b[0], b[1], i])
+                for k, b in stratified_cells(cfg) for i in range(n)]
+    else:
+        jobs = [(f"problem_{i:04d}", cfg, [seed, i]) for i in range(n)]
     own = sim is None
     paths = []
     try:
-        for i in range(n):
-            name = f"problem_{i:04d}"
+        for name, job_cfg, rng_seed in jobs:
             path = path_under(out_dir, f"{name}.json")
             if not _done(path, name):
                 sim = sim or TabletopSimulator()
-                save_problem(path, generate_problem(sim, np.random.default_rng([seed, i]), cfg, name, seed))
+                save_problem(path, generate_problem(sim, np.random.default_rng(rng_seed), job_cfg, name, seed))
             paths.append(path)
     finally:
         if own and sim is not None:
