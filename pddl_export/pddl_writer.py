@@ -332,7 +332,11 @@ def strips_pddl(
     domain_name: str = "symlearn-strips",
     max_states: int = 100_000,
 ) -> StripsTask:
-    """Grounded STRIPS domain + problem over the states reachable from `init` (see module doc)."""
+    """Grounded STRIPS domain + problem over the states reachable from `init` (see module doc).
+
+    Codes outside the vocabulary are inert (RuleSet.with_codes) and get predicates of their own."""
+    fixed = [c for c in (goal.codes if isinstance(goal, SymbolicGoal) else goal) if c is not None]
+    rules = rules.with_codes([*init, *fixed])
     init_t, goal_g = checked_task(rules, init, goal)
     bits = rules.bits
     states, edges = reachable_transitions(rules, init_t, max_states)

@@ -173,6 +173,19 @@ class RuleSet:
         """Actions that change something, sorted."""
         return tuple(sorted({r.action for r in self.rules}))
 
+    def with_codes(self, codes) -> "RuleSet":
+        """This rule set with `codes` added to its vocabulary (itself if none is new).
+
+        A code no rule mentions is inert under the rules' semantics (an object no rule matches keeps
+        its code, and contexts count only the codes they name), so a scene holding codes the
+        enumeration never saw, e.g. a 5-object scene's, is still a well-defined task for the rules.
+        """
+        new = {int(c) for c in codes} - set(self.codes)
+        if not new:
+            return self
+        return RuleSet(self.bits, tuple(sorted(set(self.vocabulary) | new)), self.max_objects, self.rules,
+                       self.n_rules_before_generalization)
+
     def rules_for(self, action: int, code_from: int) -> tuple[Rule, ...]:
         """The rules of one (action, own code), mutually exclusive; () if none."""
         return self._index.get((int(action), int(code_from)), ())

@@ -176,7 +176,19 @@ class SASEncoder:
         return self._siblings[negation]
 
     def task(self, init: Sequence[int], goal: SymbolicGoal | Sequence[int | None]) -> SASTask:
-        """The SAS+ task from init codes to goal codes (ValueError on unknown codes or shapes)."""
+        """The SAS+ task from init codes to goal codes (ValueError on bad shapes).
+
+        Codes outside the rules' vocabulary (RuleSet.with_codes: inert, kept by their objects) become
+        extra values of the object variables, through a sibling encoder cached per set of new codes.
+        """
+        fixed = [c for c in (goal.codes if isinstance(goal, SymbolicGoal) else goal) if c is not None]
+        new = frozenset(int(c) for c in (*init, *fixed)) - set(self.codes)
+        if new:
+            if not hasattr(self, "_extended"):
+                self._extended: dict[frozenset, SASEncoder] = {}
+            if new not in self._extended:
+                self._extended[new] = SASEncoder(self.rules.with_codes(new), self.max_effects, self.negation)
+            return self._extended[new].task(init, goal)
         init_t, goal_g = checked_task(self.rules, init, goal)
         n = len(init_t)
         body = self._bodies.get(n)

@@ -145,8 +145,14 @@ def test_unsolvable_and_failures_are_statuses(rules, monkeypatch, tmp_path):  # 
         if search_binary(SAS_PLANNERS[planner].package) is not None:
             res = solve_sas(enc, NEVER.init, NEVER.goal, planner, timeout_s=20)
             assert res.status is PlanStatus.UNSOLVABLE and res.plan == (), (planner, res.message)
-    res = solve_sas(enc, [99], [1], "fast-downward-sas", timeout_s=20)
-    assert res.status is PlanStatus.ERROR and "vocabulary" in res.message
+    # a code outside the vocabulary is inert under the rules: its object keeps it, so it can be neither left nor reached
+    new = min(set(range(1 << rules.bits)) - set(rules.codes))
+    res = solve_sas(enc, [new], [1], "fast-downward-sas", timeout_s=20)
+    assert res.status is PlanStatus.UNSOLVABLE and res.plan == (), res.message
+    res = solve_sas(enc, [new], [new], "fast-downward-sas", timeout_s=20)
+    assert res.status is PlanStatus.SOLVED and res.plan == () and res.predicted_states == ((new,),)
+    assert new not in enc.codes and new in rules.with_codes([new]).codes and rules.with_codes([1]) is rules
+    assert solve_sas(enc, [99], [1], "fast-downward-sas", timeout_s=20).message == "every code must fit in 3 bits"
     res = solve_sas(enc, [1], [1, 2], "fast-downward-sas", timeout_s=20)
     assert res.status is PlanStatus.ERROR and "objects" in res.message
     assert solve_sas(enc, [1], [2], "no-such", timeout_s=20).message.startswith("unknown planner")
