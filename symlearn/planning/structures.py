@@ -68,7 +68,7 @@ def reverse_tower(rng, k) -> Script:
 def stick_one_rider(rng, k) -> Script:
     """One cube onto the stick: on its middle (1), on an end of a far stick (1), or stick to the far row first (2)."""
     ls, lc = _pick(rng, NEAR_ROW, 2)
-    v = int(rng.integers(3))
+    v = int(rng.integers(3 if k <= 4 else 2))  # the far-row move leaves room for two extras only
     if v == 0:
         return [(S, ls), (C, lc)], [(lc, ls)]
     if v == 1:
@@ -101,7 +101,7 @@ def carry_loaded_stick(rng, k) -> Script:
     if v == 2 and k >= 3:
         return [(S, 1), (C, e), (C, e)], [(1, to)]  # a tower of two on the end
     ls, lc = _pick(rng, NEAR_ROW, 2)
-    if rng.random() < 0.5:
+    if k > 4 or rng.random() < 0.5:  # a stick starting in the near row leaves room for two extras only
         return [(S, 1), (C, lc)], [(lc, e), (1, to)]
     return [(S, ls), (C, lc)], [(ls, 1), (lc, e), (1, to)]
 
@@ -138,9 +138,13 @@ def rotate(rng, k) -> Script:
 
 
 def swap_towers(rng, k) -> Script:
-    """Two towers of two exchange places through a free location (6 actions; one ends upside down)."""
-    a, b, c = _pick(rng, range(N_LOCATIONS), 3)
-    return [(C, a), (C, a), (C, b), (C, b)], [(a, c), (a, c), (b, a), (b, a), (c, b), (c, b)]
+    """Two towers of two exchange places: through one free location with one tower ending upside down (6 actions),
+    or through two with both kept the right way up (7)."""
+    a, b, c, d = _pick(rng, range(N_LOCATIONS), 4)
+    spec = [(C, a), (C, a), (C, b), (C, b)]
+    if rng.random() < 0.5:
+        return spec, [(a, c), (a, c), (b, a), (b, a), (c, b), (c, b)]
+    return spec, [(a, c), (a, d), (b, c), (b, a), (c, a), (d, b), (c, b)]
 
 
 def fig6_composite(rng, k) -> Script:
