@@ -15,7 +15,7 @@ from symlearn.planning.goals import Goal, ObjectGoal, arrangement_errors, drop_o
 from symlearn.planning.problem import load_problem, load_problems
 from symlearn.planning.scenes import max_goal_distance
 from symlearn.planning.stacking import run_script
-from symlearn.planning.structure_suite import fitting_templates, generate_structures
+from symlearn.planning.structure_suite import fitting_templates
 from symlearn.planning.structures import TEMPLATES, structure_goal
 from symlearn.world import LOCATIONS, ObjectType, decode_action
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from symlearn.planning.goals import ARRANGEMENT_TOLERANCE_M, Goal, arrangement_errors, drop_order, load_goal
+from symlearn.planning.paths import check_safe_name
 from symlearn.planning.problem import Problem
 from symlearn.planning.scenes import max_goal_distance
 from symlearn.world import FAR_ROW, N_LOCATIONS, ObjectType, Scene, decode_action
@@ -84,8 +85,6 @@ def _problem(where: str, name: str, goal: Goal, initial: Scene, goal_scene: Scen
 
 def goal_file_problem(path: Path, sim=None) -> Problem:
     """A goal file's Problem, named after the file's stem (a simulator is made when none is given)."""
-    from symlearn.planning.paths import check_safe_name
-
     path = Path(path)
     where = f"goal file {path}"
     goal = load_goal(path)
