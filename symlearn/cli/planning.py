@@ -6,6 +6,8 @@ ValueError / RuntimeError with one-line messages, which the main CLI prints.
 
     symlearn train-transition --run runs/paper --data data/paper --preset paper
     symlearn problems --out problems/p13 --n 50 --objects 1-3 --length 1-4 --seed 0
+    symlearn problems --suite structures --out problems/structures --n 22 --objects 1-5 --seed 0
+    symlearn problems --goal examples/goals/fig6_composite.json --out problems/goals
     symlearn plan --run runs/paper --problem problems/p13/problem_0000.json --planner astar --closed-loop
     symlearn benchmark --run runs/paper --problems problems/p13 --planners astar,astar-ucs --out bench.json
 
@@ -58,11 +60,40 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
 def cmd_problems(args: argparse.Namespace) -> int:
     from symlearn.planning.problem_generation import generate_problems
 
+    if args.suite or args.goal:
+        if args.stratify:
+            raise ValueError("--stratify applies to random-walk problems only")
+        return _cmd_structure_problems(args)
+    args.n, args.objects = args.n or 20, args.objects or (1, 3)
+    args.length, args.seed = args.length or (1, 4), 0 if args.seed is None else args.seed
     per = " per cell" if args.stratify else ""
     print(f"problems: {args.n} problems{per}, objects {args.objects[0]}-{args.objects[1]}, length "
           f"{args.length[0]}-{args.length[1]}, seed {args.seed} -> {args.out}", file=sys.stderr)
     paths = generate_problems(Path(args.out), args.n, objects=args.objects, length=args.length, seed=args.seed,
                               overwrite=args.overwrite, stratify=args.stratify)
+    print(f"wrote {len(paths)} problems to {args.out}")
+    return 0
+
+
+def _cmd_structure_problems(args: argparse.Namespace) -> int:
+    """`problems --suite structures` (named tasks) or `problems --goal FILE` (one problem from a goal file)."""
+    from symlearn.planning.structure_suite import generate_structures, write_goal_problem
+
+    if args.length is not None:
+        raise ValueError("--length applies to random-walk problems only; --suite and --goal problems carry "
+                         "their own reference plans")
+    if args.goal:
+        given = [f for f, v in (("--n", args.n), ("--objects", args.objects), ("--seed", args.seed)) if v is not None]
+        if given:
+            raise ValueError(f"--goal makes one problem from its file; {', '.join(given)} do not apply")
+        path = write_goal_problem(Path(args.goal), Path(args.out), overwrite=args.overwrite)
+        print(f"wrote {path}")
+        return 0
+    n, objects, seed = args.n or 20, args.objects or (1, 5), 0 if args.seed is None else args.seed
+    print(f"problems: suite {args.suite}, {n} problems, objects {objects[0]}-{objects[1]}, seed {seed} -> {args.out}",
+          file=sys.stderr)
+    paths = generate_structures(Path(args.out), n, objects=objects, seed=seed, suite=args.suite,
+                                overwrite=args.overwrite)
     print(f"wrote {len(paths)} problems to {args.out}")
     return 0
 
@@ -149,13 +180,19 @@ def add_problems_command(sub) -> None:
     """Add `problems` to the CLI's sub-parsers."""
     p = sub.add_parser("problems", help="generate planning problems (initial scene, goal scene) in the simulator")
     p.add_argument("--out", required=True, help="directory for the problem JSON files")
-    p.add_argument("--n", type=positive_int, default=20, help="number of problems")
-    p.add_argument("--objects", type=int_range, default=(1, 3), help="objects per scene, e.g. 1-3 or 4-5")
-    p.add_argument("--length", type=int_range, default=(1, 4), help="generator actions per problem, e.g. 1-4")
-    p.add_argument("--seed", type=non_negative_int, default=0)
+    p.add_argument("--n", type=positive_int, help="number of problems (default 20)")
+    p.add_argument("--objects", type=int_range,
+                   help="objects per scene, e.g. 1-3 or 4-5 (default 1-3; 1-5 with --suite)")
+    p.add_argument("--length", type=int_range, help="generator actions per random-walk problem, e.g. 1-4 (default 1-4)")
+    p.add_argument("--seed", type=non_negative_int, help="base seed (default 0)")
     p.add_argument("--stratify", action="store_true",
-                   help="--n problems per cell of object count x horizon bucket (1-2, 3-4, 5-6, 7-8 actions) "
-                        "within --objects and --length, named by cell (k3_len5-6_0007)")
+                   help="--n random-walk problems per cell of object count x horizon bucket (1-2, 3-4, 5-6, 7-8 "
+                        "actions) within --objects and --length, named by cell (k3_len5-6_0007)")
+    kind = p.add_mutually_exclusive_group()
+    kind.add_argument("--suite", choices=["structures"],
+                      help="named structure tasks (towers, cubes on the stick, ...; docs/PROBLEMS.md) instead of "
+                           "random walks")
+    kind.add_argument("--goal", help="a goal file (docs/PROBLEMS.md): write one problem, OUT/<file stem>.json")
     p.add_argument("--overwrite", action="store_true",
                    help="remove the problem files already in --out first (without it, a folder holding problems "
                         "of other settings is refused; one of the same settings is completed)")
