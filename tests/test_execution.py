@@ -418,8 +418,9 @@ def test_departure_whose_rest_still_reaches_the_goal_is_continued(sim, walks):
     assert states[-1] == tuple(goal_codes(sim, enc, pr))
     predicted = [states[0], _wrong(states[1]), *states[2:]]  # wrong about the first step only
     cfg = ExecutionConfig(closed_loop=True, max_replans=1)
+    ignorant = ObservedTransitions(_Still())  # one model that cannot see the rest work is not enough to abandon it
     ex = execute_plan(sim, pr, _plan(pr.actions, predicted), enc, states[-1], cfg, replan=_refuse,
-                      model=ObservedTransitions(_Still(), seen))
+                      models=[ignorant, ObservedTransitions(_Still(), seen)])
     assert ex.continued == 1 and ex.replans == 0 and ex.fallbacks == 0
     assert ex.executed == pr.actions and ex.success and ex.diverged
     assert ex.first_departure_step == 0 and ex.departed_objects == tuple(range(pr.k))
@@ -436,11 +437,11 @@ def test_fallback_to_an_alternative_plan(sim, walks):
     a0 = _empty_pick(pr)  # the main plan claims this empty pick does what the first reference step does
     main = dataclasses.replace(_plan([a0, *pr.actions[1:]], states), alternatives=((pr.actions, tuple(states)),))
     cfg = ExecutionConfig(closed_loop=True, max_replans=1)
-    ex = execute_plan(sim, pr, main, enc, states[-1], cfg, replan=_refuse, model=ObservedTransitions(_Still(), seen))
+    ex = execute_plan(sim, pr, main, enc, states[-1], cfg, replan=_refuse, models=[ObservedTransitions(_Still(), seen)])
     assert ex.fallbacks == 1 and ex.replans == 0 and ex.continued == 0
     assert ex.executed == (a0, *pr.actions) and ex.success and ex.on_prediction
     ex = execute_plan(sim, pr, main, enc, states[-1], dataclasses.replace(cfg, max_fallbacks=0),
-                      replan=lambda c: _plan([], [c]), model=ObservedTransitions(_Still(), seen))
+                      replan=lambda c: _plan([], [c]), models=[ObservedTransitions(_Still(), seen)])
     assert ex.fallbacks == 0 and ex.replans == 1 and not ex.success
 
 

@@ -6,9 +6,9 @@ are compared with the planner's predicted state. Success is geometric (every obj
 2 cm of its goal position); the symbolic match (final codes == goal codes) is reported beside
 it. With `closed_loop=True`, a departure from the prediction is answered in this order:
 
-1. continue: the rest of the plan, rolled from the observed codes through the corrected
-   model (the planner's own model, answered from memory where execution has seen a step),
-   still reaches the goal codes: keep it, with the rolled states as its new predictions;
+1. continue: the rest of the plan, rolled from the observed codes through a corrected model
+   (the planner's own model or the network, answered from memory where execution has seen a
+   step), still reaches the goal codes: keep it, with the rolled states as its new predictions;
 2. fall back: a further plan of a top-k planner (PlanResult.alternatives) or the current
    one passes through the observed codes, and its suffix from there reaches the goal when
    rolled the same way: run that suffix (at most `max_fallbacks` times);
@@ -31,7 +31,7 @@ from __future__ import annotations
 import time
 from dataclasses import asdict, dataclass, field
 from enum import Enum
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -139,10 +139,10 @@ def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: Symboli
                  config: ExecutionConfig = ExecutionConfig(),
                  replan: Callable[[np.ndarray], PlanResult] | None = None,
                  record: Callable[[tuple, int, tuple], None] | None = None, recorder=None,
-                 model: TransitionFn | None = None) -> ExecutionResult:
+                 models: Sequence[TransitionFn] = ()) -> ExecutionResult:
     """Run plan.plan from the problem's initial poses; closed loop recovers from departures (module docstring).
 
-    `model` is the corrected model that rolls a plan's rest from observed codes (without it a departure
+    `models` are the corrected models that roll a plan's rest from observed codes (without any, a departure
     goes straight to `replan(observed_codes)`); `record(state, action, observed_next)` hears every executed
     step (ObservedTransitions.record); `recorder` (a symlearn.planning.recording.PlanRecorder) takes a
     camera frame at the start and after each step.
@@ -156,7 +156,7 @@ def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: Symboli
     prog, seg = Progress([_codes(sim, encoder)]), Segment.of(plan)
     while seg is not None:
         while seg is not None and seg.t < len(seg.actions):
-            seg = _step(sim, encoder, seg, prog, goal, config, replan, record, recorder, model)
+            seg = _step(sim, encoder, seg, prog, goal, config, replan, record, recorder, models)
         codes = prog.observed[-1]
         if (seg is None or not config.closed_loop or prog.replans >= config.max_replans
                 or goal.satisfied(np.asarray(codes, np.int64))[0]):
@@ -176,7 +176,7 @@ def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: Symboli
 
 
 def _step(sim, encoder, seg: Segment, prog: Progress, goal: SymbolicGoal, config: ExecutionConfig,
-          replan, record, recorder, model) -> Segment | None:
+          replan, record, recorder, models) -> Segment | None:
     """Execute seg's next action, observe, and on a departure recover; the segment to go on with (None: stop)."""
     action = seg.actions[seg.t]
     prog.off_table |= sim.step(decode_action(action)).off_table
@@ -198,8 +198,8 @@ def _step(sim, encoder, seg: Segment, prog: Progress, goal: SymbolicGoal, config
     if not config.closed_loop:
         seg.t += 1
         return seg
-    if model is not None:
-        kept = recover(seg, codes, model, goal, prog, config.max_fallbacks)
+    if models:
+        kept = recover(seg, codes, models, goal, prog, config.max_fallbacks)
         if kept is not None:
             return kept
     if prog.replans >= config.max_replans:
@@ -350,11 +350,11 @@ def run_problem(sim, encoder, transition: TransitionFn, problem: Problem, planne
     if plan.found:
         memory = ObservedTransitions(transition)
         own = getattr(planner_fn, "planning_model", None)  # rule planners predict with their rules
-        model = memory if own is None else ObservedTransitions(own(transition), memory.seen)
+        models = (memory,) if own is None else (ObservedTransitions(own(transition), memory.seen), memory)
         ex = execute_plan(sim, problem, plan, encoder, sym_goal, config,
                           replan=lambda codes: safe_plan(planner, planner_fn, memory, codes, sym_goal,
                                                          config.timeout_s),
-                          record=memory.record if config.closed_loop else None, recorder=recorder, model=model)
+                          record=memory.record if config.closed_loop else None, recorder=recorder, models=models)
     elif recorder is not None:  # nothing to execute: the start scene alone
         place_scene(sim, problem.initial)
         recorder.start(sim)

@@ -1,15 +1,17 @@
 """Closed-loop recovery after a departure: keep the plan, fall back to another plan's suffix, or replan.
 
 The policy (symlearn.planning.execution runs it): roll the rest of the current plan from the
-observed codes through the corrected model; if it still reaches the goal codes, keep it. Else
+observed codes through the corrected models; if one of them says it still reaches the goal codes,
+keep it. Else
 take the first plan among the current one and the planner's alternatives (top-k) that passes
 through the observed codes and whose suffix from there reaches the goal when rolled the same
-way. Else the caller replans.
+way. Else the caller replans. The models are the planner's own (the network, or a rule planner's
+rules) and the network, each answering from memory where execution has seen a step.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -57,12 +59,25 @@ class Progress:
     departed: tuple[int, ...] = ()
 
 
-def recover(seg: Segment, codes: tuple[int, ...], model: TransitionFn, goal: SymbolicGoal,
+def _reaching(models: Sequence[TransitionFn], codes: tuple[int, ...], actions: list[int],
+              goal: SymbolicGoal) -> list[tuple[int, ...]] | None:
+    """The states of the first model whose roll of `actions` from `codes` ends at the goal codes, else None."""
+    for model in models:
+        rolled = roll(model, codes, actions)
+        if goal.satisfied(np.asarray(rolled[-1], np.int64))[0]:
+            return rolled
+    return None
+
+
+def recover(seg: Segment, codes: tuple[int, ...], models: Sequence[TransitionFn], goal: SymbolicGoal,
             prog: Progress, max_fallbacks: int) -> Segment | None:
-    """After a departure: the segment to go on with (continued or a fallback suffix), or None to replan."""
-    reaches = lambda states: bool(goal.satisfied(np.asarray(states[-1], np.int64))[0])  # noqa: E731
-    rolled = roll(model, codes, seg.actions[seg.t + 1:])
-    if reaches(rolled):
+    """After a departure: the segment to go on with (continued or a fallback suffix), or None to replan.
+
+    A plan is kept (or a suffix taken) when ANY of `models` predicts it reaches the goal: keeping the
+    plan is what open loop does, so abandoning it asks for every model's evidence that it fails.
+    """
+    rolled = _reaching(models, codes, seg.actions[seg.t + 1:], goal)
+    if rolled is not None:
         prog.continued += 1
         seg.predicted = seg.predicted[:seg.t + 1] + rolled
         seg.t += 1
@@ -73,8 +88,8 @@ def recover(seg: Segment, codes: tuple[int, ...], model: TransitionFn, goal: Sym
         for j, state in enumerate(states):
             if tuple(state) != codes or (plan == tuple(seg.actions) and j == seg.t + 1):
                 continue
-            rolled = roll(model, codes, list(plan[j:]))
-            if reaches(rolled):
+            rolled = _reaching(models, codes, list(plan[j:]), goal)
+            if rolled is not None:
                 prog.fallbacks, prog.segment_ok = prog.fallbacks + 1, True
                 return Segment(list(plan[j:]), rolled, seg.alternatives)
     return None
