@@ -18,8 +18,10 @@ from symlearn.planning import benchmark as bench
 from symlearn.learning.checkpoint import save_checkpoint
 from symlearn.cli.planning import add_planning_commands
 from symlearn.planning.execution import (ExecutionConfig, FailureStage, ObservedTransitions, ProblemRun, execute_plan,
-                                        run_problem)
+                                        failure_causes, run_problem)
 from symlearn.planning.planners import PLANNERS, PlannerContext, make_planner
+from pddl_export.rules import Rule, RuleSet
+from pddl_export.sas_writer import SASEncoder
 from pddl_export.symbolic import SymbolicGoal
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig
 from symlearn.planning.problem import GOAL_TOLERANCE_M, load_problem
@@ -47,6 +49,21 @@ def encoder():
 def problems(tmp_path_factory, sim):
     out = tmp_path_factory.mktemp("exec_problems")
     return [load_problem(p) for p in generate_problems(out, 2, objects=(2, 3), length=(1, 3), seed=7, sim=sim)]
+
+
+@pytest.fixture(scope="module")
+def walks(tmp_path_factory, sim):
+    """Problems of 2-3 reference steps whose position codes differ at every reference state."""
+    out = tmp_path_factory.mktemp("exec_walks")
+    enc = _PositionEncoder(sim)
+    keep = []
+    for path in generate_problems(out, 8, objects=(2, 3), length=(2, 3), seed=5, sim=sim):
+        pr = load_problem(path)
+        states = _truth(sim, enc, pr, pr.actions)[1]
+        if len(set(states)) == len(states) and 7 not in states[-1]:
+            keep.append(pr)
+    assert len(keep) >= 2, "too few usable walks"
+    return keep
 
 
 @pytest.fixture(scope="module")
@@ -78,6 +95,53 @@ def _empty_pick(problem) -> int:
     free = [i for i, (x, y) in enumerate(LOCATIONS) if np.min(np.abs(pos - (x, y)).max(1)) > 0.25]
     assert free, "test scene covers every location"
     return action_id(free[0], free[0])
+
+
+class _PositionEncoder(torch.nn.Module):
+    """Hand-made effect model: an object's code is the index of the table location under it (7: none).
+
+    It reads the simulator's poses instead of the crops, so codes mean something the tests can
+    reason about: a pick-and-release moves an object's code, a stack shares its location's code.
+    With constant=True every object has code 0 (every scene aliases every goal).
+    """
+
+    def __init__(self, sim, constant: bool = False) -> None:
+        super().__init__()
+        self.sim, self.constant = sim, constant
+        self.cfg = argparse.Namespace(bits=3)
+        self.dummy = torch.nn.Parameter(torch.zeros(1))
+
+    def encode(self, crops, mask):
+        from symlearn.world import LOCATIONS
+
+        pos = self.sim.get_scene().positions()[:, :2]
+        dist = np.linalg.norm(pos[:, None] - np.array(LOCATIONS)[None], axis=2)  # (k, 6)
+        codes = np.where(dist.min(1) < 0.1, dist.argmin(1), 7) * (not self.constant)
+        bits = (codes[:, None] >> np.arange(2, -1, -1)) & 1
+        return torch.tensor(bits[None], dtype=torch.float32), None
+
+
+class _Still:
+    """Toy network: no action changes anything."""
+
+    bits = 3
+
+    def __call__(self, codes, actions):
+        return np.array(codes, np.int64)
+
+
+def _truth(sim, enc, pr, actions) -> tuple[dict, list]:
+    """The observed steps of running `actions` open loop: (state -> {action: next} as ObservedTransitions.seen, states)."""
+    start = scene_codes(sim, enc, pr.initial)
+    ex = execute_plan(sim, pr, _plan(actions, []), enc, start)
+    seen: dict = {}
+    for s, a, n in zip(ex.observed_states, ex.executed, ex.observed_states[1:]):
+        seen.setdefault(s, {})[a] = n
+    return seen, list(ex.observed_states)
+
+
+def _refuse(codes):
+    raise AssertionError(f"replanned from {codes}")
 
 
 # ------------------------------------------------------------------------------- execute_plan
@@ -196,6 +260,8 @@ def test_no_plan_stages(sim, encoder, run_dir, problems, status, stage):
                                         planning_time_s=0.0))
     row = run_problem(sim, encoder, LearnedTransition.from_run(run_dir), problems[0], "t", fn)
     assert not row.found and row.failure_stage == stage and row.plan_length is None
+    assert row.failure_cause == stage and row.attribution["first_departure_step"] is None
+    assert row.attribution["rules_net_disagree"] is None and row.attribution["replans"] == 0
     assert not row.success and row.max_distance_m is None and row.status == status.value
 
 
@@ -224,13 +290,14 @@ def test_execution_and_goal_mismatch_stages(sim, encoder, run_dir, problems):
     assert row.success and row.failure_stage is None and row.plan_length == pr.generator_length
 
 
-def test_run_problem_closed_loop_row(sim, encoder, run_dir, problems):
+def test_run_problem_closed_loop_row(sim, problems):
     pr = problems[0]
     a = _empty_pick(pr)
     liar = _fixed(lambda s, g: _plan([a], [s, _wrong(s)]))
-    row = run_problem(sim, encoder, LearnedTransition.from_run(run_dir), pr, "liar", liar,
+    row = run_problem(sim, _PositionEncoder(sim), _Still(), pr, "liar", liar,
                       ExecutionConfig(closed_loop=True, max_replans=2))
     assert row.closed_loop and row.replans == 2 and row.failure_stage == "execution"
+    assert row.failure_cause == "departure" and row.attribution["replans"] == 2
     assert json.loads(json.dumps(row.to_json()))["replans"] == 2
 
 
@@ -240,8 +307,12 @@ def test_problem_run_validation():
                 replans=0, generator_length=1)
     with pytest.raises(ValueError, match="unknown failure stage"):
         ProblemRun(**base, failure_stage="physics")
-    with pytest.raises(ValueError, match="no failure stage"):
+    with pytest.raises(ValueError, match="no failure stage or cause"):
         ProblemRun(**{**base, "success": True}, failure_stage="execution")
+    with pytest.raises(ValueError, match="no failure stage or cause"):
+        ProblemRun(**{**base, "success": True}, failure_stage=None, failure_cause="departure")
+    with pytest.raises(ValueError, match="unknown failure cause 'gremlins'"):
+        ProblemRun(**base, failure_stage="execution", failure_cause="gremlins")
 
 
 # ------------------------------------------------------------------------------- benchmark and registry
@@ -335,3 +406,119 @@ def test_cli_problems_command(tmp_path):
     args = p.parse_args(["problems", "--out", str(tmp_path / "pp"), "--n", "1", "--objects", "1-2", "--seed", "2"])
     assert args.func(args) == 0
     assert load_problem(tmp_path / "pp" / "problem_0000.json").k in (1, 2)
+
+
+# ------------------------------------------------------------------------------- recovery and attribution
+
+
+def test_departure_whose_rest_still_reaches_the_goal_is_continued(sim, walks):
+    enc = _PositionEncoder(sim)
+    pr = walks[0]
+    seen, states = _truth(sim, enc, pr, pr.actions)
+    assert states[-1] == tuple(goal_codes(sim, enc, pr))
+    predicted = [states[0], _wrong(states[1]), *states[2:]]  # wrong about the first step only
+    cfg = ExecutionConfig(closed_loop=True, max_replans=1)
+    ignorant = ObservedTransitions(_Still())  # one model that cannot see the rest work is not enough to abandon it
+    ex = execute_plan(sim, pr, _plan(pr.actions, predicted), enc, states[-1], cfg, replan=_refuse,
+                      models=[ignorant, ObservedTransitions(_Still(), seen)])
+    assert ex.continued == 1 and ex.replans == 0 and ex.fallbacks == 0
+    assert ex.executed == pr.actions and ex.success and ex.diverged
+    assert ex.first_departure_step == 0 and ex.departed_objects == tuple(range(pr.k))
+    calls = []  # without a model to roll the rest, the same departure is replanned
+    ex = execute_plan(sim, pr, _plan(pr.actions, predicted), enc, states[-1], cfg,
+                      replan=lambda c: calls.append(tuple(c)) or _plan([], [c]))
+    assert calls == [states[1]] and ex.replans == 1 and ex.executed == pr.actions[:1] and not ex.success
+
+
+def test_fallback_to_an_alternative_plan(sim, walks):
+    enc = _PositionEncoder(sim)
+    pr = walks[1]
+    seen, states = _truth(sim, enc, pr, pr.actions)
+    a0 = _empty_pick(pr)  # the main plan claims this empty pick does what the first reference step does
+    main = dataclasses.replace(_plan([a0, *pr.actions[1:]], states), alternatives=((pr.actions, tuple(states)),))
+    cfg = ExecutionConfig(closed_loop=True, max_replans=1)
+    ex = execute_plan(sim, pr, main, enc, states[-1], cfg, replan=_refuse, models=[ObservedTransitions(_Still(), seen)])
+    assert ex.fallbacks == 1 and ex.replans == 0 and ex.continued == 0
+    assert ex.executed == (a0, *pr.actions) and ex.success and ex.on_prediction
+    ex = execute_plan(sim, pr, main, enc, states[-1], dataclasses.replace(cfg, max_fallbacks=0),
+                      replan=lambda c: _plan([], [c]), models=[ObservedTransitions(_Still(), seen)])
+    assert ex.fallbacks == 0 and ex.replans == 1 and not ex.success
+
+
+def test_plan_ending_away_from_the_goal_is_replanned(sim, walks):
+    enc = _PositionEncoder(sim)
+    pr = walks[0]
+    states = _truth(sim, enc, pr, pr.actions)[1]
+    calls = []
+    ex = execute_plan(sim, pr, _plan([], states[:1]), enc, states[-1], ExecutionConfig(closed_loop=True),
+                      replan=lambda c: calls.append(tuple(c)) or _plan(pr.actions, states))
+    assert calls == [states[0]] and ex.replans == 1 and ex.success and ex.executed == pr.actions
+    ex = execute_plan(sim, pr, _plan([], states[:1]), enc, states[-1])  # open loop: nothing more
+    assert ex.executed == () and not ex.success
+
+
+def _rows(sim, pr):
+    """A departure, an aliasing, a no-plan and a successful row of one problem, with hand-made encoders."""
+    a = _empty_pick(pr)
+    enc, blind = _PositionEncoder(sim), _PositionEncoder(sim, constant=True)
+    s = tuple(scene_codes(sim, enc, pr.initial))
+    rules = RuleSet(bits=3, vocabulary=tuple(range(8)), max_objects=3, n_rules_before_generalization=0,
+                    rules=(Rule(action=a, code_from=s[0], code_to=s[0] ^ 1),))  # rules say a moves object 0
+    departs = run_problem(sim, enc, _Still(), pr, "departs", _fixed(lambda s, g: _plan([a], [s, _wrong(s)])),
+                          rules=rules)
+    aliased = run_problem(sim, blind, _Still(), pr, "stays", _fixed(lambda s, g: _plan([a], [s, s])))
+    none = run_problem(sim, enc, _Still(), pr, "none", _fixed(lambda s, g: PlanResult(
+        planner="none", status=PlanStatus.UNSOLVABLE, plan=(), predicted_states=(), expansions=0, planning_time_s=0)))
+    gen = run_problem(sim, enc, _Still(), pr, "gen", _fixed(lambda s, g: _plan(pr.actions, [])))
+    return departs, aliased, none, gen
+
+
+def test_failure_attribution_per_cause(sim, walks):
+    pr = walks[0]
+    departs, aliased, none, gen = _rows(sim, pr)
+    assert departs.failure_cause == "departure" and departs.failure_stage == "execution"
+    assert departs.attribution == {"first_departure_step": 0, "departed_objects": list(range(pr.k)),
+                                   "rules_net_disagree": True, "aliasing": False, "replans": 0,
+                                   "replan_failed": False, "continued": 0, "fallbacks": 0}
+    assert aliased.failure_cause == "symbol_aliasing" and aliased.symbolic_match and not aliased.success
+    assert aliased.attribution["aliasing"] and aliased.attribution["first_departure_step"] is None
+    assert aliased.max_distance_m > GOAL_TOLERANCE_M
+    assert none.failure_cause == "no_plan" and none.attribution["departed_objects"] == []
+    assert gen.success and gen.failure_cause is None and gen.attribution["first_departure_step"] is None
+    a = _empty_pick(pr)
+    enc = _PositionEncoder(sim)
+    agree = RuleSet(bits=3, vocabulary=tuple(range(8)), max_objects=3, n_rules_before_generalization=0, rules=())
+    for rules, want in ((agree, False), (None, None)):
+        row = run_problem(sim, enc, _Still(), pr, "d", _fixed(lambda s, g: _plan([a], [s, _wrong(s)])), rules=rules)
+        assert row.failure_cause == "departure" and row.attribution["rules_net_disagree"] is want
+
+
+def test_failure_causes_add_up_to_the_failures(sim, walks):
+    rows = [r for pr in walks[:2] for r in _rows(sim, pr)]
+    counts = failure_causes(rows)
+    assert counts == {"departure": 2, "no_plan": 2, "symbol_aliasing": 2}
+    assert sum(counts.values()) == sum(not r.success for r in rows)
+    as_json = [json.loads(json.dumps(r.to_json())) for r in rows]
+    assert failure_causes(as_json) == counts
+    legacy = {k: v for k, v in as_json[0].items() if k != "failure_cause"}
+    assert failure_causes([legacy]) == {"unattributed": 1}
+
+
+def test_rules_planner_replans_on_the_overridden_rules(tmp_path):
+    from pddl_export.overrides import override_rules
+    from symlearn.planning.planners import RulesTransition, make_pddl_planner
+
+    rules = RuleSet(bits=2, vocabulary=(0, 1, 2, 3), max_objects=2, n_rules_before_generalization=0,
+                    rules=(Rule(action=4, code_from=1, code_to=3), Rule(action=17, code_from=1, code_to=2),
+                           Rule(action=17, code_from=2, code_to=3)))
+    plan = make_pddl_planner(rules, "h", "fast-downward-sas-opt", write_dir=tmp_path)
+    goal = SymbolicGoal((3, None))
+    first = plan(RulesTransition(rules), np.array([1, 0]), goal, 20.0)
+    assert first.plan == (4,) and not first.extra["rules_vs_net"]
+    memory = ObservedTransitions(RulesTransition(rules))
+    memory.record((1, 0), 4, (1, 0))  # execution showed that action 4 does nothing here
+    second = plan(memory, np.array([1, 0]), goal, 20.0)
+    assert second.plan == (17, 17) and not second.extra["rules_vs_net"], second.message
+    fixed = override_rules(rules, memory.seen)
+    assert (tmp_path / "task_2.sas").read_text() == SASEncoder(fixed).task([1, 0], goal).text
+    assert (tmp_path / "task.sas").read_text() == SASEncoder(rules).task([1, 0], goal).text

@@ -1,13 +1,25 @@
-"""Executing symbolic plans in the simulator: open loop, or closed loop with replanning.
+"""Executing symbolic plans in the simulator: open loop, or closed loop with recovery.
 
 A plan (a PlanResult from any planner) is run action by action with `sim.step` from the
 problem's initial poses. After each action the real scene is rendered and encoded; the codes
 are compared with the planner's predicted state. Success is geometric (every object within
 2 cm of its goal position); the symbolic match (final codes == goal codes) is reported beside
-it. With `closed_loop=True`, a departure from the prediction triggers replanning from the
-observed codes, at most `max_replans` times; the replanning search uses the network corrected
-by every transition seen so far in this execution (ObservedTransitions), so it does not repeat an
-action the scene has just answered differently than predicted.
+it. With `closed_loop=True`, a departure from the prediction is answered in this order:
+
+1. continue: the rest of the plan, rolled from the observed codes through a corrected model
+   (the planner's own model or the network, answered from memory where execution has seen a
+   step), still reaches the goal codes: keep it, with the rolled states as its new predictions;
+2. fall back: a further plan of a top-k planner (PlanResult.alternatives) or the current
+   one passes through the observed codes, and its suffix from there reaches the goal when
+   rolled the same way: run that suffix (at most `max_fallbacks` times);
+3. replan from the observed codes (at most `max_replans` times) with the network corrected by
+   every step seen so far (ObservedTransitions); rule planners plan on their rules overridden
+   by those steps (pddl_export.overrides). A plan that ends away from the goal codes is
+   replanned too.
+
+Every failed row gets one cause (failure_cause) and an attribution: the first step whose
+observed codes departed from the prediction, which objects, whether the rules and the network
+disagree on that step, aliasing, replans.
 
     >>> row = run_problem(sim, encoder, transition, problem, "astar", make_planner("astar"),
     ...                   ExecutionConfig(closed_loop=True))                       # doctest: +SKIP
@@ -19,13 +31,15 @@ from __future__ import annotations
 import time
 from dataclasses import asdict, dataclass, field
 from enum import Enum
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 
 from search.result import PlanResult, PlanStatus, failed
+from pddl_export.rules import RuleSet, apply_rules
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
 from symlearn.planning.problem import GOAL_TOLERANCE_M, Problem
+from symlearn.planning.recovery import Progress, Segment, recover, replanned
 from symlearn.planning.scenes import max_goal_distance, place_scene, symbolic_goal
 from symlearn.symbolic.transition_data import encode_observation
 from symlearn.world import decode_action
@@ -53,13 +67,14 @@ class ExecutionConfig:
     tolerance_m: float = GOAL_TOLERANCE_M  # every object within 2 cm of its goal position
     closed_loop: bool = False  # replan when the observed codes depart from the prediction
     max_replans: int = 3  # bound on replanning calls per problem
+    max_fallbacks: int = 3  # bound on switches to another plan's suffix (top-k fallback) per problem
     timeout_s: float = 30.0  # per planner call
 
     def __post_init__(self) -> None:
         if not self.tolerance_m > 0:
             raise ValueError(f"tolerance_m={self.tolerance_m} must be positive")
-        if self.max_replans < 0:
-            raise ValueError(f"max_replans={self.max_replans} must be >= 0")
+        if self.max_replans < 0 or self.max_fallbacks < 0:
+            raise ValueError(f"max_replans={self.max_replans} and max_fallbacks={self.max_fallbacks} must be >= 0")
         if not self.timeout_s > 0:
             raise ValueError(f"timeout_s={self.timeout_s} must be positive")
 
@@ -78,6 +93,10 @@ class ExecutionResult:
     replans: int
     replan_failed: bool  # a replanning call found no plan, so execution stopped
     off_table: bool  # some object fell off the table
+    first_departure_step: int | None = None  # index into `executed` of the first step off its prediction
+    departed_objects: tuple[int, ...] = ()  # objects whose codes differed from the prediction there
+    continued: int = 0  # departures after which the plan's rest still reached the goal and was kept
+    fallbacks: int = 0  # switches to a suffix of another (top-k) plan
 
 
 class ObservedTransitions:
@@ -88,9 +107,10 @@ class ObservedTransitions:
     an action again in the state where the network was just proven wrong about it.
     """
 
-    def __init__(self, inner: TransitionFn) -> None:
+    def __init__(self, inner: TransitionFn, seen: dict | None = None) -> None:
         self.inner, self.bits = inner, inner.bits
-        self.seen: dict[tuple[int, ...], dict[int, tuple[int, ...]]] = {}  # state -> {action: next}
+        # state -> {action: next}; pass another memory's `seen` to share it (one memory, two models)
+        self.seen: dict[tuple[int, ...], dict[int, tuple[int, ...]]] = {} if seen is None else seen
 
     def record(self, state, action: int, nxt) -> None:
         self.seen.setdefault(tuple(int(c) for c in state), {})[int(action)] = tuple(int(c) for c in nxt)
@@ -118,11 +138,14 @@ def _codes(sim, encoder) -> tuple[int, ...]:
 def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: SymbolicGoal | np.ndarray,
                  config: ExecutionConfig = ExecutionConfig(),
                  replan: Callable[[np.ndarray], PlanResult] | None = None,
-                 record: Callable[[tuple, int, tuple], None] | None = None, recorder=None) -> ExecutionResult:
-    """Run plan.plan from the problem's initial poses; closed loop replans with `replan(observed_codes)`.
+                 record: Callable[[tuple, int, tuple], None] | None = None, recorder=None,
+                 models: Sequence[TransitionFn] = ()) -> ExecutionResult:
+    """Run plan.plan from the problem's initial poses; closed loop recovers from departures (module docstring).
 
-    `record(state, action, observed_next)` hears every executed step (ObservedTransitions.record);
-    `recorder` (a symlearn.planning.recording.PlanRecorder) takes a camera frame at the start and after each step.
+    `models` are the corrected models that roll a plan's rest from observed codes (without any, a departure
+    goes straight to `replan(observed_codes)`); `record(state, action, observed_next)` hears every executed
+    step (ObservedTransitions.record); `recorder` (a symlearn.planning.recording.PlanRecorder) takes a
+    camera frame at the start and after each step.
     """
     if config.closed_loop and replan is None:
         raise ValueError("closed-loop execution needs a replan function")
@@ -130,39 +153,59 @@ def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: Symboli
     place_scene(sim, problem.initial)
     if recorder is not None:
         recorder.start(sim)
-    codes = _codes(sim, encoder)
-    observed, executed = [codes], []
-    actions, predicted = list(plan.plan), list(plan.predicted_states)
-    t, replans, diverged, segment_ok, replan_failed, off_table = 0, 0, False, True, False, False
-    while t < len(actions):
-        res = sim.step(decode_action(actions[t]))
-        off_table |= res.off_table
-        executed.append(actions[t])
-        if recorder is not None:
-            recorder.step(sim, actions[t])
-        before, codes = codes, _codes(sim, encoder)
-        observed.append(codes)
-        if record is not None:
-            record(before, actions[t], codes)
-        if predicted and codes != predicted[t + 1]:
-            diverged, segment_ok = True, False
-            if config.closed_loop and replans < config.max_replans:
-                replans += 1
-                new = replan(np.asarray(codes, np.int64))
-                if not new.found:
-                    replan_failed = True
-                    break
-                actions, predicted, t, segment_ok = list(new.plan), list(new.predicted_states), 0, True
-                continue
-        t += 1
-    if not predicted:  # a planner without predictions: judge the end state only
-        segment_ok = bool(goal.satisfied(np.asarray(codes, np.int64))[0])
+    prog, seg = Progress([_codes(sim, encoder)]), Segment.of(plan)
+    while seg is not None:
+        while seg is not None and seg.t < len(seg.actions):
+            seg = _step(sim, encoder, seg, prog, goal, config, replan, record, recorder, models)
+        codes = prog.observed[-1]
+        if (seg is None or not config.closed_loop or prog.replans >= config.max_replans
+                or goal.satisfied(np.asarray(codes, np.int64))[0]):
+            break
+        seg = replanned(replan, codes, prog)  # the plan ended away from the goal codes
+    codes = prog.observed[-1]
+    if not plan.predicted_states:  # a planner without predictions: judge the end state only
+        prog.segment_ok = bool(goal.satisfied(np.asarray(codes, np.int64))[0])
     dist = max_goal_distance(sim.get_scene(), problem.goal, problem.free)
-    return ExecutionResult(success=dist <= config.tolerance_m and not off_table,
+    return ExecutionResult(success=dist <= config.tolerance_m and not prog.off_table,
                            symbolic_match=bool(goal.satisfied(np.asarray(codes, np.int64))[0]),
-                           max_distance_m=dist, executed=tuple(executed), observed_states=tuple(observed),
-                           diverged=diverged, on_prediction=segment_ok and not replan_failed, replans=replans,
-                           replan_failed=replan_failed, off_table=off_table)
+                           max_distance_m=dist, executed=tuple(prog.executed), observed_states=tuple(prog.observed),
+                           diverged=prog.diverged, on_prediction=prog.segment_ok and not prog.replan_failed,
+                           replans=prog.replans, replan_failed=prog.replan_failed, off_table=prog.off_table,
+                           first_departure_step=prog.first_departure, departed_objects=prog.departed,
+                           continued=prog.continued, fallbacks=prog.fallbacks)
+
+
+def _step(sim, encoder, seg: Segment, prog: Progress, goal: SymbolicGoal, config: ExecutionConfig,
+          replan, record, recorder, models) -> Segment | None:
+    """Execute seg's next action, observe, and on a departure recover; the segment to go on with (None: stop)."""
+    action = seg.actions[seg.t]
+    prog.off_table |= sim.step(decode_action(action)).off_table
+    prog.executed.append(action)
+    if recorder is not None:
+        recorder.step(sim, action)
+    before, codes = prog.observed[-1], _codes(sim, encoder)
+    prog.observed.append(codes)
+    if record is not None:
+        record(before, action, codes)
+    want = seg.predicted[seg.t + 1] if seg.predicted else codes
+    if codes == tuple(want):
+        seg.t += 1
+        return seg
+    prog.diverged, prog.segment_ok = True, False
+    if prog.first_departure is None:
+        prog.first_departure = len(prog.executed) - 1
+        prog.departed = tuple(i for i, (c, w) in enumerate(zip(codes, want)) if c != w)
+    if not config.closed_loop:
+        seg.t += 1
+        return seg
+    if models:
+        kept = recover(seg, codes, models, goal, prog, config.max_fallbacks)
+        if kept is not None:
+            return kept
+    if prog.replans >= config.max_replans:
+        seg.t += 1  # no replans left: go on with the plan as it is
+        return seg
+    return replanned(replan, codes, prog)
 
 
 @dataclass(frozen=True)
@@ -196,8 +239,10 @@ class ProblemRun:
                 raise ValueError(f"unknown failure stage {self.failure_stage!r}; "
                                  f"known: {', '.join(s.value for s in FailureStage)}")
             object.__setattr__(self, "failure_stage", FailureStage(self.failure_stage))
-        if self.success and self.failure_stage is not None:
-            raise ValueError("a successful run has no failure stage")
+        if self.success and (self.failure_stage is not None or self.failure_cause is not None):
+            raise ValueError("a successful run has no failure stage or cause")
+        if self.failure_cause is not None and self.failure_cause not in FAILURE_CAUSES:
+            raise ValueError(f"unknown failure cause {self.failure_cause!r}; known: {', '.join(FAILURE_CAUSES)}")
 
     def to_json(self) -> dict:
         """The row as plain JSON values (the failure stage as its string value)."""
@@ -217,6 +262,68 @@ def failure_stage(plan: PlanResult, ex: ExecutionResult | None) -> FailureStage 
     return FailureStage.GOAL_MISMATCH if ex.on_prediction else FailureStage.EXECUTION
 
 
+FAILURE_CAUSES = ("no_plan", "timeout", "off_table", "symbol_aliasing", "departure")
+
+
+def failure_cause(plan: PlanResult, ex: ExecutionResult | None) -> str | None:
+    """The one cause of a failed run (FAILURE_CAUSES), None on success.
+
+    No plan or a timeout; else an object off the table; else aliasing (the final codes meet the
+    goal codes, the poses do not); else a departure: the codes left the prediction (or, for a plan
+    without predictions, ended away from the goal codes it promised) and did not come back.
+    """
+    if not plan.found:
+        return "timeout" if plan.status is PlanStatus.TIMEOUT else "no_plan"
+    if ex is None or ex.success:
+        return None
+    if ex.off_table:
+        return "off_table"
+    return "symbol_aliasing" if ex.symbolic_match else "departure"
+
+
+def attribution(ex: ExecutionResult | None, goal: SymbolicGoal, transition: TransitionFn,
+                rules: RuleSet | None, tolerance_m: float) -> dict:
+    """Per-step details of a run (the attribution keys of ProblemRun); every key present, also without a run.
+
+    The first departure is the first executed step whose observed codes differ from the prediction;
+    a run without one that ended away from the goal codes departs at its end (step = number of
+    executed actions), with the objects whose codes miss the goal. rules_net_disagree compares the
+    rules' and the network's next codes on the first departed step (None without rules or step).
+    """
+    out = {"first_departure_step": None, "departed_objects": [], "rules_net_disagree": None, "aliasing": False,
+           "replans": 0, "replan_failed": False, "continued": 0, "fallbacks": 0}
+    if ex is None:
+        return out
+    final = np.asarray(ex.observed_states[-1], np.int64)
+    step, objects = ex.first_departure_step, list(ex.departed_objects)
+    if step is None and not ex.symbolic_match:
+        step = len(ex.executed)
+        objects = [i for i, c in enumerate(goal.codes) if c is not None and int(final[i]) != c]
+    disagree = None
+    if rules is not None and step is not None and step < len(ex.executed):
+        state, action = np.asarray([ex.observed_states[step]], np.int64), np.asarray([ex.executed[step]], np.int64)
+        net = np.asarray(transition(state, action), np.int64)[0]
+        disagree = bool(not np.array_equal(apply_rules(rules, state[0], int(action[0])), net))
+    out.update(first_departure_step=step, departed_objects=objects, rules_net_disagree=disagree,
+               aliasing=bool(ex.symbolic_match and ex.max_distance_m > tolerance_m), replans=ex.replans,
+               replan_failed=ex.replan_failed, continued=ex.continued, fallbacks=ex.fallbacks)
+    return out
+
+
+def failure_causes(rows) -> dict[str, int]:
+    """cause -> number of failed rows (ProblemRun or their JSON dicts); the counts add up to the failures.
+
+    A failed row without a cause (written before causes existed) counts as "unattributed".
+    """
+    out: dict[str, int] = {}
+    for r in rows:
+        get = r.get if isinstance(r, dict) else lambda k, r=r: getattr(r, k)
+        if not get("success"):
+            cause = get("failure_cause") or "unattributed"
+            out[cause] = out.get(cause, 0) + 1
+    return dict(sorted(out.items()))
+
+
 def safe_plan(planner: str, planner_fn: PlannerFn, transition: TransitionFn, start: np.ndarray,
               goal: SymbolicGoal, timeout_s: float) -> PlanResult:
     """Call a planner; an exception it raises becomes an ERROR result, so one problem cannot stop a benchmark."""
@@ -229,8 +336,12 @@ def safe_plan(planner: str, planner_fn: PlannerFn, transition: TransitionFn, sta
 
 def run_problem(sim, encoder, transition: TransitionFn, problem: Problem, planner: str, planner_fn: PlannerFn,
                 config: ExecutionConfig = ExecutionConfig(), initial_plan: PlanResult | None = None,
-                recorder=None) -> ProblemRun:
-    """Encode start and goal, plan (or reuse initial_plan), execute, and report one row (frames into `recorder`)."""
+                recorder=None, rules: RuleSet | None = None) -> ProblemRun:
+    """Encode start and goal, plan (or reuse initial_plan), execute, attribute a failure, report one row.
+
+    `rules` (default: the planner's own, for rule planners) let the attribution say whether the rules and
+    the network disagree on the first departed step; frames go into `recorder`.
+    """
     sym_goal = symbolic_goal(sim, encoder, problem)
     place_scene(sim, problem.initial)
     start = encode_observation(encoder, sim.observe())
@@ -238,13 +349,17 @@ def run_problem(sim, encoder, transition: TransitionFn, problem: Problem, planne
     ex = None
     if plan.found:
         memory = ObservedTransitions(transition)
+        own = getattr(planner_fn, "planning_model", None)  # rule planners predict with their rules
+        models = (memory,) if own is None else (ObservedTransitions(own(transition), memory.seen), memory)
         ex = execute_plan(sim, problem, plan, encoder, sym_goal, config,
                           replan=lambda codes: safe_plan(planner, planner_fn, memory, codes, sym_goal,
                                                          config.timeout_s),
-                          record=memory.record if config.closed_loop else None, recorder=recorder)
+                          record=memory.record if config.closed_loop else None, recorder=recorder, models=models)
     elif recorder is not None:  # nothing to execute: the start scene alone
         place_scene(sim, problem.initial)
         recorder.start(sim)
+    rules = rules if rules is not None else getattr(planner_fn, "rules", None)
+    cause, why = failure_cause(plan, ex), attribution(ex, sym_goal, transition, rules, config.tolerance_m)
     return ProblemRun(
         problem=problem.name, planner=planner, found=plan.found, status=plan.status.value,
         plan_length=len(plan.plan) if plan.found else None, planning_time_s=plan.planning_time_s,
@@ -252,4 +367,5 @@ def run_problem(sim, encoder, transition: TransitionFn, problem: Problem, planne
         max_distance_m=None if ex is None else round(ex.max_distance_m, 5), closed_loop=config.closed_loop,
         replans=0 if ex is None else ex.replans, failure_stage=failure_stage(plan, ex),
         generator_length=problem.generator_length, message=plan.message, n_objects=problem.k,
-        timings={k: v for k, v in plan.extra.items() if k.endswith("_s")}, task=problem.task)
+        timings={k: v for k, v in plan.extra.items() if k.endswith("_s")}, task=problem.task,
+        failure_cause=cause, attribution=why)

@@ -32,7 +32,8 @@ import numpy as np
 
 from pddl_export.files import atomic_write_text, sha256_file
 from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl
-from pddl_export.rules import RuleSet
+from pddl_export.overrides import override_rules
+from pddl_export.rules import RuleSet, apply_rules_batch
 from pddl_export.rules_io import PDDL_DIR, RULES_FILE, load_rules
 from pddl_export.sas_writer import SASEncoder
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
@@ -114,49 +115,87 @@ def network_agrees(transition: TransitionFn, plan: PlanResult) -> bool:
     return True
 
 
+class RulesTransition:
+    """The rules as a transition function (apply_rules_batch): what a rule planner predicts a step does."""
+
+    def __init__(self, rules: RuleSet) -> None:
+        self.rules, self.bits = rules, rules.bits
+
+    def __call__(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        return apply_rules_batch(self.rules, np.asarray(codes, np.int64), np.asarray(actions, np.int64))
+
+
+def _observation_key(transition: TransitionFn) -> tuple:
+    """The observed steps a transition carries (ObservedTransitions.seen), as a hashable key; () if none."""
+    seen = getattr(transition, "seen", None) or {}
+    return tuple(sorted((s, a, n) for s, steps in seen.items() for a, n in steps.items()))
+
+
 class _RulesPlanner:
     """A planner function over the exported rules: PDDL (conditional or grounded STRIPS) or a SAS+ task.
 
-    With `write_dir`, every problem it writes is also saved there (problem.pddl, then
-    problem_2.pddl for a replan, ...; STRIPS planners save their grounded domain beside it,
-    SAS+ planners the task.sas they ran).
+    Given a transition that carries observed steps (execution's ObservedTransitions, its `seen`),
+    it plans on the rules overridden by them (pddl_export.overrides), so a replan does not count
+    on a step execution has disproven. With `write_dir`, every problem it writes is also saved
+    there (problem.pddl, then problem_2.pddl for a replan, ...; STRIPS planners save their
+    grounded domain beside it, SAS+ planners the task.sas they ran, and a replan on overridden
+    rules the conditional domain_<n>.pddl it used).
     """
 
     def __init__(self, rules: RuleSet, model_hash: str, name: str, engine: str, form: str,
                  write_dir: Path | None) -> None:
         self.rules, self.model_hash, self.name, self.engine, self.form = rules, model_hash, name, engine, form
         self.write_dir = None if write_dir is None else Path(write_dir)
-        self.domain = conditional_domain(rules, model_hash) if form == "conditional" else None
-        self.encoder = SASEncoder(rules) if form == "sas" else None
         self.calls = 0
+        self._cache: tuple = ()
+        self._tools = self._build(rules)
+
+    def _build(self, rules: RuleSet) -> tuple[RuleSet, str | None, SASEncoder | None]:
+        return (rules, conditional_domain(rules, self.model_hash) if self.form == "conditional" else None,
+                SASEncoder(rules) if self.form == "sas" else None)
+
+    def _tools_for(self, transition: TransitionFn) -> tuple[RuleSet, str | None, SASEncoder | None]:
+        """(rules, conditional domain, SAS+ encoder) for this call: overridden by the transition's observations."""
+        key = _observation_key(transition)
+        if not key:
+            return self._tools
+        if not self._cache or self._cache[0] != key:
+            self._cache = (key, self._build(override_rules(self.rules, transition.seen)))  # type: ignore[attr-defined]
+        return self._cache[1]
+
+    def planning_model(self, transition: TransitionFn) -> TransitionFn:
+        """What this planner predicts a step does (its rules), for execution's check of a plan's remainder."""
+        return RulesTransition(self.rules)
 
     def __call__(self, transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
         init = [int(c) for c in start]
-        if self.encoder is not None:
-            return self._checked(transition, self._solve_sas(init, goal, timeout_s))
-        return self._solve_pddl(transition, init, goal, timeout_s)
+        rules, domain, encoder = self._tools_for(transition)
+        if encoder is not None:
+            return self._checked(transition, self._solve_sas(rules, encoder, init, goal, timeout_s))
+        return self._solve_pddl(rules, domain, transition, init, goal, timeout_s)
 
-    def _solve_sas(self, init: list[int], goal: SymbolicGoal, timeout_s: float) -> PlanResult:
+    def _solve_sas(self, rules: RuleSet, encoder: SASEncoder, init: list[int], goal: SymbolicGoal,
+                   timeout_s: float) -> PlanResult:
         prob_path = self._next_path("problem", ".pddl")
         if prob_path is not None:  # the SAS+ task is saved next to the same problem in PDDL, for reading
             try:
-                atomic_write_text(prob_path, problem_pddl(self.rules, init, goal, self.model_hash))
+                atomic_write_text(prob_path, problem_pddl(rules, init, goal, self.model_hash))
             except ValueError:
                 pass  # unknown codes: solve_sas reports them
         sas_path = None if prob_path is None else prob_path.with_name(prob_path.name.replace("problem", "task")
                                                                       .replace(".pddl", ".sas"))
-        return solve_sas(self.encoder, init, goal, self.engine, timeout_s, write_to=sas_path)
+        return solve_sas(encoder, init, goal, self.engine, timeout_s, write_to=sas_path)
 
-    def _solve_pddl(self, transition: TransitionFn, init: list[int], goal: SymbolicGoal,
-                    timeout_s: float) -> PlanResult:
+    def _solve_pddl(self, rules: RuleSet, domain: str | None, transition: TransitionFn, init: list[int],
+                    goal: SymbolicGoal, timeout_s: float) -> PlanResult:
         t0 = time.perf_counter()
         try:
             prebuilt = None
             if self.form == "strips":  # built directly: unified-planning's reader is too slow for its size
-                task = strips_pddl(self.rules, init, goal, self.model_hash)
+                task = strips_pddl(rules, init, goal, self.model_hash)
                 dom, prob, prebuilt = task.domain, task.problem, strips_problem(task)
             else:
-                dom, prob = self.domain, problem_pddl(self.rules, init, goal, self.model_hash)
+                dom, prob = domain, problem_pddl(rules, init, goal, self.model_hash)
         except (ValueError, RuntimeError) as e:  # codes outside the vocabulary, too many states
             return failed(self.name, PlanStatus.ERROR, t0, str(e))
         prob_path = self._next_path("problem", ".pddl")
@@ -164,6 +203,8 @@ class _RulesPlanner:
             atomic_write_text(prob_path, prob)
             if self.form == "strips":
                 atomic_write_text(prob_path.with_name(prob_path.name.replace("problem", "domain_strips")), dom)
+            elif rules is not self.rules:
+                atomic_write_text(prob_path.with_name(prob_path.name.replace("problem", "domain")), dom)
         write_s = time.perf_counter() - t0
         res = solve_pddl(dom, prob, self.engine, max(timeout_s - write_s, 0.001),
                          cache_domain=self.form == "conditional", problem=prebuilt)
