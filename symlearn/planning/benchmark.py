@@ -2,7 +2,9 @@
 
 Planners are named entries of the one registry, symlearn.planning.planners.PLANNERS (the
 learned-net A* variants and the planners on the exported rules); `benchmark` builds the named
-ones for the run and refuses unknown names before any work.
+ones for the run and refuses unknown names before any work. Beside the per-planner summary, the
+result holds `grid` (objects x reference-length bucket, open and closed loop), `failure_causes`
+and `tasks` (structure-suite tasks); symlearn.planning.benchmark_plots renders them.
 
     >>> res = benchmark(Path("runs/paper"), Path("problems/p13"), ["astar", "astar-ucs"],
     ...                 Path("runs/paper/bench.json"), closed_loop=True, timeout_s=30)  # doctest: +SKIP

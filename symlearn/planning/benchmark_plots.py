@@ -98,19 +98,24 @@ def _figure(grid: dict, key: str, ylabel: str, log: bool, loops: tuple[str, ...]
     from matplotlib.figure import Figure
 
     objects = sorted({k for by_loop in grid.values() for loop in by_loop.values() for k in loop}, key=int)
-    buckets = [b for b in LENGTH_BUCKETS if any(b in cells for by_loop in grid.values()
-                                                for loop in by_loop.values() for cells in loop.values())]
+    buckets = [b for b in LENGTH_BUCKETS if b in MAIN_BUCKETS or any(
+        b in cells for by_loop in grid.values() for loop in by_loop.values() for cells in loop.values())]
     fig = Figure(figsize=(PANEL_IN[0] * max(len(objects), 1), PANEL_IN[1]), dpi=DPI, layout="constrained")
-    axes = fig.subplots(1, max(len(objects), 1), squeeze=False)[0]
+    axes = fig.subplots(1, max(len(objects), 1), squeeze=False, sharey=True)[0]
     colours = {p: f"C{i % 10}" for i, p in enumerate(grid)}
+    xs = list(range(len(buckets)))  # the same bucket positions on every panel
+    handles: dict = {}
     for ax, k in zip(axes, objects):
         for planner, by_loop in grid.items():
             for loop in loops:
                 ys = _series(by_loop, loop, k, buckets, key)
                 if not all(math.isnan(y) for y in ys):
-                    ax.plot(buckets, ys, marker="o", color=colours[planner], linestyle="-" if loop == "open" else "--",
-                            label=f"{planner} ({loop})")
+                    (line,) = ax.plot(xs, ys, marker="o", color=colours[planner],
+                                      linestyle="-" if loop == "open" else "--")
+                    handles.setdefault(f"{planner} ({loop})", line)
         ax.set_title(f"{k} object{'s' if k != '1' else ''}")
+        ax.set_xticks(xs, buckets)
+        ax.set_xlim(-0.5, len(buckets) - 0.5)
         ax.set_xlabel("reference plan length")
         if log:
             ax.set_yscale("log")
@@ -118,8 +123,8 @@ def _figure(grid: dict, key: str, ylabel: str, log: bool, loops: tuple[str, ...]
             ax.set_ylim(-0.03, 1.03)
         ax.grid(alpha=0.3)
     axes[0].set_ylabel(ylabel)
-    if objects:
-        axes[-1].legend(fontsize=7, loc="best")
+    if handles:
+        fig.legend(list(handles.values()), list(handles), loc="outside right upper", fontsize=7)
     return fig
 
 
