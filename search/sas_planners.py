@@ -8,7 +8,9 @@ SymK is a fork of Fast Downward with symbolic (BDD) search and reads the same fo
 The plan is read back, replayed with the rules (it must reach the goal, else the encoding
 is wrong and the result is an ERROR) and reported with the planner's own times:
 `fd_search_time_s` (search only) and `fd_total_time_s` (reading the task + search), next to
-`planner_time_s` (the process, wall clock) and `sas_write_time_s`.
+`planner_time_s` (the process, wall clock) and `sas_write_time_s`. "symk-sas-topk" runs symk-sas, then
+SymK's top-k search for the TOP_K shortest loopless plans: the best is the result's plan, the others
+(each replayed with the rules the same way) its `alternatives`, shortest first.
 
     >>> r = solve_sas(SASEncoder(rules), [3, 7], [5, None], "fast-downward-sas", 10)  # doctest: +SKIP
     >>> r.status, r.plan, r.extra["fd_search_time_s"]                                 # doctest: +SKIP
@@ -43,6 +45,19 @@ class SASPlanner:
     search: str  # the --search argument
     optimal: bool  # guarantees a shortest plan (unit costs)
     negation: Negation = Negation.AXIOMS  # the task form its heuristics accept (see pddl_export.sas_writer)
+    top_k: int = 1  # plans asked for: more than one comes back as PlanResult.alternatives (SymK only)
+
+
+TOP_K = 5  # plans symk-sas-topk asks for: the best, and up to four to fall back on
+TOP_K_SLACK = 2  # its further plans are at most this many actions longer than the best
+
+
+def top_k_search(k: int, bound: int) -> str:
+    """SymK's top-k search for the k shortest loopless plans shorter than `bound` (written to plan.1 .. plan.k).
+
+    simple=true: no plan visits a state twice, so an alternative is not the best plan with a wasted step.
+    """
+    return f"symk_bd(simple=true, bound={bound}, plan_selection=top_k(num_plans={k}))"
 
 
 SAS_PLANNERS = {
@@ -51,6 +66,9 @@ SAS_PLANNERS = {
     "fast-downward-sas": SASPlanner("up_fast_downward", "let(hff, ff(), eager_greedy([hff], preferred=[hff]))", False),
     "fast-downward-sas-opt": SASPlanner("up_fast_downward", "astar(blind())", True),
     "symk-sas": SASPlanner("up_symk", "sym_bd()", True),  # symbolic bidirectional uniform-cost search
+    # symk-sas first (SymK's top-k search never ends on a task without plans, even under a bound), then the
+    # top-k search bounded by the best plan's length + TOP_K_SLACK for the further plans (see _more_plans)
+    "symk-sas-topk": SASPlanner("up_symk", "sym_bd()", True, top_k=TOP_K),
     # optimal A* with a merge-and-shrink abstraction (bisimulation, DFP merging): the strong admissible heuristic
     # that takes conditional effects; it refuses axioms, so the task tracks "z does not hold X" in effects
     "fast-downward-sas-ms": SASPlanner(
@@ -108,55 +126,113 @@ def _read_log(log: str, extra: dict) -> int | None:
     return int(expanded[-1]) if expanded else None
 
 
-def _run_search(binary: Path, spec: SASPlanner, task_text: str, planner: str, timeout_s: float, write_s: float,
-                memory_mb: int, t0: float, extra: dict) -> tuple[list[str], int | None] | PlanResult:
-    """Run the search binary on the task (standard input): the plan's operator names and expansions, or a failure.
+def _read_plans(folder: Path) -> list[list[str]]:
+    """Operator names of each complete plan the binary wrote: `plan`, or `plan.1`, `plan.2`, ... for top-k.
 
-    The binary runs in its own process group in a symlearn-fd-* folder; the group is killed at the time
-    limit, and both the group and the folder go on a kill of this process (search.processes).
+    A file without its closing "; cost" line was cut short by a kill and is left out.
     """
-    with planner_guard(), temp_dir("symlearn-fd-") as tmp:  # for the plan file
-        plan_path = tmp / "plan"
-        args = [str(binary), "--search", spec.search, "--internal-plan-file", str(plan_path)]
+    files = [folder / "plan"] if (folder / "plan").is_file() else sorted(
+        (f for f in folder.glob("plan.*") if f.suffix[1:].isdigit()), key=lambda f: int(f.suffix[1:]))
+    plans = []
+    for f in files:
+        lines = [ln.strip() for ln in f.read_text().splitlines()]
+        if any(ln.startswith("; cost") for ln in lines):
+            plans.append([ln[1:-1] for ln in lines if ln.startswith("(")])
+    return plans
+
+
+def _run_search(binary: Path, search: str, task_text: str, planner: str, timeout_s: float, spent_s: float,
+                memory_mb: int, t0: float, extra: dict,
+                partial_ok: bool = False) -> tuple[list[list[str]], int | None] | PlanResult:
+    """Run the search binary on the task (standard input): its plans' operator names and expansions, or a failure.
+
+    The binary runs in its own process group in a symlearn-fd-* folder for timeout_s - spent_s; the group
+    is killed at the limit, and both the group and the folder go on a kill of this process
+    (search.processes). With partial_ok, a search stopped by the limit returns the plans it had completed
+    (extra["top_k_timed_out"]).
+    """
+    with planner_guard(), temp_dir("symlearn-fd-") as tmp:  # for the plan files
+        args = [str(binary), "--search", search, "--internal-plan-file", str(tmp / "plan")]
         t1 = time.perf_counter()
         try:
             code, log, err, timed_out = run_group(
-                args, task_text, max(timeout_s - write_s, 1e-3), cwd=tmp,
+                args, task_text, max(timeout_s - spent_s, 1e-3), cwd=tmp,
                 after_start=(lambda pid: _limit_memory(pid, memory_mb)) if memory_mb else None)
         except OSError as e:
             return failed(planner, PlanStatus.ERROR, t0, f"could not run {planner}: {e}", **extra)
-        if timed_out:
+        plans = _read_plans(tmp) if code == 0 or (timed_out and partial_ok) else []
+        if timed_out and not plans:
             return failed(planner, PlanStatus.TIMEOUT, t0, f"{planner} hit the {timeout_s:g} s time limit "
                           "(process group killed)", planner_time_s=time.perf_counter() - t1, **extra)
         extra["planner_time_s"] = time.perf_counter() - t1
+        if timed_out:
+            extra["top_k_timed_out"] = True
         expansions = _read_log(log, extra)
-        if code != 0 or not plan_path.is_file():
+        if not plans:
             status, why = _EXIT.get(code, (PlanStatus.ERROR, f"exited with code {code}"))
             why = why if status is PlanStatus.UNSOLVABLE else f"{planner} {why}"
             tail = (err.strip().splitlines() or [""])[-1]
             return failed(planner, status, t0, f"{why}{': ' + tail if status is PlanStatus.ERROR and tail else ''}",
                           **extra)
-        names = [ln.strip()[1:-1] for ln in plan_path.read_text().splitlines() if ln.strip().startswith("(")]
-    return names, expansions
+    return plans, expansions
 
 
-def _replayed(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal, names: list[str], planner: str,
-              spec: SASPlanner, expansions: int | None, t0: float, extra: dict) -> PlanResult:
-    """The plan as action ids, replayed with the rules; an ERROR if it names unknown operators or misses the goal."""
-    try:
-        plan = tuple(action_id_from_name(n) for n in names)
-    except ValueError as e:
-        return failed(planner, PlanStatus.ERROR, t0, f"{planner} returned an unknown operator: {e}", **extra)
+def _more_plans(binary: Path, k: int, best: int, task_text: str, planner: str, timeout_s: float, memory_mb: int,
+                t0: float, extra: dict) -> list[list[str]] | None:
+    """The k shortest loopless plans at most TOP_K_SLACK longer than the best (of length `best`), in the time
+    left; on a failure or time-out, only those completed, or None (the first search's plan stands alone)."""
+    more, t2 = {}, time.perf_counter()
+    ran = _run_search(binary, top_k_search(k, best + 1 + TOP_K_SLACK), task_text, planner, timeout_s,
+                      t2 - t0, memory_mb, t0, more, partial_ok=True)
+    extra["top_k_time_s"] = time.perf_counter() - t2
+    extra["planner_time_s"] = extra.get("planner_time_s", 0.0) + extra["top_k_time_s"]  # both processes
+    for key in ("fd_total_time_s", "fd_search_time_s"):
+        if key in more:
+            extra[key] = extra.get(key, 0.0) + more[key]
+    if isinstance(ran, PlanResult):
+        extra["top_k_timed_out"] = ran.status is PlanStatus.TIMEOUT
+        return None
+    extra["top_k_timed_out"] = bool(more.get("top_k_timed_out"))
+    return ran[0]
+
+
+def _replay(rules, init: Sequence[int], names: list[str]) -> tuple[tuple[int, ...], tuple[tuple[int, ...], ...]]:
+    """A plan's action ids and the states the rules predict along it (ValueError on an unknown operator)."""
+    plan = tuple(action_id_from_name(n) for n in names)
     states = [np.asarray([int(c) for c in init], np.int64)]
     for a in plan:
-        states.append(apply_rules(encoder.rules, states[-1], a))
-    if not goal.satisfied(states[-1])[0]:
+        states.append(apply_rules(rules, states[-1], a))
+    return plan, tuple(tuple(int(c) for c in s) for s in states)
+
+
+def _replayed(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal, plans: list[list[str]], planner: str,
+              spec: SASPlanner, expansions: int | None, t0: float, extra: dict) -> PlanResult:
+    """The best plan as action ids, replayed with the rules; an ERROR if it names unknown operators or misses
+    the goal. Further plans (top-k) become alternatives, shortest first; any that miss the goal are dropped."""
+    try:
+        plan, states = _replay(encoder.rules, init, plans[0])
+    except ValueError as e:
+        return failed(planner, PlanStatus.ERROR, t0, f"{planner} returned an unknown operator: {e}", **extra)
+    if not goal.satisfied(np.asarray(states[-1]))[0]:
         return failed(planner, PlanStatus.ERROR, t0, f"the plan does not reach the goal under the rules "
                       f"(the SAS+ encoding disagrees with apply_rules)", **extra)
-    return PlanResult(planner=planner, status=PlanStatus.SOLVED, plan=plan,
-                      predicted_states=tuple(tuple(int(c) for c in s) for s in states), expansions=expansions,
-                      planning_time_s=time.perf_counter() - t0,
-                      extra=dict(extra, optimal=spec.optimal))
+    alternatives, dropped = {}, 0
+    for names in plans[1:]:
+        try:
+            alt, alt_states = _replay(encoder.rules, init, names)
+        except ValueError:
+            dropped += 1
+            continue
+        if alt == plan or alt in alternatives or not goal.satisfied(np.asarray(alt_states[-1]))[0]:
+            dropped += 1
+            continue
+        alternatives[alt] = alt_states
+    if spec.top_k > 1:
+        extra = dict(extra, top_k_plans=1 + len(alternatives), top_k_dropped=dropped)
+    ordered = sorted(alternatives.items(), key=lambda kv: len(kv[0]))  # stable: the planner's order within a length
+    return PlanResult(planner=planner, status=PlanStatus.SOLVED, plan=plan, predicted_states=states,
+                      expansions=expansions, planning_time_s=time.perf_counter() - t0,
+                      extra=dict(extra, optimal=spec.optimal), alternatives=tuple(ordered))
 
 
 def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Sequence[int | None], planner: str,
@@ -189,8 +265,11 @@ def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Seq
              "sas_operators": task.n_operators, "sas_effects": task.n_effects, "sas_axioms": task.n_axioms}
     if write_to is not None:
         atomic_write_text(Path(write_to), task.text)
-    ran = _run_search(binary, spec, task.text, planner, timeout_s, write_s, memory_mb, t0, extra)
+    ran = _run_search(binary, spec.search, task.text, planner, timeout_s, write_s, memory_mb, t0, extra)
     if isinstance(ran, PlanResult):
         return ran
-    names, expansions = ran
-    return _replayed(encoder, init, goal_g, names, planner, spec, expansions, t0, extra)
+    plans, expansions = ran
+    if spec.top_k > 1:
+        plans = _more_plans(binary, spec.top_k, len(plans[0]), task.text, planner, timeout_s, memory_mb, t0,
+                            extra) or plans
+    return _replayed(encoder, init, goal_g, plans, planner, spec, expansions, t0, extra)

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from pddl_export.pddl_writer import action_name, conditional_domain, problem_pddl
-from pddl_export.rules import INF, Rule, RuleSet, apply_rules_batch
+from pddl_export.rules import INF, Rule, RuleSet, apply_rules, apply_rules_batch
 from pddl_export.sas_writer import SASEncoder, TermKind, context_terms
 from search.sas_planners import SAS_PLANNERS, search_binary, solve_sas
 from search.result import PlanStatus
@@ -226,3 +226,61 @@ def test_effects_negation_has_no_axioms_and_same_optimal_lengths(random_nets):  
             assert (len(res.plan) if res.status is PlanStatus.SOLVED else -1) == want, (init, goal, res.message)
             compared += 1
     assert compared >= 4 or search_binary("up_fast_downward") is None
+
+
+def _loopless_plan_lengths(rs, init, goal: SymbolicGoal, max_depth: int) -> list[int]:
+    """The length of every plan under apply_rules that visits no state twice, up to max_depth, sorted."""
+
+    lengths, stack = [], [((tuple(init),), 0)]
+    while stack:
+        path, depth = stack.pop()
+        if goal.satisfied(np.array(path[-1]))[0]:
+            lengths.append(depth)
+            continue  # a loopless plan ends at its first goal state
+        if depth == max_depth:
+            continue
+        for a in range(N_ACTIONS):
+            nxt = tuple(int(c) for c in apply_rules(rs, np.array(path[-1]), a))
+            if nxt not in path:
+                stack.append((path + (nxt,), depth + 1))
+    return sorted(lengths)
+
+
+def test_top_k_returns_the_k_shortest_loopless_plans_each_valid_under_the_rules():
+    """Start (1, 3), goal (2, 2): three plans of length 2 ([0, 1], [1, 0], [3, 0]) and longer detours.
+
+    symk-sas-topk returns TOP_K distinct plans, each reaching the goal when replayed with the rules,
+    shortest first, whose lengths are the TOP_K smallest over every loopless plan at most TOP_K_SLACK longer.
+    """
+    from search.sas_planners import TOP_K, TOP_K_SLACK
+
+    _require("symk-sas-topk")
+    rs = RuleSet(2, (1, 2, 3), 2, (Rule(0, 1, 2), Rule(1, 3, 2), Rule(3, 3, 1), Rule(4, 2, 3)), 4)
+    init, goal = (1, 3), SymbolicGoal((2, 2))
+    want = _loopless_plan_lengths(rs, init, goal, max_depth=2 + TOP_K_SLACK)[:TOP_K]
+    assert want[:3] == [2, 2, 2] and len(want) == TOP_K and want[-1] > 2  # the case has ties and longer plans
+    res = solve_sas(SASEncoder(rs), init, goal, "symk-sas-topk", timeout_s=20)
+    assert res.status is PlanStatus.SOLVED, res.message
+    plans = [(res.plan, res.predicted_states)] + list(res.alternatives)
+    assert len(plans) == TOP_K and len({p for p, _ in plans}) == TOP_K
+    assert [len(p) for p, _ in plans] == want
+    for plan, states in plans:
+        replay = [np.array(init)]
+        for a in plan:
+            replay.append(apply_rules(rs, replay[-1], a))
+        assert states == tuple(tuple(int(c) for c in s) for s in replay)
+        assert goal.satisfied(replay[-1])[0] and len(set(states)) == len(states)  # valid and loopless
+    assert res.extra["top_k_plans"] == TOP_K and res.extra["top_k_dropped"] == 0
+    assert solve_sas(SASEncoder(rs), init, goal, "symk-sas", timeout_s=20).alternatives == ()
+
+
+def test_plan_files_cut_short_by_a_kill_are_left_out(tmp_path):
+    """A top-k plan file without its closing cost line (the binary was killed while writing it) is not read."""
+    from search.sas_planners import _read_plans
+
+    (tmp_path / "plan.1").write_text("(pick-0-release-1)\n(pick-1-release-2)\n; cost = 2 (unit cost)\n")
+    (tmp_path / "plan.10").write_text("(pick-0-release-3)\n; cost = 1 (unit cost)\n")
+    (tmp_path / "plan.2").write_text("(pick-0-release-1)\n(pick-2-rel")
+    assert _read_plans(tmp_path) == [["pick-0-release-1", "pick-1-release-2"], ["pick-0-release-3"]]
+    (tmp_path / "plan").write_text("(pick-5-release-0)\n; cost = 1 (unit cost)\n")
+    assert _read_plans(tmp_path) == [["pick-5-release-0"]]

@@ -10,6 +10,7 @@ ValueError / RuntimeError with one-line messages, which the main CLI prints.
     symlearn problems --goal examples/goals/fig6_composite.json --out problems/goals
     symlearn plan --run runs/paper --problem problems/p13/problem_0000.json --planner astar --closed-loop
     symlearn benchmark --run runs/paper --problems problems/p13 --planners astar,astar-ucs --out bench.json
+    symlearn benchmark --run runs/paper --problems problems/grid --planners astar,symk-sas --out g.json --plots plots/
 
 `problems` records its settings in OUT/problems.manifest: the same command again completes an
 interrupted set, other settings are refused unless --overwrite. `benchmark` appends every finished
@@ -142,13 +143,19 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 def cmd_benchmark(args: argparse.Namespace) -> int:
     from symlearn.planning.benchmark import benchmark, format_table
+    from symlearn.planning.benchmark_plots import format_grid, write_plots
 
     _set_threads(args)
-    res = benchmark(Path(args.run), Path(args.problems), args.planners, Path(args.out), closed_loop=args.closed_loop,
+    res = benchmark(Path(args.run), args.problems, args.planners, Path(args.out), closed_loop=args.closed_loop,
                     timeout_s=args.timeout, max_replans=args.max_replans, show_progress=not args.quiet,
                     record_dir=Path(args.record) if args.record else None)
     print(format_table(res))
+    print()
+    print(format_grid(res["grid"]))
     print(f"wrote {args.out}")
+    if args.plots:
+        for path in write_plots(res["grid"], Path(args.plots)):
+            print(f"wrote {path}")
     return 0
 
 
@@ -226,10 +233,13 @@ def add_benchmark_command(sub) -> None:
     """Add `benchmark` to the CLI's sub-parsers."""
     c = sub.add_parser("benchmark", help="plan and execute every problem of a directory with several planners")
     c.add_argument("--run", required=True, help="run directory with best.pt and transition.pt")
-    c.add_argument("--problems", required=True, help="directory of problem JSON files")
+    c.add_argument("--problems", required=True,
+                   help="folder of problem JSON files; several as A,B,C, or a folder whose subfolders are problem "
+                        "sets (rows then carry the set's folder name)")
     c.add_argument("--planners", type=planner_list, default=["astar", "astar-ucs"],
                    help="comma-separated planner names")
     c.add_argument("--out", required=True, help="benchmark JSON file")
+    c.add_argument("--plots", help="folder for the success and planning-time plots by objects x reference length")
     c.add_argument("--quiet", action="store_true")
     c.add_argument("--record", help="directory for GIFs of failed plans (<problem>_<planner>.gif)")
     _add_execution_flags(c)

@@ -1,8 +1,10 @@
-"""Benchmarking planners on a directory of problems: plan with the learned symbols, execute, score.
+"""Benchmarking planners on folders of problems: plan with the learned symbols, execute, score.
 
 Planners are named entries of the one registry, symlearn.planning.planners.PLANNERS (the
 learned-net A* variants and the planners on the exported rules); `benchmark` builds the named
-ones for the run and refuses unknown names before any work.
+ones for the run and refuses unknown names before any work. Beside the per-planner summary, the
+result holds `grid` (objects x reference-length bucket, open and closed loop), `failure_causes`
+and `tasks` (structure-suite tasks); symlearn.planning.benchmark_plots renders them.
 
     >>> res = benchmark(Path("runs/paper"), Path("problems/p13"), ["astar", "astar-ucs"],
     ...                 Path("runs/paper/bench.json"), closed_loop=True, timeout_s=30)  # doctest: +SKIP
@@ -10,17 +12,21 @@ ones for the run and refuses unknown names before any work.
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
 import statistics
 import time
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Sequence
 
 from pddl_export.files import finite_or_null
 from pddl_export.rules_io import PDDL_DIR, RULES_FILE
-from symlearn.planning.execution import ExecutionConfig, ProblemRun, run_problem
+from symlearn.planning.execution import ExecutionConfig, ProblemRun, failure_causes, run_problem
 from symlearn.planning.planners import make_planners
+from symlearn.planning.problem import RANDOM_WALK, Problem, load_problems
 from symlearn.planning.recording import PlanRecorder
 from symlearn.provenance import atomic_write_json, atomic_write_text, sha256_bytes, sha256_file, versions
 
@@ -62,6 +68,69 @@ def summarize_rows(rows: list[ProblemRun]) -> dict:
             s["success_rate_closed_loop"] = _rate(closed, "success")
             s["mean_replans_closed_loop"] = round(statistics.mean(r.replans for r in closed), 3)
         out[planner] = s
+    return out
+
+
+LENGTH_BUCKETS = ("1-2", "3-4", "5-6", "7-8", "9+", "?")  # reference (generator) plan lengths, in plot order
+LOOPS = ("open", "closed")
+
+
+def length_bucket(length: int | None) -> str:
+    """The reference-length bucket of a problem: "1-2", "3-4", "5-6", "7-8", "9+", or "?" for 0 or unknown."""
+    if not isinstance(length, int) or length <= 0:
+        return "?"
+    if length > 8:
+        return "9+"
+    lo = length - (length + 1) % 2
+    return f"{lo}-{lo + 1}"
+
+
+def _cell(rows: list[ProblemRun]) -> dict:
+    """Success, found rate, median planning time and (over solved rows) mean plan and reference lengths."""
+    solved = [r for r in rows if r.found]
+    return {"n": len(rows), "success_rate": _rate(rows, "success"), "found_rate": _rate(rows, "found"),
+            "median_time_s": round(statistics.median(r.planning_time_s for r in rows), 5),
+            "mean_plan_length": round(statistics.mean(r.plan_length for r in solved), 3) if solved else None,
+            "mean_reference_length": round(statistics.mean(r.generator_length for r in solved), 3) if solved else None}
+
+
+def summary_grid(rows: list[ProblemRun]) -> dict:
+    """planner -> "open"/"closed" -> object count -> length bucket -> cell (_cell); only cells with rows."""
+    out: dict = {}
+    for planner in dict.fromkeys(r.planner for r in rows):
+        out[planner] = {}
+        for loop in LOOPS:
+            mine = [r for r in rows if r.planner == planner and r.closed_loop == (loop == "closed")]
+            by_objects: dict = {}
+            for k in sorted({r.n_objects for r in mine}):
+                cells = {b: [r for r in mine if r.n_objects == k and length_bucket(r.generator_length) == b]
+                         for b in LENGTH_BUCKETS}
+                by_objects[str(k)] = {b: _cell(rs) for b, rs in cells.items() if rs}
+            if by_objects:
+                out[planner][loop] = by_objects
+    return out
+
+
+def summary_failure_causes(rows: list[ProblemRun]) -> dict:
+    """planner -> "open"/"closed" -> failure cause -> count (adding up to that planner's failed rows)."""
+    out: dict = {}
+    for planner in dict.fromkeys(r.planner for r in rows):
+        out[planner] = {loop: failure_causes([r for r in rows if r.planner == planner
+                                              and r.closed_loop == (loop == "closed")])
+                        for loop in LOOPS if any(r.planner == planner and r.closed_loop == (loop == "closed")
+                                                 for r in rows)}
+    return out
+
+
+def summary_tasks(rows: list[ProblemRun]) -> dict:
+    """planner -> "open"/"closed" -> structure-suite task -> cell; random-walk problems are left to the grid."""
+    out: dict = {}
+    for planner in dict.fromkeys(r.planner for r in rows):
+        for loop in LOOPS:
+            mine = [r for r in rows if r.planner == planner and r.closed_loop == (loop == "closed")
+                    and r.task != RANDOM_WALK]
+            for task in sorted({r.task for r in mine}):
+                out.setdefault(planner, {}).setdefault(loop, {})[task] = _cell([r for r in mine if r.task == task])
     return out
 
 
@@ -131,7 +200,41 @@ def _line(obj) -> str:
     return json.dumps(finite_or_null(obj), allow_nan=False, separators=(",", ":")) + "\n"
 
 
-def _settings(run_dir: Path, problems_dir: Path, problems: list, planners: list[str], closed_loop: bool,
+@dataclass(frozen=True)
+class SetProblem:
+    """A problem of one of a benchmark's sets, with its unique row key and the name its rows show."""
+
+    key: str  # the file name, prefixed "<set folder>/" when the benchmark runs several sets
+    label: str  # the problem's name, prefixed the same way
+    path: Path
+    problem: Problem
+
+
+def problem_sets(problems: str | Path | Sequence[str | Path]) -> list[Path]:
+    """The problem folders to run: a list, a comma-separated string, a folder of problem files, or a folder
+    whose subfolders hold problem sets (each one set, in name order). Two sets of one folder name are refused."""
+    items = [Path(x) for x in (str(problems).split(",") if isinstance(problems, (str, Path)) else problems)
+             if str(x).strip()]
+    if len(items) == 1 and items[0].is_dir() and not any(items[0].glob("*.json")):
+        items = sorted(d for d in items[0].iterdir() if d.is_dir() and any(d.glob("*.json"))) or items
+    if not items:
+        raise ValueError("no problem folders given")
+    names = [p.name for p in items]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ValueError(f"problem sets {', '.join(twice)} are named twice; their rows would share keys")
+    return items
+
+
+def load_sets(sets: Sequence[Path]) -> list[SetProblem]:
+    """Every problem of every set; with several sets the keys and names carry the set's folder name."""
+    if len(sets) == 1:
+        return [SetProblem(path.name, pr.name, path, pr) for path, pr in load_problems(sets[0])]
+    return [SetProblem(f"{d.name}/{path.name}", f"{d.name}/{pr.name}", path, pr)
+            for d in sets for path, pr in load_problems(d)]
+
+
+def _settings(run_dir: Path, sets: list[Path], problems: list[SetProblem], planners: list[str], closed_loop: bool,
               timeout_s: float, max_replans: int) -> dict:
     """What a benchmark's result depends on: a partial run resumes only under the very same settings."""
     from symlearn.planning.planners import planner_spec
@@ -139,80 +242,121 @@ def _settings(run_dir: Path, problems_dir: Path, problems: list, planners: list[
 
     rules = run_dir / PDDL_DIR / RULES_FILE
     needs_rules = any(planner_spec(n).needs_rules for n in planners)
-    return {"run": str(run_dir.resolve()), "problems": str(problems_dir.resolve()), "planners": list(planners),
-            "closed_loop": closed_loop, "timeout_s": timeout_s, "max_replans": max_replans,
-            "transition_sha256": sha256_file(run_dir / TRANSITION_FILE)[:16],
+    folders = [str(d.resolve()) for d in sets]
+    return {"run": str(run_dir.resolve()), "problems": folders[0] if len(folders) == 1 else folders,
+            "planners": list(planners), "closed_loop": closed_loop, "timeout_s": timeout_s,
+            "max_replans": max_replans, "transition_sha256": sha256_file(run_dir / TRANSITION_FILE)[:16],
             "rules_sha256": sha256_file(rules)[:16] if needs_rules else None,
-            "problems_sha256": sha256_bytes(b"".join(sha256_bytes(p.read_bytes()).encode()
-                                                     for p, _ in problems))[:16]}
+            "problems_sha256": sha256_bytes(b"".join(sha256_bytes(p.path.read_bytes()).encode()
+                                                     for p in problems))[:16]}
 
 
-def _run_rows(run_dir: Path, problems: list, fns: dict, log: RowLog, closed_loop: bool, timeout_s: float,
-              max_replans: int, show_progress: bool, record_dir: Path | None = None) -> list[ProblemRun]:
+class _first_call_kept:
+    """The planner function, keeping the result of its first call (the initial plan) in store[key].
+
+    Attributes (a rule planner's `rules`, `planning_model`) are the wrapped function's.
+    """
+
+    def __init__(self, fn, store: dict, key: tuple) -> None:
+        self.fn, self.store, self.key = fn, store, key
+
+    def __call__(self, transition, start, goal, timeout_s):
+        res = self.fn(transition, start, goal, timeout_s)
+        self.store.setdefault(self.key, res)
+        return res
+
+    def __getattr__(self, name: str):
+        return getattr(self.fn, name)
+
+
+def _current_rules(run_dir: Path):
+    """The run's exported rules when they match its transition model (for the attribution of every planner), else None."""
+    from pddl_export.rules_io import load_rules
+    from symlearn.planning.planners import check_rules_current
+
+    if not (run_dir / PDDL_DIR / RULES_FILE).is_file():
+        return None
+    try:
+        rules, model_hash = load_rules(run_dir)
+        check_rules_current(run_dir, model_hash)
+    except ValueError:
+        return None
+    return rules
+
+
+def _run_rows(run_dir: Path, problems: list[SetProblem], fns: dict, log: RowLog, closed_loop: bool,
+              timeout_s: float, max_replans: int, show_progress: bool,
+              record_dir: Path | None = None) -> list[ProblemRun]:
     """Every (problem, planner, loop) row in order: finished ones from the log, the rest run and logged."""
     from symlearn.learning.checkpoint import load_effect_model
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.learned_transition import LearnedTransition
 
     loops = [False, True] if closed_loop else [False]
-    todo = [(path, problem, name, loop) for path, problem in problems for name in fns for loop in loops
-            if (path.name, name, loop) not in log.done]
+    todo = [(p, name, loop) for p in problems for name in fns for loop in loops if (p.key, name, loop) not in log.done]
     if todo:
         encoder, _ = load_effect_model(run_dir)
         transition = LearnedTransition.from_run(run_dir)
+        rules = _current_rules(run_dir)
+        first_plans: dict[tuple, object] = {}  # (problem key, planner) -> the open loop's plan
         with TabletopSimulator() as sim:
-            for path, problem, name, loop in todo:
+            for p, name, loop in todo:
                 cfg = ExecutionConfig(closed_loop=loop, max_replans=max_replans, timeout_s=timeout_s)
                 rec = None if record_dir is None or loop else PlanRecorder()
-                row = run_problem(sim, encoder, transition, problem, name, fns[name], cfg, recorder=rec)
+                # closed loop starts from the open loop's very plan, so the two differ only by what execution does
+                fn = fns[name] if loop else _first_call_kept(fns[name], first_plans, (p.key, name))
+                row = run_problem(sim, encoder, transition, p.problem, name, fn, cfg, recorder=rec, rules=rules,
+                                  initial_plan=first_plans.pop((p.key, name), None) if loop else None)
+                row = dataclasses.replace(row, problem=p.label)
                 if rec is not None and not row.success:
-                    rec.save_gif(Path(record_dir) / f"{problem.name}_{name}.gif")
-                log.append((path.name, name, loop), finite_or_null(row.to_json()))
+                    rec.save_gif(Path(record_dir) / f"{p.label.replace('/', '_')}_{name}.gif")
+                log.append((p.key, name, loop), finite_or_null(row.to_json()))
                 if show_progress:
-                    print(f"[{len(log.done)}/{len(problems) * len(fns) * len(loops)}] {problem.name} {name}"
+                    print(f"[{len(log.done)}/{len(problems) * len(fns) * len(loops)}] {p.label} {name}"
                           f"{' closed-loop' if loop else ''}: {row.status} len {row.plan_length} "
                           f"success {row.success}", flush=True)
     elif show_progress:
         print(f"every row was already in {log.path}", flush=True)
-    return [ProblemRun(**log.done[(path.name, name, loop)])
-            for path, _ in problems for name in fns for loop in loops]
+    return [ProblemRun(**log.done[(p.key, name, loop)]) for p in problems for name in fns for loop in loops]
 
 
-def benchmark(run_dir: Path, problems_dir: Path, planners: list[str], out_file: Path,
+def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners: list[str], out_file: Path,
               closed_loop: bool = False, timeout_s: float = 30.0, max_replans: int = 3,
               show_progress: bool = True, record_dir: Path | None = None) -> dict:
     """Plan and execute every problem with every planner (closed loop too if asked); write out_file.
 
-    Each finished row is appended to OUT.rows.jsonl at once; a run interrupted (killed) and started
-    again with the same settings resumes there, and its final JSON equals an uninterrupted run's
-    (its timings aside). The log is removed once out_file is written. With record_dir, each failed
-    open-loop run is saved as record_dir/<problem>_<planner>.gif.
+    problems_dir is one problem folder or several (see problem_sets): with several, each row's key and
+    problem name start with its set's folder name. Each finished row is appended to OUT.rows.jsonl at
+    once; a run interrupted (killed) and started again with the same settings resumes there, and its
+    final JSON equals an uninterrupted run's (its timings aside). The log is removed once out_file is
+    written. With record_dir, each failed open-loop run is saved as record_dir/<problem>_<planner>.gif.
     """
-    from symlearn.planning.problem import load_problems
-
     if not planners:
         raise ValueError("no planners given")
     if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
         raise ValueError(f"timeout {timeout_s!r} must be a finite positive number of seconds")
-    run_dir, problems_dir, out_file = Path(run_dir), Path(problems_dir), Path(out_file)
+    run_dir, out_file = Path(run_dir), Path(out_file)
     fns = make_planners(list(planners), run_dir)  # refuses unknown names (and missing or stale rules) first
-    problems = load_problems(problems_dir)
-    settings = _settings(run_dir, problems_dir, problems, list(planners), closed_loop, timeout_s, max_replans)
+    sets = problem_sets(problems_dir)
+    problems = load_sets(sets)
+    settings = _settings(run_dir, sets, problems, list(planners), closed_loop, timeout_s, max_replans)
     t0 = time.perf_counter()
     out_file.parent.mkdir(parents=True, exist_ok=True)
     log = RowLog(rows_path(out_file), settings)
     try:
         log.open()
         rows = _run_rows(run_dir, problems, fns, log, closed_loop, timeout_s, max_replans, show_progress,
-                        record_dir)
+                         record_dir)
     finally:
         log.close()
-    result = {"run": str(run_dir), "problems": str(problems_dir), "n_problems": len(problems),
-              "planners": list(planners), "closed_loop": closed_loop, "timeout_s": timeout_s,
-              "max_replans": max_replans, "transition_sha256": settings["transition_sha256"],
+    result = {"run": str(run_dir), "problems": str(sets[0]) if len(sets) == 1 else [str(d) for d in sets],
+              "n_problems": len(problems), "planners": list(planners), "closed_loop": closed_loop,
+              "timeout_s": timeout_s, "max_replans": max_replans, "transition_sha256": settings["transition_sha256"],
               "problems_sha256": settings["problems_sha256"],
               "versions": versions(), "wall_time_s": round(time.perf_counter() - t0, 2),
-              "summary": summarize_rows(rows), "rows": [r.to_json() for r in rows]}
+              "summary": summarize_rows(rows), "grid": summary_grid(rows),
+              "failure_causes": summary_failure_causes(rows), "tasks": summary_tasks(rows),
+              "rows": [r.to_json() for r in rows]}
     result = finite_or_null(result)
     atomic_write_json(out_file, result)
     log.path.unlink()

@@ -237,6 +237,8 @@ _RULES_PLANNERS = {
     "fast-downward-sas": ("fast-downward-sas", "sas", "Fast Downward's search on a direct SAS+ task"),
     "fast-downward-sas-opt": ("fast-downward-sas-opt", "sas", "optimal Fast Downward search on the SAS+ task"),
     "symk-sas": ("symk-sas", "sas", "SymK's symbolic search on the same SAS+ task"),
+    "symk-sas-topk": ("symk-sas-topk", "sas",
+                      "SymK top-k plans on the SAS+ task; execution falls back to the next plan when one departs"),
     "fast-downward-sas-ms": ("fast-downward-sas-ms", "sas",
                              "optimal A* with merge-and-shrink on the SAS+ task without axioms"),
     "fast-downward-sas-lama": ("fast-downward-sas-lama", "sas",

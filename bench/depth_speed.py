@@ -1,0 +1,142 @@
+"""Whole-call planning time of the learned-net A* and the rule-based planners where search is hard.
+
+On problems of 4-5 objects and reference plans of 5 or more actions, every planner plans from the
+same start and goal codes (each problem's scenes are encoded once in the simulator), and the whole
+planner call is timed: writing the task, starting the process, searching and reading the plan back.
+Reports per planner the median whole-call time (time-outs count as their time), the number solved,
+the ratio A* median / planner median and the fastest rule-based planner. Without --problems, a small
+set is generated into OUT's folder first.
+
+    python bench/depth_speed.py --run pretrained/quick-authors12k --timeout 30 --out bench/results/depth_speed.json
+    python bench/depth_speed.py --run runs/paper --problems problems/o4-l5,problems/o5-l7 --out depth.json
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import time
+from pathlib import Path
+
+RULE_PLANNERS = ("fast-downward-sas-lama", "symk-sas", "fast-downward-sas", "fast-downward-sas-ms")
+
+
+def _range(text: str) -> tuple[int, int]:
+    lo, _, hi = text.partition("-")
+    return int(lo), int(hi or lo)
+
+
+def select(folders: list[Path], objects: tuple[int, int], min_length: int) -> list[tuple[str, object]]:
+    """(label, problem) for the problems of the folders with objects[0]..objects[1] objects and a long reference."""
+    from symlearn.planning.problem import load_problems
+
+    out = []
+    for d in folders:
+        for _, p in load_problems(d):
+            if objects[0] <= p.k <= objects[1] and p.generator_length >= min_length:
+                out.append((f"{d.name}/{p.name}" if len(folders) > 1 else p.name, p))
+    return out
+
+
+def time_planners(run: Path, problems: list, planners: list[str], timeout_s: float, budget_s: float) -> list[dict]:
+    """One record per problem: each planner's status, whole-call time, plan length; stops at the time budget."""
+    from symlearn.learning.checkpoint import load_effect_model
+    from symlearn.planning.execution import safe_plan
+    from symlearn.planning.planners import make_planners
+    from symlearn.planning.scenes import scene_codes, symbolic_goal
+    from symlearn.sim.simulator import TabletopSimulator
+    from symlearn.symbolic.learned_transition import LearnedTransition
+
+    fns = make_planners(planners, run)
+    encoder, _ = load_effect_model(run)
+    transition = LearnedTransition.from_run(run)
+    records, t0 = [], time.perf_counter()
+    with TabletopSimulator() as sim:
+        for label, problem in problems:
+            if time.perf_counter() - t0 > budget_s:
+                break
+            goal = symbolic_goal(sim, encoder, problem)
+            start = scene_codes(sim, encoder, problem.initial)
+            rec = {"problem": label, "n_objects": problem.k, "reference_length": problem.generator_length,
+                   "start": [int(c) for c in start], "goal": list(goal.codes), "planners": {}}
+            for name in planners:
+                t = time.perf_counter()
+                res = safe_plan(name, fns[name], transition, start, goal, timeout_s)
+                took = time.perf_counter() - t
+                rec["planners"][name] = {"status": res.status.value, "time_s": round(took, 4),
+                                         "plan_length": len(res.plan) if res.found else None,
+                                         "expansions": res.expansions}
+            records.append(rec)
+            print(f"{label} ({problem.k} objects, reference {problem.generator_length}): " + ", ".join(
+                f"{n} {r['status']} {r['time_s']:.2f}s" for n, r in rec["planners"].items()), flush=True)
+    return records
+
+
+def summarize(records: list[dict], planners: list[str]) -> dict:
+    """Per planner: median whole-call time, solved count, median over solved calls; ratios to A*; the fastest."""
+    per = {}
+    for name in planners:
+        runs = [r["planners"][name] for r in records]
+        solved = [x["time_s"] for x in runs if x["status"] == "solved"]
+        per[name] = {"n": len(runs), "solved": len(solved),
+                     "median_time_s": round(statistics.median(x["time_s"] for x in runs), 4) if runs else None,
+                     "median_solved_time_s": round(statistics.median(solved), 4) if solved else None}
+    base = per["astar"]["median_time_s"]
+    for name, s in per.items():
+        s["astar_over_planner"] = round(base / s["median_time_s"], 3) if base and s["median_time_s"] else None
+    rules = [n for n in planners if n != "astar" and per[n]["median_time_s"] is not None]
+    fastest = min(rules, key=lambda n: (per[n]["median_time_s"], -per[n]["solved"])) if rules else None
+    return {"planners": per, "fastest_rule_planner": fastest}
+
+
+def main() -> None:
+    from symlearn.provenance import atomic_write_json, versions
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--run", type=Path, required=True, help="run with best.pt, transition.pt and pddl/rules.json")
+    ap.add_argument("--problems", help="comma-separated problem folders (default: generate a set beside --out)")
+    ap.add_argument("--planners", default=",".join(RULE_PLANNERS), help="rule-based planners (astar always runs)")
+    ap.add_argument("--objects", type=_range, default=(4, 5), help="objects per problem, e.g. 4-5")
+    ap.add_argument("--length", type=_range, default=(5, 8), help="reference lengths generated, e.g. 5-8")
+    ap.add_argument("--min-length", type=int, default=5, help="shortest reference length kept")
+    ap.add_argument("--n", type=int, default=10, help="problems generated when --problems is not given")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--timeout", type=float, default=30.0, help="seconds per planner call")
+    ap.add_argument("--budget", type=float, default=float("inf"), help="start no new problem after this many seconds")
+    ap.add_argument("--out", type=Path, required=True)
+    args = ap.parse_args()
+    import torch
+
+    torch.set_num_threads(1)
+    planners = ["astar"] + [p for p in args.planners.split(",") if p and p != "astar"]
+    if args.problems:
+        folders = [Path(p) for p in args.problems.split(",") if p]
+    else:
+        from symlearn.planning.problem_generation import generate_problems
+
+        folders = [args.out.parent / f"{args.out.stem}_problems"]
+        generate_problems(folders[0], args.n, objects=args.objects, length=args.length, seed=args.seed)
+    problems = select(folders, args.objects, args.min_length)
+    if not problems:
+        raise SystemExit(f"no problem of {args.objects[0]}-{args.objects[1]} objects and reference length "
+                         f">= {args.min_length} in {', '.join(map(str, folders))}")
+    t0 = time.perf_counter()
+    records = time_planners(args.run, problems, planners, args.timeout, args.budget)
+    result = {"run": str(args.run), "problems": [str(d) for d in folders], "n_selected": len(problems),
+              "n_timed": len(records), "objects": list(args.objects), "min_length": args.min_length,
+              "timeout_s": args.timeout, "torch_threads": 1, "wall_time_s": round(time.perf_counter() - t0, 1),
+              "date": time.strftime("%Y-%m-%d"), "machine": {"processor": platform.processor() or platform.machine(),
+                                                             "cpus": os.cpu_count(), "python": platform.python_version()},
+              "versions": versions(), **summarize(records, planners), "records": records}
+    atomic_write_json(args.out, result)
+    print(f"\n{'planner':<24}{'solved':>8}{'median s':>10}{'solved med s':>14}{'A*/planner':>12}")
+    for name, s in result["planners"].items():
+        cells = [f"{s['solved']}/{s['n']}", s["median_time_s"], s["median_solved_time_s"], s["astar_over_planner"]]
+        print(f"{name:<24}{cells[0]:>8}" + "".join(f"{'-' if v is None else f'{v:.3f}':>{w}}"
+                                                  for v, w in zip(cells[1:], (10, 14, 12))))
+    print(f"fastest rule-based planner: {result['fastest_rule_planner']}\nwrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()

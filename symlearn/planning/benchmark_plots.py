@@ -1,0 +1,173 @@
+"""The objects x reference-length grid of a benchmark as text, Markdown and plots.
+
+`symlearn benchmark` prints `format_grid` after a run and, with --plots DIR, writes `write_plots`'
+figures; on a saved result JSON the same come from this module's command line, which prints the
+Markdown tables that docs/BENCHMARKS.md holds:
+
+    python -m symlearn.planning.benchmark_plots bench.json --out plots/
+"""
+from __future__ import annotations
+
+import argparse
+import io
+import json
+import math
+from pathlib import Path
+
+from symlearn.planning.benchmark import (LENGTH_BUCKETS, LOOPS, summary_failure_causes, summary_grid,
+                                         summary_tasks)
+from symlearn.planning.execution import ProblemRun
+from symlearn.provenance import atomic_write_bytes
+
+MAIN_BUCKETS = LENGTH_BUCKETS[:4]  # always shown; "9+" and "?" only when some row falls there
+DPI = 100
+PANEL_IN = (4.0, 3.2)  # inches per object-count panel (width, height)
+PLOT_FILES = ("success_by_length.png", "time_by_length.png")
+
+
+def grid_of(result: dict) -> dict:
+    """The result's grid, failure causes and tasks (recomputed from its rows when an older JSON lacks them)."""
+    if "grid" in result and "failure_causes" in result:
+        return {"grid": result["grid"], "failure_causes": result["failure_causes"], "tasks": result.get("tasks", {})}
+    rows = [ProblemRun(**r) for r in result.get("rows", [])]
+    if not rows:
+        raise ValueError("the benchmark result holds neither a grid nor rows")
+    return {"grid": summary_grid(rows), "failure_causes": summary_failure_causes(rows), "tasks": summary_tasks(rows)}
+
+
+def _axes(by_loop: dict) -> tuple[list[str], list[str]]:
+    """Object counts (rows) and buckets (columns) of one planner's grid, in order."""
+    objects = sorted({k for loop in by_loop.values() for k in loop}, key=int)
+    used = {b for loop in by_loop.values() for cells in loop.values() for b in cells}
+    return objects, [b for b in LENGTH_BUCKETS if b in MAIN_BUCKETS or b in used]
+
+
+def _cell_text(by_loop: dict, k: str, bucket: str, sep: str) -> str:
+    """"open/closed (n)" success rates of one cell; "-" where a loop has no rows."""
+    cells = [by_loop.get(loop, {}).get(k, {}).get(bucket) for loop in LOOPS]
+    if not any(cells):
+        return "-"
+    rates = [f"{c['success_rate']:.2f}" if c else "-" for c in cells]
+    return f"{rates[0]}{sep}{rates[1]} ({next(c for c in cells if c)['n']})"
+
+
+def format_grid(grid: dict) -> str:
+    """One text table per planner: rows object counts, columns reference-length buckets, cells open/closed (n)."""
+    out = []
+    for planner, by_loop in grid.items():
+        objects, buckets = _axes(by_loop)
+        lines = [f"{planner}: success open/closed (n) by objects x reference length",
+                 f"{'objects':>8}" + "".join(f"{b:>18}" for b in buckets)]
+        lines += [f"{k:>8}" + "".join(f"{_cell_text(by_loop, k, b, '/'):>18}" for b in buckets) for k in objects]
+        out.append("\n".join(lines))
+    return "\n\n".join(out)
+
+
+def markdown_grid(summary: dict) -> str:
+    """Markdown for docs/BENCHMARKS.md: a grid table per planner, failure causes, and structure-suite tasks."""
+    parts = []
+    for planner, by_loop in summary["grid"].items():
+        objects, buckets = _axes(by_loop)
+        rows = [f"**{planner}**: success open / closed (n)", "", "| objects | " + " | ".join(buckets) + " |",
+                "|---:|" + "---:|" * len(buckets)]
+        rows += [f"| {k} | " + " | ".join(_cell_text(by_loop, k, b, " / ") for b in buckets) + " |" for k in objects]
+        parts.append("\n".join(rows))
+    causes = sorted({c for loops in summary["failure_causes"].values() for counts in loops.values() for c in counts})
+    if causes:
+        rows = ["| planner | loop | " + " | ".join(causes) + " |", "|---|---|" + "---:|" * len(causes)]
+        rows += [f"| {planner} | {loop} | " + " | ".join(str(counts.get(c, 0)) for c in causes) + " |"
+                 for planner, loops in summary["failure_causes"].items() for loop, counts in loops.items()]
+        parts.append("Failure causes (failed rows)\n\n" + "\n".join(rows))
+    if summary.get("tasks"):
+        rows = ["| planner | loop | task | n | success | found | median time (s) |", "|---|---|---|---:|---:|---:|---:|"]
+        rows += [f"| {planner} | {loop} | {task} | {c['n']} | {c['success_rate']:.2f} | {c['found_rate']:.2f} | "
+                 f"{c['median_time_s']:.3f} |" for planner, loops in summary["tasks"].items()
+                 for loop, tasks in loops.items() for task, c in tasks.items()]
+        parts.append("Structure-suite tasks\n\n" + "\n".join(rows))
+    return "\n\n".join(parts)
+
+
+def _series(by_loop: dict, loop: str, k: str, buckets: list[str], key: str) -> list[float]:
+    """A cell value per bucket for one loop and object count, NaN where there is no cell."""
+    cells = by_loop.get(loop, {}).get(k, {})
+    return [math.nan if cells.get(b, {}).get(key) is None else cells[b][key] for b in buckets]
+
+
+def _figure(grid: dict, key: str, ylabel: str, log: bool, loops: tuple[str, ...]):
+    """One panel per object count, one colour per planner; open loop solid, closed loop dashed."""
+    from matplotlib.figure import Figure
+
+    objects = sorted({k for by_loop in grid.values() for loop in by_loop.values() for k in loop}, key=int)
+    buckets = [b for b in LENGTH_BUCKETS if b in MAIN_BUCKETS or any(
+        b in cells for by_loop in grid.values() for loop in by_loop.values() for cells in loop.values())]
+    fig = Figure(figsize=(PANEL_IN[0] * max(len(objects), 1), PANEL_IN[1]), dpi=DPI, layout="constrained")
+    axes = fig.subplots(1, max(len(objects), 1), squeeze=False, sharey=True)[0]
+    colours = {p: f"C{i % 10}" for i, p in enumerate(grid)}
+    xs = list(range(len(buckets)))  # the same bucket positions on every panel
+    handles: dict = {}
+    for ax, k in zip(axes, objects):
+        for planner, by_loop in grid.items():
+            for loop in loops:
+                ys = _series(by_loop, loop, k, buckets, key)
+                if not all(math.isnan(y) for y in ys):
+                    (line,) = ax.plot(xs, ys, marker="o", color=colours[planner],
+                                      linestyle="-" if loop == "open" else "--")
+                    handles.setdefault(f"{planner} ({loop})", line)
+        ax.set_title(f"{k} object{'s' if k != '1' else ''}")
+        ax.set_xticks(xs, buckets)
+        ax.set_xlim(-0.5, len(buckets) - 0.5)
+        ax.set_xlabel("reference plan length")
+        if log:
+            ax.set_yscale("log")
+        else:
+            ax.set_ylim(-0.03, 1.03)
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel(ylabel)
+    if handles:
+        fig.legend(list(handles.values()), list(handles), loc="outside right upper", fontsize=7)
+    return fig
+
+
+def _save(fig, path: Path) -> Path:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=DPI)
+    atomic_write_bytes(path, buf.getvalue())
+    return path
+
+
+def write_plots(grid: dict, out_dir: Path) -> list[Path]:
+    """Success and median planning time (log scale) against the reference-length bucket, as PNGs in out_dir."""
+    if not grid:
+        raise ValueError("the benchmark grid is empty: nothing to plot")
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    success = _figure(grid, "success_rate", "success rate", False, LOOPS)
+    # the first planning call: open loop's, or closed loop's where only closed loop ran
+    times = {p: {"open": by_loop.get("open") or by_loop.get("closed", {})} for p, by_loop in grid.items()}
+    timing = _figure(times, "median_time_s", "median planning time (s)", True, ("open",))
+    return [_save(success, out_dir / PLOT_FILES[0]), _save(timing, out_dir / PLOT_FILES[1])]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Write a saved benchmark result's plots into --out and print its Markdown tables."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("result", type=Path, help="JSON written by symlearn benchmark")
+    ap.add_argument("--out", type=Path, required=True, help="folder for the plots")
+    args = ap.parse_args(argv)
+    try:
+        result = json.loads(args.result.read_text())
+    except (OSError, json.JSONDecodeError) as e:
+        raise SystemExit(f"{args.result}: not a readable benchmark JSON ({e})")
+    try:
+        summary = grid_of(result)
+    except (ValueError, TypeError) as e:
+        raise SystemExit(f"{args.result}: {e}")
+    for path in write_plots(summary["grid"], args.out):
+        print(f"wrote {path}")
+    print()
+    print(markdown_grid(summary))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
