@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import functools
 import itertools
+import time
 from dataclasses import dataclass
 from enum import Enum
 from typing import Sequence
@@ -64,6 +65,10 @@ MAX_SUBSET_CODES = 4  # context_terms minimizes over rules with at most this man
 
 class TaskTooLargeError(RuntimeError):
     """The SAS+ encoding of a problem would have more than max_effects conditional effects."""
+
+
+class TaskTimeoutError(TaskTooLargeError):
+    """Writing the task passed its deadline (the operators of a new object count are built once, then cached)."""
 
 
 @dataclass(frozen=True)
@@ -175,7 +180,8 @@ class SASEncoder:
             self._siblings[negation] = SASEncoder(self.rules, self.max_effects, negation)
         return self._siblings[negation]
 
-    def task(self, init: Sequence[int], goal: SymbolicGoal | Sequence[int | None]) -> SASTask:
+    def task(self, init: Sequence[int], goal: SymbolicGoal | Sequence[int | None],
+             deadline: float | None = None) -> SASTask:
         """The SAS+ task from init codes to goal codes (ValueError on bad shapes).
 
         Codes outside the rules' vocabulary (RuleSet.with_codes: inert, kept by their objects) become
@@ -188,12 +194,12 @@ class SASEncoder:
                 self._extended: dict[frozenset, SASEncoder] = {}
             if new not in self._extended:
                 self._extended[new] = SASEncoder(self.rules.with_codes(new), self.max_effects, self.negation)
-            return self._extended[new].task(init, goal)
+            return self._extended[new].task(init, goal, deadline)
         init_t, goal_g = checked_task(self.rules, init, goal)
         n = len(init_t)
         body = self._bodies.get(n)
         if body is None:
-            body = self._bodies[n] = self._body(n)
+            body = self._bodies[n] = self._body(n, deadline)
         state = [str(self.value[c]) for c in init_t] + [str(int(init_t[z] == x)) if self.negation is Negation.EFFECTS
                                                          else "0" for z, x in body.tracked]
         goals = [(i, self.value[c]) for i, c in enumerate(goal_g.codes) if c is not None]
@@ -206,7 +212,8 @@ class SASEncoder:
         return SASTask(text=text, n_objects=n, n_variables=body.n_variables, n_derived=body.n_derived,
                        n_operators=body.n_operators, n_effects=body.n_effects, n_axioms=body.n_axioms)
 
-    def _body(self, n: int) -> _Body:
+    def _body(self, n: int, deadline: float | None = None) -> _Body:
+        """The variables, operators and axioms for n objects; TaskTimeoutError past `deadline` (perf_counter)."""
         bits = self.rules.bits
         has: dict[tuple[int, int], int] = {}  # (object, code) -> derived variable index, after the objects
 
@@ -217,6 +224,9 @@ class SASEncoder:
         for a in self.rules.actions:
             effects: set[tuple[tuple[tuple[int, int], ...], int, int]] = set()
             for rule in (r for r in self.rules.rules if r.action == a):
+                if deadline is not None and time.perf_counter() > deadline:
+                    raise TaskTimeoutError(f"writing the SAS+ task for {n} objects ({len(self.rules.rules)} rules) "
+                                           f"passed the time limit")
                 bounds = rule.bounds()
                 if any(lo > n - 1 for lo, _ in bounds.values()):
                     continue  # needs more other objects than the problem has

@@ -31,7 +31,7 @@ import numpy as np
 from pddl_export.files import atomic_write_text
 from pddl_export.pddl_writer import action_id_from_name
 from pddl_export.rules import apply_rules
-from pddl_export.sas_writer import Negation, SASEncoder, TaskTooLargeError
+from pddl_export.sas_writer import Negation, SASEncoder, TaskTimeoutError, TaskTooLargeError
 from search.processes import planner_guard, run_group, temp_dir
 from search.result import PlanResult, PlanStatus, failed
 from pddl_export.symbolic import SymbolicGoal
@@ -256,7 +256,9 @@ def solve_sas(encoder: SASEncoder, init: Sequence[int], goal: SymbolicGoal | Seq
                       f"(pip install {spec.package.replace('_', '-')})")
     encoder = encoder.with_negation(spec.negation)
     try:
-        task = encoder.task(init, goal)
+        task = encoder.task(init, goal, deadline=t0 + timeout_s)
+    except TaskTimeoutError as e:
+        return failed(planner, PlanStatus.TIMEOUT, t0, str(e))
     except (ValueError, TaskTooLargeError) as e:
         return failed(planner, PlanStatus.ERROR, t0, str(e))
     goal_g = goal if isinstance(goal, SymbolicGoal) else SymbolicGoal(tuple(goal))

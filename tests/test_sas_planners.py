@@ -284,3 +284,20 @@ def test_plan_files_cut_short_by_a_kill_are_left_out(tmp_path):
     assert _read_plans(tmp_path) == [["pick-0-release-1", "pick-1-release-2"], ["pick-0-release-3"]]
     (tmp_path / "plan").write_text("(pick-5-release-0)\n; cost = 1 (unit cost)\n")
     assert _read_plans(tmp_path) == [["pick-5-release-0"]]
+
+
+def test_writing_a_task_past_its_deadline_is_a_timeout(rules):  # noqa: F811
+    import time
+
+    from pddl_export.sas_writer import TaskTimeoutError
+
+    enc = SASEncoder(rules)
+    with pytest.raises(TaskTimeoutError, match="time limit"):
+        enc.task([1, 2], [2, None], deadline=time.perf_counter() - 1.0)
+    task = enc.task([1, 2], [2, None])  # no deadline: built, then cached for two objects
+    assert enc.task([2, 1], [None, 2], deadline=time.perf_counter() - 1.0).n_effects == task.n_effects
+    # through solve_sas: a limit shorter than writing the operators of a new object count is a TIMEOUT, not an error
+    slow = SASEncoder(rules)
+    slow._body = lambda n, deadline=None: (_ for _ in ()).throw(TaskTimeoutError("passed the time limit"))
+    res = solve_sas(slow, [1, 2], [2, None], "fast-downward-sas", timeout_s=5)
+    assert res.status is PlanStatus.TIMEOUT and "time limit" in res.message
