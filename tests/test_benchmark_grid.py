@@ -144,6 +144,29 @@ def test_module_main_renders_a_saved_result_even_without_a_grid(tmp_path, capsys
         main([str(bad), "--out", str(tmp_path / "p2")])
 
 
+def test_results_split_by_planner_merge_into_one(tmp_path, capsys):
+    """Two benchmarks of the same settings, other planners: one grid, equal to the grid of all rows together."""
+    settings = {"run": "r", "problems": ["a", "b"], "problems_sha256": "h", "transition_sha256": "t",
+                "timeout_s": 10, "max_replans": 3, "closed_loop": True}
+    astar = [r.to_json() for r in ROWS if r.planner == "astar"]
+    symk = [r.to_json() for r in ROWS if r.planner == "symk-sas"]
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    a.write_text(json.dumps({**settings, "planners": ["astar"], "rows": astar}))
+    b.write_text(json.dumps({**settings, "planners": ["symk-sas"], "rows": symk}))
+    merged = tmp_path / "merged.json"
+    assert main([str(a), str(b), "--out", str(tmp_path / "plots"), "--merged", str(merged)]) == 0
+    m = json.loads(merged.read_text())
+    assert m["planners"] == ["astar", "symk-sas"] and len(m["rows"]) == len(ROWS)
+    assert m["grid"] == json.loads(json.dumps(summary_grid(ROWS)))
+    assert markdown_grid(grid_of(m)) in capsys.readouterr().out
+    b.write_text(json.dumps({**settings, "timeout_s": 30, "planners": ["symk-sas"], "rows": symk}))
+    with pytest.raises(SystemExit, match="other settings .*timeout_s"):
+        main([str(a), str(b), "--out", str(tmp_path / "p2")])
+    b.write_text(json.dumps({**settings, "planners": ["astar"], "rows": astar[:1]}))
+    with pytest.raises(SystemExit, match="both hold the row"):
+        main([str(a), str(b), "--out", str(tmp_path / "p3")])
+
+
 def _sets(tmp_path: Path) -> Path:
     """A parent folder with two problem sets holding the same file names (and a stray non-set folder)."""
     parent = tmp_path / "grid"

@@ -5,6 +5,7 @@ figures; on a saved result JSON the same come from this module's command line, w
 Markdown tables that docs/BENCHMARKS.md holds:
 
     python -m symlearn.planning.benchmark_plots bench.json --out plots/
+    python -m symlearn.planning.benchmark_plots a.json b.json --out plots/   # planners split over processes
 """
 from __future__ import annotations
 
@@ -33,6 +34,35 @@ def grid_of(result: dict) -> dict:
     if not rows:
         raise ValueError("the benchmark result holds neither a grid nor rows")
     return {"grid": summary_grid(rows), "failure_causes": summary_failure_causes(rows), "tasks": summary_tasks(rows)}
+
+
+def merge_results(results: list[dict], names: list[str]) -> dict:
+    """One result from benchmarks of the same run and problems split by planner (e.g. run in parallel).
+
+    Refused (ValueError naming the files) when they were run on other runs, problems, time limits or
+    replan bounds, or when two of them hold the same (problem, planner, loop) row.
+    """
+    if len(results) == 1:
+        return results[0]
+    keys = ("run", "problems", "problems_sha256", "transition_sha256", "timeout_s", "max_replans", "closed_loop")
+    for name, r in zip(names[1:], results[1:]):
+        diff = [k for k in keys if r.get(k) != results[0].get(k)]
+        if diff:
+            raise ValueError(f"{name} and {names[0]} are benchmarks of other settings ({', '.join(diff)})")
+    seen: dict[tuple, str] = {}
+    rows = []
+    for name, r in zip(names, results):
+        keys_here = {(row["problem"], row["planner"], row["closed_loop"]) for row in r.get("rows", [])}
+        clash = sorted(keys_here & set(seen))
+        if clash:
+            raise ValueError(f"{name} and {seen[clash[0]]} both hold the row {clash[0]}")
+        seen.update(dict.fromkeys(keys_here, name))
+        rows += r.get("rows", [])
+    merged = {k: results[0].get(k) for k in keys}
+    merged["planners"] = [p for r in results for p in r.get("planners", [])]
+    merged["rows"] = rows
+    merged.update(grid_of({"rows": rows}))
+    return merged
 
 
 def _axes(by_loop: dict) -> tuple[list[str], list[str]]:
@@ -151,17 +181,27 @@ def write_plots(grid: dict, out_dir: Path) -> list[Path]:
 def main(argv: list[str] | None = None) -> int:
     """Write a saved benchmark result's plots into --out and print its Markdown tables."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("result", type=Path, help="JSON written by symlearn benchmark")
+    ap.add_argument("result", type=Path, nargs="+",
+                    help="JSON written by symlearn benchmark; several (same run and problems, other planners) merge")
     ap.add_argument("--out", type=Path, required=True, help="folder for the plots")
+    ap.add_argument("--merged", type=Path, help="also write the merged result JSON here")
     args = ap.parse_args(argv)
+    results = []
+    for path in args.result:
+        try:
+            results.append(json.loads(path.read_text()))
+        except (OSError, json.JSONDecodeError, UnicodeDecodeError) as e:
+            raise SystemExit(f"{path}: not a readable benchmark JSON ({str(e).splitlines()[0]})")
     try:
-        result = json.loads(args.result.read_text())
-    except (OSError, json.JSONDecodeError) as e:
-        raise SystemExit(f"{args.result}: not a readable benchmark JSON ({e})")
-    try:
+        result = merge_results(results, [str(p) for p in args.result])
         summary = grid_of(result)
-    except (ValueError, TypeError) as e:
-        raise SystemExit(f"{args.result}: {e}")
+    except (ValueError, TypeError, KeyError) as e:
+        raise SystemExit(f"{args.result[0]}: {e}")
+    if args.merged:
+        from pddl_export.files import atomic_write_json, finite_or_null
+
+        atomic_write_json(args.merged, finite_or_null(result))
+        print(f"wrote {args.merged}")
     for path in write_plots(summary["grid"], args.out):
         print(f"wrote {path}")
     print()
