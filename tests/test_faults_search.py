@@ -88,6 +88,8 @@ def _fake_planner(tmp: Path) -> Path:
 SAS_DRIVER = """
 import sys
 sys.path[:0] = [{repo!r}, {tests!r}]
+import signal
+signal.signal(signal.SIGINT, signal.default_int_handler)  # as in a foreground shell: a background one ignores SIGINT
 from pathlib import Path
 import search.sas_planners as sp
 from pddl_export.enumeration import enumerate_transitions
@@ -102,6 +104,8 @@ print(sp.solve_sas(SASEncoder(rules), [UNDER, FAR], [NEAR, NEAR], "symk-sas", {t
 UP_DRIVER = """
 import sys
 sys.path[:0] = [{repo!r}, {tests!r}]
+import signal
+signal.signal(signal.SIGINT, signal.default_int_handler)  # as in a foreground shell: a background one ignores SIGINT
 from pddl_export.enumeration import enumerate_transitions
 from pddl_export.distil import distil_rules
 from pddl_export.pddl_writer import conditional_domain, problem_pddl
