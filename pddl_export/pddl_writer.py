@@ -239,6 +239,12 @@ def checked_task(rules: RuleSet, init: Sequence[int], goal: SymbolicGoal | Seque
     return init_t, goal_g
 
 
+def task_codes(init: Sequence[int], goal: SymbolicGoal | Sequence[int | None]) -> frozenset[int]:
+    """Every code a task names: the initial codes and the goal's fixed ones."""
+    fixed = goal.codes if isinstance(goal, SymbolicGoal) else goal
+    return frozenset(int(c) for c in (*init, *fixed) if c is not None)
+
+
 def _goal_text(goal: SymbolicGoal, bits: int) -> str:
     atoms = [f"({code_predicate(c, bits)} {object_name(i)})" for i, c in enumerate(goal.codes) if c is not None]
     return f"(:goal (and {' '.join(atoms)}))"
@@ -335,8 +341,7 @@ def strips_pddl(
     """Grounded STRIPS domain + problem over the states reachable from `init` (see module doc).
 
     Codes outside the vocabulary are inert (RuleSet.with_codes) and get predicates of their own."""
-    fixed = [c for c in (goal.codes if isinstance(goal, SymbolicGoal) else goal) if c is not None]
-    rules = rules.with_codes([*init, *fixed])
+    rules = rules.with_codes(task_codes(init, goal))
     init_t, goal_g = checked_task(rules, init, goal)
     bits = rules.bits
     states, edges = reachable_transitions(rules, init_t, max_states)

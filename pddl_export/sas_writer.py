@@ -54,7 +54,7 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import Sequence
 
-from pddl_export.pddl_writer import action_name, checked_task, code_predicate, object_name
+from pddl_export.pddl_writer import action_name, checked_task, code_predicate, object_name, task_codes
 from pddl_export.rules import RuleSet
 from pddl_export.symbolic import SymbolicGoal
 
@@ -187,8 +187,7 @@ class SASEncoder:
         Codes outside the rules' vocabulary (RuleSet.with_codes: inert, kept by their objects) become
         extra values of the object variables, through a sibling encoder cached per set of new codes.
         """
-        fixed = [c for c in (goal.codes if isinstance(goal, SymbolicGoal) else goal) if c is not None]
-        new = frozenset(int(c) for c in (*init, *fixed)) - set(self.codes)
+        new = task_codes(init, goal) - set(self.codes)
         if new:
             if not hasattr(self, "_extended"):
                 self._extended: dict[frozenset, SASEncoder] = {}

@@ -269,11 +269,17 @@ class _first_call_kept:
         return getattr(self.fn, name)
 
 
-def _current_rules(run_dir: Path):
-    """The run's exported rules when they match its transition model (for the attribution of every planner), else None."""
+def _current_rules(run_dir: Path, fns: dict):
+    """The run's exported rules when they match its transition model (for the attribution of every planner), else None.
+
+    A rule planner among `fns` already holds them (make_planners loaded and checked them); else they are read here.
+    """
     from pddl_export.rules_io import load_rules
     from symlearn.planning.planners import check_rules_current
 
+    held = next((f.rules for f in fns.values() if getattr(f, "rules", None) is not None), None)
+    if held is not None:
+        return held
     if not (run_dir / PDDL_DIR / RULES_FILE).is_file():
         return None
     try:
@@ -297,7 +303,7 @@ def _run_rows(run_dir: Path, problems: list[SetProblem], fns: dict, log: RowLog,
     if todo:
         encoder, _ = load_effect_model(run_dir)
         transition = LearnedTransition.from_run(run_dir)
-        rules = _current_rules(run_dir)
+        rules = _current_rules(run_dir, fns)
         first_plans: dict[tuple, object] = {}  # (problem key, planner) -> the open loop's plan
         with TabletopSimulator() as sim:
             for p, name, loop in todo:

@@ -44,6 +44,7 @@ from search.sas_planners import solve_sas
 from search.up_problem import strips_problem
 from symlearn.planning.execution import PlannerFn
 from symlearn.planning.paths import path_under
+from symlearn.planning.recovery import roll
 
 
 @dataclass(frozen=True)
@@ -107,12 +108,7 @@ def network_agrees(transition: TransitionFn, plan: PlanResult) -> bool:
     """Whether the network, run along the plan, predicts the same states as the planner did."""
     if not plan.predicted_states:
         return True
-    state = np.asarray(plan.predicted_states[0], np.int64)
-    for a, want in zip(plan.plan, plan.predicted_states[1:]):
-        state = transition(state[None], np.array([a]))[0]
-        if tuple(int(c) for c in state) != tuple(want):
-            return False
-    return True
+    return roll(transition, plan.predicted_states[0], list(plan.plan)) == list(plan.predicted_states)
 
 
 class RulesTransition:
@@ -181,7 +177,7 @@ class _RulesPlanner:
             try:
                 atomic_write_text(prob_path, problem_pddl(rules, init, goal, self.model_hash))
             except ValueError:
-                pass  # unknown codes: solve_sas reports them
+                pass  # codes outside the vocabulary have no PDDL predicate; the SAS+ task holds them (inert)
         sas_path = None if prob_path is None else prob_path.with_name(prob_path.name.replace("problem", "task")
                                                                       .replace(".pddl", ".sas"))
         return solve_sas(encoder, init, goal, self.engine, timeout_s, write_to=sas_path)
