@@ -19,7 +19,8 @@ import statistics
 import time
 from pathlib import Path
 
-RULE_PLANNERS = ("fast-downward-sas-lama", "symk-sas", "fast-downward-sas", "fast-downward-sas-ms")
+RULE_PLANNERS = ("rules-astar", "rules-bfs", "fast-downward-sas", "fast-downward-sas-lama", "symk-sas",
+                 "fast-downward-sas-ms")
 
 
 def _range(text: str) -> tuple[int, int]:

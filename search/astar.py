@@ -63,16 +63,26 @@ def astar(
     max_expansions: int,
     timeout_s: float,
     uniform_cost: bool = False,
+    batch: int = 1,
+    successors_many: Callable[[list[S]], list[Iterable[tuple[A, S, float]]]] | None = None,
 ) -> SearchOutcome[S, A]:
     """Best-first search on f = g + h; uniform_cost=True uses h = 0 (optimal cost, Dijkstra).
 
     Duplicates are detected by the best g seen per state: a pushed entry whose g is no longer
     the best is skipped when popped, and a state is re-opened if a cheaper path to it appears
     (this only happens with an inconsistent heuristic). Ties on f go to the lower h, then to
-    the earlier push.
+    the earlier push. A successor with h = inf is a dead end and is never pushed (UNSOLVABLE
+    then means: no goal outside the states the heuristic calls dead ends).
+
+    With batch > 1 and successors_many (states -> their successor lists, one vectorized call),
+    up to `batch` best open states are popped and expanded together: each popped state is
+    goal-tested first, so a goal is still returned as soon as it is popped, but states of
+    slightly higher f may be expanded before a cheaper path found in the same batch is.
     """
     if max_expansions < 0:
         raise ValueError(f"max_expansions must be >= 0, got {max_expansions}")
+    if batch < 1 or (batch > 1 and successors_many is None):
+        raise ValueError(f"batch must be >= 1, and batch > 1 needs successors_many (got batch={batch})")
     if not timeout_s > 0:
         raise ValueError(f"timeout_s must be > 0, got {timeout_s}")
     t0 = time.perf_counter()
@@ -91,25 +101,32 @@ def astar(
             cost=best_g[goal] if goal is not None else math.inf,
             expansions=expansions, generated=generated, time_s=time.perf_counter() - t0)
 
+    expand_many = successors_many or (lambda states: [successors(x) for x in states])
     while open_:
-        if time.perf_counter() - t0 > timeout_s:
-            return outcome(PlanStatus.TIMEOUT)
-        _, _, _, g, state = heapq.heappop(open_)
-        if g > best_g[state]:
-            continue  # stale entry: a cheaper path to this state was pushed after it
-        if is_goal(state):
-            return outcome(PlanStatus.SOLVED, state)
-        if expansions >= max_expansions:
-            return outcome(PlanStatus.NODE_LIMIT)
-        expansions += 1
-        for action, nxt, cost in successors(state):
-            if cost < 0:
-                raise ValueError(f"A* needs non-negative costs, got {cost} for action {action!r}")
-            g_next = g + cost
-            if g_next < best_g.get(nxt, math.inf):
-                best_g[nxt] = g_next
-                parent[nxt] = (state, action)
-                h = h_of(nxt)
-                heapq.heappush(open_, (g_next + h, h, next(tie), g_next, nxt))
-                generated += 1
+        popped: list[tuple[float, S]] = []
+        while open_ and len(popped) < batch:
+            if time.perf_counter() - t0 > timeout_s:
+                return outcome(PlanStatus.TIMEOUT)
+            _, _, _, g, state = heapq.heappop(open_)
+            if g > best_g[state]:
+                continue  # stale entry: a cheaper path to this state was pushed after it
+            if is_goal(state):
+                return outcome(PlanStatus.SOLVED, state)
+            if expansions >= max_expansions:
+                return outcome(PlanStatus.NODE_LIMIT)
+            expansions += 1
+            popped.append((g, state))
+        for (g, state), succ in zip(popped, expand_many([x for _, x in popped])):
+            for action, nxt, cost in succ:
+                if cost < 0:
+                    raise ValueError(f"A* needs non-negative costs, got {cost} for action {action!r}")
+                g_next = g + cost
+                if g_next < best_g.get(nxt, math.inf):
+                    h = h_of(nxt)
+                    if h == math.inf:
+                        continue  # a dead end: the heuristic proves no goal is reachable from it
+                    best_g[nxt] = g_next
+                    parent[nxt] = (state, action)
+                    heapq.heappush(open_, (g_next + h, h, next(tie), g_next, nxt))
+                    generated += 1
     return outcome(PlanStatus.UNSOLVABLE)

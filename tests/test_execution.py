@@ -355,7 +355,8 @@ def test_unknown_planner_lists_every_planner(tmp_path, run_dir):
 def test_registry_holds_every_planner_and_is_immutable():
     assert list(PLANNERS) == ["astar", "astar-ucs", "fast-downward", "symk", "pyperplan", "fast-downward-opt",
                               "fast-downward-blind", "fast-downward-sas", "fast-downward-sas-opt", "symk-sas",
-                              "symk-sas-topk", "fast-downward-sas-ms", "fast-downward-sas-lama"]
+                              "symk-sas-topk", "fast-downward-sas-ms", "fast-downward-sas-lama",
+                              "rules-astar", "rules-bfs"]
     assert [n for n, s in PLANNERS.items() if not s.needs_rules] == ["astar", "astar-ucs"]
     assert all(s.name == n and s.description for n, s in PLANNERS.items())
     with pytest.raises(TypeError):

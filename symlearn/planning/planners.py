@@ -11,7 +11,8 @@ planners write the problem for the start and goal codes (and, for STRIPS-only pl
 grounded STRIPS form of the domain for this problem) and call the planner through
 unified-planning (search.classical), or, for the `-sas` planners, write the rules for this
 problem as a SAS+ task and run Fast Downward's or SymK's search on it without a translator
-(search.sas_planners). Their plans are checked against the network: if rolling the
+(search.sas_planners). The `rules-` planners search the rules in this process (search.rules_search),
+without writing a task or starting a process. Their plans are checked against the network: if rolling the
 transition network along the plan gives other states than the PDDL predicted, the result is
 marked `rules_vs_net`. PDDL writing time and the planner's own time are reported separately.
 
@@ -34,12 +35,14 @@ from pddl_export.files import atomic_write_text, sha256_file
 from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl
 from pddl_export.overrides import override_rules
 from pddl_export.rules import RuleSet, apply_rules_batch
+from pddl_export.rule_successors import RuleSuccessors
 from pddl_export.rules_io import PDDL_DIR, RULES_FILE, load_rules
 from pddl_export.sas_writer import SASEncoder
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
 from search.classical import solve_pddl
 from search.learned_astar import plan_symbolic
 from search.result import PlanResult, PlanStatus, failed
+from search.rules_search import plan_rules
 from search.sas_planners import solve_sas
 from search.up_problem import strips_problem
 from symlearn.planning.execution import PlannerFn
@@ -223,7 +226,24 @@ class _RulesPlanner:
         return dataclasses.replace(res, planner=self.name, extra=extra)
 
 
-# registry name -> (engine name in search.classical / search.sas_planners, task form, description)
+class _InProcessRulesPlanner(_RulesPlanner):
+    """A search over the exported rules in this process (search.rules_search), compiled once per rule set.
+
+    Closed loop works as for the other rule planners: observed steps override the rules.
+    Nothing is written: there is no task file.
+    """
+
+    def _build(self, rules: RuleSet) -> tuple[RuleSet, RuleSuccessors]:  # type: ignore[override]
+        return rules, RuleSuccessors(rules)
+
+    def __call__(self, transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
+        _, successors = self._tools_for(transition)
+        return self._checked(transition, plan_rules(successors, [int(c) for c in start], goal, self.engine,
+                                                    timeout_s=timeout_s, planner_name=self.name))
+
+
+# registry name -> (engine name in search.classical / search.sas_planners / search.rules_search, task form,
+# description)
 _RULES_PLANNERS = {
     "fast-downward": ("fast-downward", "conditional", "Fast Downward on the conditional-effects PDDL domain"),
     "symk": ("symk", "conditional", "SymK on the conditional-effects PDDL domain"),
@@ -239,6 +259,9 @@ _RULES_PLANNERS = {
                              "optimal A* with merge-and-shrink on the SAS+ task without axioms"),
     "fast-downward-sas-lama": ("fast-downward-sas-lama", "sas",
                                "LAMA's first iteration (FF and landmarks) on the SAS+ task without axioms"),
+    "rules-astar": ("astar", "in-process", "A* over the rules in process, batched expansions, code-distance heuristic"),
+    "rules-bfs": ("bfs", "in-process",
+                  "breadth-first search over the rules in process: shortest plans, proves unreachable goals"),
 }
 
 
@@ -247,7 +270,8 @@ def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Pat
     if name not in _RULES_PLANNERS:
         raise ValueError(f"{name!r} is not a planner on the exported rules; known: {', '.join(_RULES_PLANNERS)}")
     engine, form, _ = _RULES_PLANNERS[name]
-    return _RulesPlanner(rules, model_hash, name, engine, form, write_dir)
+    kind = _InProcessRulesPlanner if form == "in-process" else _RulesPlanner
+    return kind(rules, model_hash, name, engine, form, write_dir)
 
 
 def _build_rules_planner(name: str, context: PlannerContext) -> PlannerFn:

@@ -1,0 +1,86 @@
+"""Every successor of a batch of joint states under the rules, for searches that expand in batches.
+
+apply_rules_batch (pddl_export.rules) is the reference semantics; it loops over rules and
+compares every row with each. A search over joint states of 4-5 objects meets millions of
+states, and there RuleSuccessors is ~20x faster: it groups rules by own code, touches only
+the objects that hold that code, and tests all of a code's rules in one comparison. Tests check
+both against each other. States pack into one int64 key (pack_states) for duplicate detection.
+
+    >>> from pddl_export.rules import Rule, RuleSet
+    >>> rs = RuleSet(bits=2, vocabulary=(1, 2, 3), max_objects=2, n_rules_before_generalization=1,
+    ...              rules=(Rule(action=5, code_from=1, code_to=2, forbids=(3,)),))
+    >>> succ = RuleSuccessors(rs)
+    >>> succ.actions.tolist(), succ(np.array([[1, 2], [3, 1]])).tolist()
+    ([5], [[[2, 2]], [[3, 1]]])
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from pddl_export.rules import INF, RuleSet
+
+MAX_PACKED_BITS = 62  # a packed state must fit in a non-negative int64
+
+
+def pack_states(states: np.ndarray, bits: int) -> np.ndarray:
+    """(N, K) codes of `bits` bits each -> (N,) int64 keys, object 0 in the lowest bits; refuses K * bits > 62."""
+    states = np.asarray(states, np.int64)
+    k = states.shape[1]
+    if k * bits > MAX_PACKED_BITS:
+        raise ValueError(f"{k} objects of {bits}-bit codes do not pack into one int64 "
+                         f"(at most {MAX_PACKED_BITS // bits} objects)")
+    shifts = np.arange(k, dtype=np.int64) * bits
+    return (states << shifts).sum(axis=1) if k else np.zeros(len(states), np.int64)
+
+
+class RuleSuccessors:
+    """states (F, K) -> next states (F, A, K) under each of the rules' A changing actions (self.actions).
+
+    The rules are compiled per own code c: the codes any rule on c counts (its context codes) and
+    each rule's [lo, hi) bounds on them as dense arrays. A batch is then evaluated per code: the
+    (state, object) pairs holding c, their others' counts of c's context codes, and one
+    broadcast comparison against all of c's rules at once (the rules of one action and own
+    code are mutually exclusive, so at most one of them fires per pair and action).
+    """
+
+    def __init__(self, rules: RuleSet, chunk: int = 20_000) -> None:
+        self.rules, self.bits, self.chunk = rules, int(rules.bits), int(chunk)
+        self.actions = np.array(rules.actions, np.int64)
+        column = {int(a): i for i, a in enumerate(self.actions)}
+        self._context = np.array(sorted({x for r in rules.rules for x in r.bounds()}), np.int64)
+        where = {int(x): i for i, x in enumerate(self._context)}
+        by_code: dict[int, list] = {}
+        for r in rules.rules:
+            by_code.setdefault(r.code_from, []).append(r)
+        self._groups = {}  # own code -> (context columns, (R, C) lo, (R, C) hi, (R,) action column, (R,) code_to)
+        for c, group in sorted(by_code.items()):
+            cols = sorted({where[x] for r in group for x in r.bounds()})
+            lo = np.zeros((len(group), len(cols)), np.int64)
+            hi = np.full((len(group), len(cols)), INF, np.int64)
+            for i, r in enumerate(group):
+                for x, (l, h) in r.bounds().items():
+                    j = cols.index(where[x])
+                    lo[i, j], hi[i, j] = l, h
+            self._groups[c] = (np.array(cols, np.int64), lo, hi,
+                               np.array([column[r.action] for r in group], np.int64),
+                               np.array([r.code_to for r in group], np.int64))
+
+    def __call__(self, states: np.ndarray) -> np.ndarray:
+        states = np.asarray(states, np.int64)
+        if states.ndim != 2:
+            raise ValueError(f"states must have shape (F, K), got {states.shape}")
+        f, k = states.shape
+        out = np.repeat(states[:, None, :], len(self.actions), axis=1)  # (F, A, K): unchanged unless a rule fires
+        for lo_row in range(0, f, self.chunk):
+            part = states[lo_row:lo_row + self.chunk]
+            counts = (part[:, :, None] == self._context).sum(axis=1)  # (F', C) objects holding each context code
+            for c in np.unique(part).tolist():  # only the codes present: a small batch holds few
+                if c not in self._groups:
+                    continue
+                cols, lo, hi, acol, code_to = self._groups[c]
+                rows, pos = np.nonzero(part == c)
+                others = counts[rows][:, cols] - (self._context[cols] == c)  # (n, C_c) counts among the OTHER objects
+                fires = np.all((others[:, None, :] >= lo) & (others[:, None, :] < hi), axis=2)  # (n, R)
+                p, r = np.nonzero(fires)
+                out[lo_row + rows[p], acol[r], pos[p]] = code_to[r]
+        return out
