@@ -23,7 +23,7 @@ import time
 from dataclasses import dataclass
 from typing import Callable, Generic, Hashable, Iterable, TypeVar
 
-from search.result import PlanStatus
+from search.result import PlanResult, PlanStatus
 
 S = TypeVar("S", bound=Hashable)
 A = TypeVar("A")
@@ -130,3 +130,17 @@ def astar(
                     heapq.heappush(open_, (g_next + h, h, next(tie), g_next, nxt))
                     generated += 1
     return outcome(PlanStatus.UNSOLVABLE)
+
+
+def outcome_result(out: SearchOutcome, planner: str, t0: float, timeout_s: float, limit: str, reached: str,
+                   extra: dict) -> PlanResult:
+    """A search's outcome as the one PlanResult: `limit` names the bound a NODE_LIMIT hit, `reached` what was exhausted."""
+    messages = {
+        PlanStatus.SOLVED: "",
+        PlanStatus.UNSOLVABLE: f"no goal state among {reached}",
+        PlanStatus.NODE_LIMIT: f"stopped at {limit}",
+        PlanStatus.TIMEOUT: f"stopped at timeout_s={timeout_s} after {out.expansions} expansions",
+    }
+    return PlanResult(planner=planner, status=out.status, plan=out.actions, predicted_states=out.states,
+                      expansions=out.expansions, planning_time_s=time.perf_counter() - t0,
+                      message=messages[out.status], extra={"generated": out.generated, **extra})

@@ -25,8 +25,8 @@ import time
 
 import numpy as np
 
-from search.astar import astar
-from search.result import PlanResult, PlanStatus
+from search.astar import astar, outcome_result
+from search.result import PlanResult
 from pddl_export.symbolic import N_ACTIONS, SymbolicGoal, TransitionFn
 
 State = tuple[int, ...]
@@ -87,19 +87,5 @@ def plan_symbolic(
 
     out = astar(tuple(start_arr.tolist()), is_goal, successors, heuristic,
                 max_expansions=max_expansions, timeout_s=timeout_s, uniform_cost=uniform_cost)
-    messages = {
-        PlanStatus.SOLVED: "",
-        PlanStatus.UNSOLVABLE: f"no goal state among the {out.expansions} reachable states",
-        PlanStatus.NODE_LIMIT: f"stopped at max_expansions={max_expansions}",
-        PlanStatus.TIMEOUT: f"stopped at timeout_s={timeout_s} after {out.expansions} expansions",
-    }
-    return PlanResult(
-        planner=planner_name,
-        status=out.status,
-        plan=out.actions,
-        predicted_states=out.states,
-        expansions=out.expansions,
-        planning_time_s=time.perf_counter() - t0,
-        message=messages[out.status],
-        extra={"generated": out.generated, "uniform_cost": uniform_cost},
-    )
+    return outcome_result(out, planner_name, t0, timeout_s, f"max_expansions={max_expansions}",
+                          f"the {out.expansions} reachable states", {"uniform_cost": uniform_cost})

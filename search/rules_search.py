@@ -29,9 +29,9 @@ import numpy as np
 from pddl_export.rule_successors import RuleSuccessors
 from pddl_export.rules import RuleSet
 from pddl_export.symbolic import SymbolicGoal
-from search.astar import astar
+from search.astar import astar, outcome_result
 from search.batched_bfs import breadth_first
-from search.result import PlanResult, PlanStatus
+from search.result import PlanResult
 
 METHODS = ("astar", "bfs")
 State = tuple[int, ...]
@@ -114,13 +114,5 @@ def plan_rules(
                     max_expansions=max_expansions, timeout_s=timeout_s, batch=batch,
                     successors_many=successors_many)
         limit = f"max_expansions={max_expansions}"
-    messages = {
-        PlanStatus.SOLVED: "",
-        PlanStatus.UNSOLVABLE: f"no goal state among the {out.generated} states the rules reach",
-        PlanStatus.NODE_LIMIT: f"stopped at {limit}",
-        PlanStatus.TIMEOUT: f"stopped at timeout_s={timeout_s} after {out.expansions} expansions",
-    }
-    return PlanResult(
-        planner=planner_name or f"rules-{method}", status=out.status, plan=out.actions,
-        predicted_states=out.states, expansions=out.expansions, planning_time_s=time.perf_counter() - t0,
-        message=messages[out.status], extra={"generated": out.generated, "batch": batch if method == "astar" else 0})
+    return outcome_result(out, planner_name or f"rules-{method}", t0, timeout_s, limit,
+                          f"the {out.generated} states the rules reach", {"batch": batch if method == "astar" else 0})
