@@ -23,14 +23,13 @@ MAX_PACKED_BITS = 62  # a packed state must fit in a non-negative int64
 
 
 def pack_states(states: np.ndarray, bits: int) -> np.ndarray:
-    """(N, K) codes of `bits` bits each -> (N,) int64 keys, object 0 in the lowest bits; refuses K * bits > 62."""
+    """(..., K) codes of `bits` bits each -> (...) int64 keys, object 0 in the lowest bits; refuses K * bits > 62."""
     states = np.asarray(states, np.int64)
-    k = states.shape[1]
+    k = states.shape[-1]
     if k * bits > MAX_PACKED_BITS:
         raise ValueError(f"{k} objects of {bits}-bit codes do not pack into one int64 "
                          f"(at most {MAX_PACKED_BITS // bits} objects)")
-    shifts = np.arange(k, dtype=np.int64) * bits
-    return (states << shifts).sum(axis=1) if k else np.zeros(len(states), np.int64)
+    return (states << np.arange(k, dtype=np.int64) * bits).sum(axis=-1)
 
 
 class RuleSuccessors:

@@ -25,6 +25,38 @@ from search.astar import SearchOutcome
 from search.result import PlanStatus
 
 
+Layer = tuple[np.ndarray, np.ndarray, np.ndarray]  # states (n, K), parent index in the previous layer, action
+
+
+def _path(layers: list[Layer], goal_index: int) -> tuple[tuple[int, ...], tuple[tuple[int, ...], ...]]:
+    """The actions and states from the start to state goal_index of the last layer, following parents back."""
+    plan: list[int] = []
+    path: list[tuple[int, ...]] = []
+    i = goal_index
+    for depth in range(len(layers) - 1, -1, -1):
+        states, parents, acts = layers[depth]
+        path.append(tuple(int(c) for c in states[i]))
+        if depth:
+            plan.append(int(acts[i]))
+            i = int(parents[i])
+    return tuple(reversed(plan)), tuple(reversed(path))
+
+
+def _new_successors(part: np.ndarray, nxt: np.ndarray, actions: np.ndarray, seen: np.ndarray,
+                    bits: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(keys, states, parent rows in part, actions) of the successors nxt (F, A, K) of part not in sorted `seen`.
+
+    Self-loops are dropped, and a state reached several times keeps its first (parent, action).
+    """
+    keys = pack_states(nxt, bits)  # (F, A)
+    fi, ai = np.nonzero(keys != pack_states(part, bits)[:, None])  # by parent, then action
+    keys, first = np.unique(keys[fi, ai], return_index=True)  # first occurrence: lowest parent, then action
+    pos = np.minimum(np.searchsorted(seen, keys), len(seen) - 1)  # seen is never empty
+    fresh = seen[pos] != keys
+    fi, ai = fi[first[fresh]], ai[first[fresh]]
+    return keys[fresh], nxt[fi, ai], fi, actions[ai]
+
+
 def breadth_first(
     start: np.ndarray,
     successors: Callable[[np.ndarray], np.ndarray],
@@ -52,23 +84,13 @@ def breadth_first(
     t0 = time.perf_counter()
     start = np.asarray(start, np.int64).reshape(1, -1)
     actions = np.asarray(actions, np.int64)
-    # per layer: its states (n, K), each one's parent index in the previous layer and action
-    layers: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = [(start, np.zeros(1, np.int64), np.zeros(1, np.int64))]
+    layers: list[Layer] = [(start, np.zeros(1, np.int64), np.zeros(1, np.int64))]
     seen = pack_states(start, bits)
     expansions, generated = 0, 1
 
     def outcome(status: PlanStatus, goal_index: int | None = None) -> SearchOutcome:
-        plan: list[int] = []
-        path: list[tuple[int, ...]] = []
-        if goal_index is not None:
-            i = goal_index
-            for depth in range(len(layers) - 1, -1, -1):
-                states, parents, acts = layers[depth]
-                path.append(tuple(int(c) for c in states[i]))
-                if depth:
-                    plan.append(int(acts[i]))
-                    i = int(parents[i])
-        return SearchOutcome(status=status, actions=tuple(reversed(plan)), states=tuple(reversed(path)),
+        plan, path = _path(layers, goal_index) if goal_index is not None else ((), ())
+        return SearchOutcome(status=status, actions=plan, states=path,
                              cost=float(len(plan)) if goal_index is not None else float("inf"),
                              expansions=expansions, generated=generated, time_s=time.perf_counter() - t0)
 
@@ -79,27 +101,17 @@ def breadth_first(
         frontier = layers[-1][0]
         if not len(frontier):
             return outcome(PlanStatus.UNSOLVABLE)
-        new_keys, new_states, new_parents, new_actions = [], [], [], []
+        parts = []  # per chunk: keys, states, parents, actions of its new states
         for lo in range(0, len(frontier), chunk):
             if time.perf_counter() - t0 > timeout_s:
                 return outcome(PlanStatus.TIMEOUT)
             part = frontier[lo:lo + chunk]
-            nxt = successors(part)  # (F, A, K)
+            keys, states, parents, acts = _new_successors(part, successors(part), actions, seen, bits)
+            parts.append((keys, states, parents + lo, acts))
             expansions += len(part)
-            keys = (nxt << np.arange(nxt.shape[2], dtype=np.int64) * bits).sum(axis=2)  # (F, A): pack_states per row
-            fi, ai = np.nonzero(keys != pack_states(part, bits)[:, None])  # self-loops dropped; by parent, then action
-            keys, first = np.unique(keys[fi, ai], return_index=True)  # first occurrence: lowest parent, then action
-            pos = np.minimum(np.searchsorted(seen, keys), len(seen) - 1)  # seen is sorted and never empty
-            fresh = seen[pos] != keys
-            fi, ai = fi[first[fresh]], ai[first[fresh]]
-            new_keys.append(keys[fresh])
-            new_states.append(nxt[fi, ai])
-            new_parents.append(lo + fi)
-            new_actions.append(actions[ai])
-        keys = np.concatenate(new_keys)
+        keys, states, parents, acts = (np.concatenate(x) for x in zip(*parts))
         keys, first = np.unique(keys, return_index=True)  # a state new to two chunks: keep the earlier chunk's
-        states = np.concatenate(new_states)[first]
-        parents, acts = np.concatenate(new_parents)[first], np.concatenate(new_actions)[first]
+        states, parents, acts = states[first], parents[first], acts[first]
         order = np.lexsort((acts, parents))  # layer order: by parent, then action
         states, parents, acts, keys = states[order], parents[order], acts[order], keys[order]
         generated += len(keys)

@@ -106,7 +106,7 @@ def plan_rules(
         def successors_many(states: list[State]) -> list[list[tuple[int, State, float]]]:
             nxt = succ(np.array(states, np.int64).reshape(len(states), len(start_arr)))  # (B, A, K)
             rows = nxt.tolist()
-            return [[(actions[a], tuple(r), 1.0) for a, r in enumerate(per) if tuple(r) != s]
+            return [[(actions[a], t, 1.0) for a, r in enumerate(per) if (t := tuple(r)) != s]
                     for s, per in zip(states, rows)]
 
         out = astar(tuple(start_arr.tolist()), lambda s: all(s[i] == c for i, c in fixed),
