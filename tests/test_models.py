@@ -88,3 +88,57 @@ def test_config_validation_and_presets():
     p = ModelConfig.from_preset("paper")
     assert p.conv_channels == (64, 128, 256, 512) and p.n_layers == 4 and p.decoder_hidden == (256, 256, 256)
     assert ModelConfig.from_json(p.to_json()) == p
+
+
+def test_dynamics_head_predicts_next_codes_from_the_codes_before():
+    from symlearn.learning.models import code_prediction_loss
+
+    cfg = ModelConfig.from_preset("quick", dynamics_head=True)
+    model = AttentiveDeepSym(cfg).train()
+    mask = torch.tensor([[1, 1, 0], [1, 0, 0]]).bool()
+    crops, post = torch.rand(2, 3, 3, 32, 32), torch.rand(2, 3, 3, 32, 32)
+    out = model(crops, mask, torch.tensor([0, 35]), post_crops=post)
+    assert out.next_logits.shape == out.next_codes.shape == (2, 3, cfg.bits)
+    assert float(out.next_logits[~mask].abs().sum()) == 0.0  # padded slots predict nothing
+    assert out.post_logits.shape == out.logits.shape
+    loss = code_prediction_loss(out.next_logits, out.next_codes, mask)
+    # equals binary cross-entropy with the post codes as targets, over the real objects
+    ref = torch.nn.functional.binary_cross_entropy_with_logits(out.next_logits[mask], out.next_codes[mask].detach())
+    assert float(loss) == pytest.approx(float(ref), rel=1e-5)
+    # the gradient reaches the encoder through the codes before only: the targets are detached
+    g_pre = torch.autograd.grad(loss, out.codes, retain_graph=True)[0]
+    assert g_pre.abs().sum() > 0 and not out.next_codes.detach().requires_grad
+    assert torch.autograd.grad(loss, out.post_logits, retain_graph=True, allow_unused=True)[0] is None
+    # without post crops only effects and codes come back; without a head no next-code logits
+    assert model(crops, mask, torch.tensor([0, 35])).next_logits is None
+    plain = AttentiveDeepSym(ModelConfig.from_preset("quick"))(crops, mask, torch.tensor([0, 1]), post_crops=post)
+    assert plain.next_logits is None and plain.next_codes.shape == (2, 3, cfg.bits)
+    with pytest.raises(ValueError, match="post_crops"):
+        model(crops, mask, torch.tensor([0, 35]), post_crops=post[:, :2])
+
+
+def test_masked_mse_weights_objects():
+    pred, target = torch.zeros(1, 2, 3), torch.ones(1, 2, 3)
+    target[0, 1] = 2.0  # object 1 errs by 2 per axis (squared 4), object 0 by 1
+    mask = torch.tensor([[True, True]])
+    assert float(masked_mse(pred, target, mask)) == pytest.approx((1 + 4) / 2)
+    assert float(masked_mse(pred, target, mask, torch.tensor([[1.0, 3.0]]))) == pytest.approx((1 + 12) / 2)
+
+
+def test_stability_loss_is_zero_only_for_agreeing_decisive_bits_of_still_objects():
+    from symlearn.learning.models import code_stability_loss
+
+    still = torch.tensor([[True, False]])
+    agree = torch.tensor([[[3.0, -2.5], [0.1, 0.1]]])  # object 0: same side, beyond the margin of 2
+    assert float(code_stability_loss(agree, agree.clone(), still, 2.0)) == 0.0  # object 1 is not still: ignored
+    flip = agree.clone()
+    flip[0, 0, 0] = -3.0  # bit 0 of the still object flips sign: the sum is 0 (side +1), the -3 pays 2 + 3
+    assert float(code_stability_loss(agree, flip, still, 2.0)) == pytest.approx(5.0 / 2, rel=1e-6)
+    flip[0, 0, 0] = -4.0  # now the sum says 0: the +3 pays 2 + 3, the -4 nothing
+    assert float(code_stability_loss(agree, flip, still, 2.0)) == pytest.approx(5.0 / 2, rel=1e-6)
+    weak = agree.clone()
+    weak[0, 0, 1] = -1.0  # agrees but only 1 from 0: pays 1 on one side
+    assert float(code_stability_loss(agree, weak, still, 2.0)) == pytest.approx(1.0 / 2, rel=1e-6)
+    pre = agree.clone().requires_grad_(True)
+    code_stability_loss(pre, flip, still, 2.0).backward()
+    assert pre.grad[0, 1].abs().sum() == 0 and pre.grad[0, 0].abs().sum() > 0  # only still objects are pushed

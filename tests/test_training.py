@@ -98,3 +98,63 @@ def test_two_process_ddp_ends_with_identical_weights(data, tmp_path):
     assert r.returncode == 0, r.stderr[-2000:]
     m = json.loads((run / "metrics.json").read_text())
     assert m["world_size"] == 2 and m["ranks_identical"] is True
+
+
+def test_rider_weights_mark_exactly_the_riders(tiny_data):
+    import dataclasses
+
+    from symlearn.data.dataset import load_split
+    from symlearn.data.statistics import rider_mask
+    from symlearn.learning.training import effect_normalization, to_tensors
+
+    d = load_split(data_path := tiny_data.path, "train")
+    # make object 1 of every two-object scene a rider: object 0 held, object 1 carried 10 cm along y
+    two = np.flatnonzero(d.n_objects >= 2)
+    grasped, effect = d.grasped.copy(), d.effect.copy()
+    grasped[two] = 0
+    effect[two, 1] = [0.0, 0.1, 0.0]
+    d = dataclasses.replace(d, grasped=grasped, effect=effect)
+    riders = rider_mask(d)
+    assert len(two) > 0 and riders[two, 1].all() and not riders[:, 0].any(), data_path
+    mean, std = effect_normalization(d)
+    t = to_tensors(d, mean, std, rider_weight=5.0, with_post=True)
+    assert np.array_equal(t.weight.numpy(), np.where(riders, 5.0, 1.0))
+    assert to_tensors(d, mean, std).weight is None and to_tensors(d, mean, std).post_depth is None
+    from symlearn.data.statistics import still_mask
+    assert np.array_equal(t.still.numpy(), still_mask(d)) and not (t.still.numpy() & riders).any()
+    assert t.post_crops(torch.arange(3)).shape == t.batch(torch.arange(3))[0].shape
+
+
+def test_levers_train_and_are_recorded(data, tmp_path):
+    cfg = TrainConfig.from_preset("quick", **TINY, rider_weight=4.0, dynamics_weight=0.5, stability_weight=1.0)
+    assert cfg.model.dynamics_head  # a positive dynamics weight switches the head on
+    out = train(data, tmp_path / "lev", cfg, show_progress=False)
+    assert len(out["history"]) == 2 and np.isfinite(out["history"][-1]["train_loss"])
+    saved = json.loads((tmp_path / "lev" / "config.json").read_text())["train_config"]
+    assert saved["rider_weight"] == 4.0 and saved["dynamics_weight"] == 0.5 and saved["model"]["dynamics_head"]
+    assert saved["stability_weight"] == 1.0
+    model, _ = load_effect_model(tmp_path / "lev")
+    assert model.dynamics is not None
+
+
+def test_lever_settings_refused():
+    with pytest.raises(ValueError, match="rider_weight"):
+        TrainConfig.from_preset("quick", rider_weight=0.0)
+    with pytest.raises(ValueError, match="dynamics_weight"):
+        TrainConfig.from_preset("quick", dynamics_weight=-1.0)
+    with pytest.raises(ValueError, match="dynamics_head"):
+        TrainConfig(dynamics_weight=1.0)
+    with pytest.raises(ValueError, match="stability_margin"):
+        TrainConfig.from_preset("quick", stability_weight=1.0, stability_margin=0.0)
+
+
+def test_config_from_before_the_levers_still_resumes():
+    from symlearn.learning.training import _resumable
+
+    cfg = TrainConfig.from_preset("quick", **TINY)
+    old = cfg.to_json()
+    for key in ("rider_weight", "dynamics_weight", "stability_weight", "stability_margin"):
+        del old[key]
+    del old["model"]["dynamics_head"]
+    assert _resumable(old) == _resumable(cfg.to_json())
+    assert _resumable({**old, "lr": 0.5}) != _resumable(cfg.to_json())

@@ -59,6 +59,17 @@ def positive_finite_float(text: str) -> float:
     return value
 
 
+def non_negative_finite_float(text: str) -> float:
+    """'0.5' -> 0.5, '0' -> 0.0; negatives, inf and nan are argparse errors naming the text."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r} must be a non-negative finite number")
+    return value
+
+
 class OneLineParser(argparse.ArgumentParser):
     """An ArgumentParser whose refusals are one line, 'PROG: error: MESSAGE (see PROG --help)', exit code 2."""
 

@@ -11,7 +11,8 @@ import sys
 import time
 from pathlib import Path
 
-from symlearn.cli.args import OneLineParser, int_range, non_negative_int, positive_finite_float, positive_int
+from symlearn.cli.args import (OneLineParser, int_range, non_negative_finite_float, non_negative_int,
+                               positive_finite_float, positive_int)
 from symlearn.cli.pipeline import add_pipeline_command
 from symlearn.cli.planning import add_planning_commands
 from symlearn.cli.report import add_report_command
@@ -70,7 +71,10 @@ def cmd_train(args: argparse.Namespace) -> int:
     from symlearn.learning.training import TrainConfig, train
 
     over = {k: v for k, v in dict(epochs=args.epochs, batch_size=args.batch_size, lr=args.lr, seed=args.seed,
-                                   max_train_samples=args.max_train_samples).items() if v is not None}
+                                   max_train_samples=args.max_train_samples, rider_weight=args.rider_weight,
+                                   dynamics_weight=args.dynamics_weight,
+                                   stability_weight=args.stability_weight,
+                                   stability_margin=args.stability_margin).items() if v is not None}
     if args.no_attention:
         over["attention"] = False
     if args.constant_lr:
@@ -179,6 +183,14 @@ def add_train_command(sub) -> None:
     t.add_argument("--seed", type=non_negative_int)
     t.add_argument("--max-train-samples", type=positive_int, help="train on the first N samples only")
     t.add_argument("--no-attention", action="store_true", help="the DeepSym baseline without attention")
+    t.add_argument("--rider-weight", type=positive_finite_float,
+                   help="loss weight of riders, objects carried by the held one (default 1)")
+    t.add_argument("--dynamics-weight", type=non_negative_finite_float,
+                   help="weight of a joint next-code loss: codes trained to carry what decides their next values (default 0)")
+    t.add_argument("--stability-weight", type=non_negative_finite_float,
+                   help="weight of a loss keeping the codes of objects an action left in place unchanged (default 0)")
+    t.add_argument("--stability-margin", type=positive_finite_float,
+                   help="logit distance from 0 the stability loss asks of each bit (default 1)")
     t.add_argument("--constant-lr", action="store_true", help="no cosine decay of the learning rate")
     t.add_argument("--no-bf16", action="store_true", help="plain float32 (bf16 autocast is the default)")
     t.add_argument("--compile", action="store_true", help="torch.compile the model")

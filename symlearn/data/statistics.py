@@ -17,6 +17,7 @@ import numpy as np
 from symlearn.data.dataset import InteractionData
 from symlearn.world import OBJECT_SIZE, TABLE_TOP_Z, ObjectType
 
+STILL_M = 0.01  # an object that moved less than this (and was not held) stayed where it was
 RIDE_MIN_M = 0.05  # a rider moves with the carried object: 5 cm is far above settling jitter (< 1 cm)
 STACK_MIN_M = 0.02  # an object on another one starts at least its support's height (>= 5 cm) higher
 
@@ -27,6 +28,13 @@ def rider_mask(data: InteractionData) -> np.ndarray:
     held = data.grasped[:, None] == np.arange(k)[None, :]
     moved = np.linalg.norm(data.effect[..., :2], axis=-1) >= RIDE_MIN_M
     return data.mask & ~held & moved & (data.grasped[:, None] >= 0)
+
+
+def still_mask(data: InteractionData) -> np.ndarray:
+    """(N, K) bool: real objects that moved less than STILL_M and were not held: their arrangement is unchanged."""
+    k = data.effect.shape[1]
+    held = data.grasped[:, None] == np.arange(k)[None, :]
+    return data.mask & ~held & (np.linalg.norm(data.effect, axis=-1) < STILL_M)
 
 
 def stacked_mask(data: InteractionData) -> np.ndarray:

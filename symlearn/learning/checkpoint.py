@@ -116,15 +116,21 @@ def load_weights(model: torch.nn.Module, state: dict, path: Path) -> None:
     model.load_state_dict(state)
 
 
-def load_effect_model(run_dir: Path, which: str = "best") -> tuple[AttentiveDeepSym, Checkpoint]:
-    """The trained model of a run, in eval mode, with its checkpoint record."""
+def analysis_device() -> torch.device:
+    """Where the analysis stages (evaluate, symbols, train-transition's encoding) run the effect model: a GPU if any."""
+    return torch.device("cuda") if torch.cuda.is_available() else torch.device("cpu")
+
+
+def load_effect_model(run_dir: Path, which: str = "best",
+                      device: torch.device | str = "cpu") -> tuple[AttentiveDeepSym, Checkpoint]:
+    """The trained model of a run, in eval mode on `device`, with its checkpoint record."""
     if which not in ("best", "last"):
         raise CheckpointError(f"unknown checkpoint {which!r}: expected best or last")
     path = Path(run_dir) / f"{which}.pt"
     ck = load_checkpoint(path)
     model = AttentiveDeepSym(ck.config)
     load_weights(model, ck.model_state, path)
-    return model.eval(), ck
+    return model.to(device).eval(), ck
 
 
 def effect_model_sha256(run_dir: Path, which: str = "best") -> str:

@@ -4,7 +4,9 @@ Rows: the trained run, optionally a no-attention run (DeepSym-style), and the me
 predictor (the training set's mean effect for every object). Errors are mean absolute errors per
 axis in millimetres over real objects, overall, by number of objects in the scene, and on riders
 (objects that moved because they stood on a carried one; `symlearn.data.statistics.rider_mask`),
-the relational effect the attention is for.
+the relational effect the attention is for. Symbol stability: the share of still objects (moved less
+than 1 cm, not held) whose code is the same before and after the action; a code that changes
+while its object stays put makes the symbolic state depend on more than the arrangement.
 """
 from __future__ import annotations
 
@@ -14,10 +16,11 @@ import numpy as np
 import torch
 
 from symlearn.data.dataset import data_fingerprint, load_split
-from symlearn.data.statistics import rider_mask
-from symlearn.learning.checkpoint import effect_model_sha256, load_effect_model, stage_record
+from symlearn.data.statistics import rider_mask, still_mask
+from symlearn.learning.checkpoint import analysis_device, effect_model_sha256, load_effect_model, stage_record
 from symlearn.provenance import atomic_write_json
-from symlearn.learning.training import predict_effects, to_tensors
+from symlearn.learning.models import AttentiveDeepSym
+from symlearn.learning.training import SplitTensors, predict_effects, to_tensors
 
 
 def _mae_rows(pred_m: np.ndarray, true_m: np.ndarray, mask: np.ndarray, n_objects: np.ndarray,
@@ -34,13 +37,32 @@ def _mae_rows(pred_m: np.ndarray, true_m: np.ndarray, mask: np.ndarray, n_object
     return out
 
 
+@torch.no_grad()
+def code_stability(model: AttentiveDeepSym, split: SplitTensors, still: np.ndarray, batch_size: int = 256) -> dict:
+    """Share of still objects ((N, K) bool) whose code is unchanged by the action, and of scenes where all are."""
+    model.eval()
+    same = []
+    for i in range(0, len(split), batch_size):
+        idx = torch.arange(i, min(i + batch_size, len(split)))
+        device = next(model.parameters()).device
+        crops, mask, _, _ = split.batch(idx)
+        before, _ = model.encode(crops.to(device), mask.to(device))
+        after, _ = model.encode(split.post_crops(idx).to(device), mask.to(device))
+        same.append((before == after).all(-1).cpu().numpy())
+    same = np.concatenate(same) if same else np.zeros(still.shape, bool)
+    n = int(still.sum())
+    return {"still_objects": n, "code_unchanged": round(float(same[still].mean()), 4) if n else None,
+            "scenes_all_unchanged": round(float((same | ~still).all(-1).mean()), 4) if len(same) else None}
+
+
 def evaluate(run_dir: Path, data_dir: Path, baseline_run: Path | None = None) -> dict:
     """Write RUN/eval.json (errors, config, seed, versions, model hash, data fingerprint) and return it."""
     run_dir = Path(run_dir)
-    model, ck = load_effect_model(run_dir)
+    model, ck = load_effect_model(run_dir, device=analysis_device())
     test = load_split(data_dir, "test")
     mean, std = ck.effect_mean, ck.effect_std
-    t = to_tensors(test, mean, std)
+    t = to_tensors(test, mean, std, with_post=True)
+    still = still_mask(test)
     truth = test.effect
     mask, nobj, riders = test.mask, test.n_objects.astype(int), rider_mask(test)
 
@@ -56,13 +78,16 @@ def evaluate(run_dir: Path, data_dir: Path, baseline_run: Path | None = None) ->
                   str(k): dict(zip("xyz", np.round(np.abs(truth[mask & (nobj == k)[:, None]]).mean(0) * 1000, 2).tolist()))
                   for k in sorted(set(nobj.tolist()))}}
     result.update(_mae_rows(denorm(predict_effects(model, t)), truth, mask, nobj, riders))
+    result["code_stability"] = code_stability(model, t, still)
     ablations = {}
     if baseline_run is not None:
-        base, bck = load_effect_model(Path(baseline_run))
+        base, bck = load_effect_model(Path(baseline_run), device=analysis_device())
         tb = to_tensors(test, bck.effect_mean, bck.effect_std)
         pb_ = predict_effects(base, tb).numpy() * bck.effect_std + bck.effect_mean
         ablations["no_attention"] = {"run": str(baseline_run), "effect_model_sha256": effect_model_sha256(baseline_run),
-                                     **_mae_rows(pb_, truth, mask, nobj, riders)}
+                                     **_mae_rows(pb_, truth, mask, nobj, riders),
+                                     "code_stability": code_stability(base, to_tensors(test, bck.effect_mean, bck.effect_std,
+                                                                                       with_post=True), still)}
     ablations["mean_effect"] = _mae_rows(np.broadcast_to(mean, truth.shape), truth, mask, nobj, riders)
     result["ablations"] = ablations
     atomic_write_json(run_dir / "eval.json", result)
@@ -90,4 +115,8 @@ def format_table(result: dict) -> str:
         lines.append(fmt(name, rows))
     m = result["mean_abs_effect_mm"]
     lines.append(f"{'mean |effect|':<16}{m['x']:8.1f}{m['y']:8.1f}{m['z']:8.1f}")
+    cs = result.get("code_stability")
+    if cs and cs["code_unchanged"] is not None:
+        lines.append(f"symbol stability: {cs['code_unchanged']:.3f} of {cs['still_objects']} still objects keep their "
+                     f"code; {cs['scenes_all_unchanged']:.3f} of scenes keep all of them")
     return "\n".join(lines)

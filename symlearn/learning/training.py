@@ -25,7 +25,9 @@ import torch.distributed as dist
 from symlearn.learning.checkpoint import load_checkpoint, load_weights, save_checkpoint
 from symlearn.data.dataset import InteractionData, data_fingerprint, load_split
 from symlearn.data.model_input import model_inputs
-from symlearn.learning.models import AttentiveDeepSym, ModelConfig, masked_mse
+from symlearn.data.statistics import rider_mask, still_mask
+from symlearn.learning.models import (AttentiveDeepSym, ModelConfig, code_prediction_loss, code_stability_loss,
+                                     masked_mse)
 from symlearn.provenance import atomic_write_json, versions
 
 
@@ -49,6 +51,15 @@ class TrainConfig:
     bf16: bool = True  # bfloat16 autocast on CPU (AMX) or GPU; weights stay float32
     compile: bool = False  # torch.compile the model
     max_train_samples: int | None = None  # a subset, for quick runs and tests
+    rider_weight: float = 1.0  # loss weight of riders (objects carried by the held one; 1.5% of objects)
+    dynamics_weight: float = 0.0  # weight of the joint next-code loss (needs model.dynamics_head)
+    stability_weight: float = 0.0  # weight of the hinge keeping still objects' codes unchanged by an action
+    stability_margin: float = 1.0  # logit distance from 0 the hinge asks of every bit of a still object
+
+    @property
+    def uses_post_crops(self) -> bool:
+        """Whether training also encodes the post-state crops (for the next-code or the stability loss)."""
+        return self.dynamics_weight > 0 or self.stability_weight > 0
 
     def __post_init__(self) -> None:
         """Refuse settings that would train nothing, on a wrong subset, or into NaN."""
@@ -58,8 +69,13 @@ class TrainConfig:
 
     @staticmethod
     def from_preset(name: str, **overrides) -> "TrainConfig":
-        """A named preset (paper, quick); model fields among the overrides go to the model config."""
+        """A named preset (paper, quick); model fields among the overrides go to the model config.
+
+        A positive dynamics_weight switches the model's dynamics head on.
+        """
         model_over = {k: overrides.pop(k) for k in list(overrides) if k in ModelConfig.__dataclass_fields__}
+        if overrides.get("dynamics_weight", 0) > 0:
+            model_over.setdefault("dynamics_head", True)
         base = {"paper": dict(epochs=60, batch_size=128, lr=5e-4),
                 "quick": dict(epochs=40, batch_size=64, lr=1e-3)}
         if name not in base:
@@ -97,6 +113,15 @@ def _config_problem(c: TrainConfig) -> str | None:
         (_is_real(c.weight_decay) and c.weight_decay >= 0, f"weight_decay={c.weight_decay!r} must be finite and >= 0"),
         (_is_real(c.lr_min_ratio) and 0 <= c.lr_min_ratio <= 1, f"lr_min_ratio={c.lr_min_ratio!r} must be in [0, 1]"),
         (_is_int(c.seed) and c.seed >= 0, f"seed={c.seed!r} must be a non-negative integer"),
+        (_is_real(c.rider_weight) and c.rider_weight > 0, f"rider_weight={c.rider_weight!r} must be finite and > 0"),
+        (_is_real(c.dynamics_weight) and c.dynamics_weight >= 0,
+         f"dynamics_weight={c.dynamics_weight!r} must be finite and >= 0"),
+        (_is_real(c.stability_weight) and c.stability_weight >= 0,
+         f"stability_weight={c.stability_weight!r} must be finite and >= 0"),
+        (_is_real(c.stability_margin) and c.stability_margin > 0,
+         f"stability_margin={c.stability_margin!r} must be finite and > 0"),
+        (c.dynamics_weight == 0 or c.model.dynamics_head,
+         f"dynamics_weight={c.dynamics_weight!r} needs a model with dynamics_head=True"),
         (c.max_train_samples is None or (_is_int(c.max_train_samples) and c.max_train_samples >= 1),
          f"max_train_samples={c.max_train_samples!r} must be a positive integer (or None: all)"),
     ]
@@ -105,7 +130,11 @@ def _config_problem(c: TrainConfig) -> str | None:
 
 @dataclass(frozen=True)
 class SplitTensors:
-    """One split as tensors: float16 depth, crop origins, mask, actions, normalized effects."""
+    """One split as tensors: float16 depth, crop origins, mask, actions, normalized effects.
+
+    With post=True in to_tensors the post-state crops come along (for the joint next-code loss),
+    and `weight` holds each object's loss weight.
+    """
 
     depth: torch.Tensor  # (N, K, S, S) float16
     origin: torch.Tensor  # (N, K, 2) float32
@@ -113,15 +142,36 @@ class SplitTensors:
     action: torch.Tensor  # (N,) int64
     effect: torch.Tensor  # (N, K, 3) float32, normalized
     n_objects: torch.Tensor  # (N,) int64
+    weight: torch.Tensor | None = None  # (N, K) float32 loss weight per object
+    post_depth: torch.Tensor | None = None  # (N, K, S, S) float16, the same objects after the action
+    post_origin: torch.Tensor | None = None  # (N, K, 2) float32
+    still: torch.Tensor | None = None  # (N, K) bool, objects the action left in place (with the post crops)
 
     def __len__(self) -> int:
         return int(self.action.shape[0])
 
+    def to(self, device: torch.device) -> "SplitTensors":
+        """The split on a device (a GPU holds a paper-size split many times over; batches are then built there)."""
+        return SplitTensors(**{f.name: None if getattr(self, f.name) is None else getattr(self, f.name).to(device)
+                               for f in dataclasses.fields(self)})
+
     def batch(self, idx: torch.Tensor, image_size: int = 256):
         """Model inputs for rows idx: crops (B, K, 3, S, S) float32, mask, actions, effects."""
+        idx = idx.to(self.depth.device)
         d = self.depth[idx].float()  # (B, K, S, S)
         crops = model_inputs(d, self.origin[idx], image_size)
         return crops, self.mask[idx], self.action[idx], self.effect[idx]
+
+    def post_crops(self, idx: torch.Tensor, image_size: int = 256) -> torch.Tensor:
+        """Model inputs of the post-state crops for rows idx (B, K, 3, S, S)."""
+        if self.post_depth is None:
+            raise ValueError("this split was built without post-state crops (to_tensors(..., with_post=True))")
+        idx = idx.to(self.post_depth.device)
+        return model_inputs(self.post_depth[idx].float(), self.post_origin[idx], image_size)
+
+    def weights(self, idx: torch.Tensor) -> torch.Tensor | None:
+        """Loss weights of rows idx, or None when every object weighs 1."""
+        return None if self.weight is None else self.weight[idx.to(self.weight.device)]
 
 
 def effect_normalization(data: InteractionData) -> tuple[np.ndarray, np.ndarray]:
@@ -130,15 +180,26 @@ def effect_normalization(data: InteractionData) -> tuple[np.ndarray, np.ndarray]
     return eff.mean(0).astype(np.float32), np.maximum(eff.std(0), 1e-6).astype(np.float32)
 
 
-def to_tensors(data: InteractionData, mean: np.ndarray, std: np.ndarray, post: bool = False) -> SplitTensors:
-    """A split's pre-state (or, with post, post-state) crops and its normalized effects as tensors."""
+def to_tensors(data: InteractionData, mean: np.ndarray, std: np.ndarray, post: bool = False,
+               with_post: bool = False, rider_weight: float = 1.0) -> SplitTensors:
+    """A split's pre-state (or, with post, post-state) crops and its normalized effects as tensors.
+
+    with_post adds the post-state crops beside the pre-state ones; rider_weight != 1 adds per-object
+    loss weights, riders (symlearn.data.statistics.rider_mask) weighing rider_weight.
+    """
     mask = torch.from_numpy(data.mask)
     eff = torch.from_numpy((data.effect - mean) / std) * mask[..., None]
+    weight = None
+    if rider_weight != 1.0:
+        weight = torch.from_numpy(np.where(rider_mask(data), rider_weight, 1.0).astype(np.float32))
     return SplitTensors(
         depth=torch.from_numpy(data.post_depth if post else data.pre_depth),
         origin=torch.from_numpy((data.post_origin if post else data.pre_origin).astype(np.float32)),
         mask=mask, action=torch.from_numpy(data.action.astype(np.int64)), effect=eff.float(),
-        n_objects=torch.from_numpy(data.n_objects.astype(np.int64)))
+        n_objects=torch.from_numpy(data.n_objects.astype(np.int64)), weight=weight,
+        post_depth=torch.from_numpy(data.post_depth) if with_post else None,
+        post_origin=torch.from_numpy(data.post_origin.astype(np.float32)) if with_post else None,
+        still=torch.from_numpy(still_mask(data)) if with_post else None)
 
 
 def _dist_info() -> tuple[int, int]:
@@ -200,6 +261,8 @@ def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, 
     device = torch.device("cuda", rank % torch.cuda.device_count()) if torch.cuda.is_available() else torch.device("cpu")
     fingerprint = data_fingerprint(data_dir)
     tr, va, mean, std = _load_training_splits(data_dir, cfg)
+    if device.type == "cuda":  # training batches are then built on the GPU: no per-step host work or copies
+        tr = tr.to(device)
     torch.manual_seed(cfg.seed)
     model = AttentiveDeepSym(cfg.model).to(device)
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
@@ -277,7 +340,8 @@ def _load_training_splits(data_dir: Path, cfg: TrainConfig) -> tuple[SplitTensor
     if train_data.pre_depth.shape[-1] % cfg.model.crop:
         raise TrainingError(f"data crops of {train_data.pre_depth.shape[-1]} px do not pool to the model's {cfg.model.crop} px")
     mean, std = effect_normalization(train_data)
-    return to_tensors(train_data, mean, std), to_tensors(val_data, mean, std), mean, std
+    tr = to_tensors(train_data, mean, std, with_post=cfg.uses_post_crops, rider_weight=cfg.rider_weight)
+    return tr, to_tensors(val_data, mean, std), mean, std
 
 
 def _resume(run_dir: Path, cfg: TrainConfig, fingerprint: str, model: AttentiveDeepSym, opt: torch.optim.Optimizer,
@@ -313,9 +377,17 @@ def _train_epoch(loop: _Loop, tr: SplitTensors, epoch: int) -> tuple[float, int,
     for b in bar:
         idx = perm[b * cfg.batch_size:(b + 1) * cfg.batch_size]
         crops, mask, act, eff = (t.to(loop.device) for t in tr.batch(idx))
+        post = tr.post_crops(idx).to(loop.device) if cfg.uses_post_crops else None
+        weight = tr.weights(idx)
         with _autocast(cfg, loop.device):
-            out = loop.step_fn(crops, mask, act, generator=loop.noise_gen)
-        loss = masked_mse(out.effect.float(), eff, mask)
+            out = loop.step_fn(crops, mask, act, generator=loop.noise_gen, post_crops=post)
+        loss = masked_mse(out.effect.float(), eff, mask, None if weight is None else weight.to(loop.device))
+        if cfg.dynamics_weight > 0:
+            loss = loss + cfg.dynamics_weight * code_prediction_loss(out.next_logits.float(), out.next_codes.float(), mask)
+        if cfg.stability_weight > 0:
+            still = tr.still[idx.to(tr.still.device)].to(loop.device) & mask
+            loss = loss + cfg.stability_weight * code_stability_loss(out.logits.float(), out.post_logits.float(), still,
+                                                                     cfg.stability_margin)
         if not torch.isfinite(loss):
             raise TrainingError(f"loss became {loss.item()} at epoch {epoch + 1}, step {b + 1}; "
                                 "lower the learning rate or check the data")
@@ -387,7 +459,14 @@ def epoch_lr(cfg: TrainConfig, epoch: int) -> float:
 
 
 def _resumable(train_config: dict) -> dict:
-    """The settings a resumed run must share with the original: all but the number of epochs."""
+    """The settings a resumed run must share with the original: all but the number of epochs.
+
+    A config written before a field existed reads as that field's default.
+    """
+    try:
+        train_config = TrainConfig.from_json(train_config).to_json()
+    except (TypeError, ValueError, KeyError):
+        pass  # unreadable: compared as written, so it cannot match
     return {k: v for k, v in train_config.items() if k != "epochs"}
 
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from pddl_export.symbolic import code_str, codes_from_bits
 from symlearn.data.dataset import InteractionData, data_fingerprint, load_split
-from symlearn.learning.checkpoint import load_effect_model, stage_record
+from symlearn.learning.checkpoint import analysis_device, load_effect_model, stage_record
 from symlearn.provenance import atomic_write_bytes, atomic_write_json
 from symlearn.symbolic.transition_data import encode_crops
 from symlearn.world import LOCATIONS, N_LOCATIONS, OBJECT_SIZE, ObjectType
@@ -39,7 +39,7 @@ def picked_objects(data: InteractionData) -> np.ndarray:
 def analyse_symbols(run_dir: Path, data_dir: Path, symbol: str | None = None, min_count: int = 100) -> dict:
     """Write RUN/symbols.json (with config, seed, versions, input hashes), symbols.png and symbol_examples.png."""
     run_dir = Path(run_dir)
-    model, ck = load_effect_model(run_dir)
+    model, ck = load_effect_model(run_dir, device=analysis_device())
     bits = ck.config.bits
     data = load_split(Path(data_dir), "train")
     codes = encode_codes(model, data.pre_depth, data.pre_origin, data.mask)

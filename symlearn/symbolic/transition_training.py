@@ -15,7 +15,7 @@ from pathlib import Path
 import torch
 
 from symlearn.data.dataset import data_fingerprint, load_split
-from symlearn.learning.checkpoint import effect_model_sha256, load_effect_model
+from symlearn.learning.checkpoint import analysis_device, effect_model_sha256, load_effect_model
 from symlearn.learning.models import AttentiveDeepSym
 from pddl_export.files import finite_or_null
 from symlearn.provenance import atomic_write_json, versions
@@ -32,7 +32,7 @@ def train_transition(run_dir: Path, data_dir: Path, cfg: TransitionConfig, seed:
     """Train m(z) on the codes of RUN's effect model; writes RUN/transition.pt and RUN/transition_metrics.json."""
     run_dir, data_dir = Path(run_dir), Path(data_dir)
     t_start = time.perf_counter()
-    encoder, ck = load_effect_model(run_dir)
+    encoder, ck = load_effect_model(run_dir, device=analysis_device())
     cfg = dataclasses.replace(cfg, bits=ck.config.bits)
     fingerprint = data_fingerprint(data_dir)
     splits = encode_splits(encoder, data_dir, cfg.encode_batch_size)
