@@ -5,7 +5,8 @@ model never sees: type, the nearest of the 6 table locations, and its height lev
 object). Purity of a property: the share of objects whose code's most common value of that property is theirs.
 Determinism: the share of objects whose (type, location, level) group's most common code is theirs: 1.0 means
 the same arrangement always gets the same symbol. Also: how many codes change when every crop window is shifted
-by 1-2 pixels (placement jitter).
+by 1-2 pixels (placement jitter), and, where the run has m(z), how often it gets the held object's next code
+right, against how often the most common next code for the same (code, release location) is the observed one.
 
     python bench/symbol_purity.py --runs pretrained/quick-authors12k,RUN2 --data data/paper_a --out bench/results/symbol_purity.json
 """
@@ -23,7 +24,9 @@ import torch
 from pddl_export.symbolic import codes_from_bits
 from symlearn.data.dataset import load_split
 from symlearn.learning.checkpoint import effect_model_sha256, load_effect_model
-from symlearn.symbolic.transition_data import encode_crops
+from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, load_transition
+from symlearn.symbolic.transition_data import build_transition_data, encode_crops
+from symlearn.symbolic.transition_model import predict_bits
 from symlearn.world import LOCATIONS
 
 LEVEL_M = 0.05  # height step: a cube is 5 cm tall
@@ -58,6 +61,7 @@ def purity(run: Path, data_dir: Path, n_shift: int = 400) -> dict:
     for dr, dc in SHIFTS:
         c = encode_crops(model, data.pre_depth[sub], origin[sub] + np.float32([dr, dc]), data.mask[sub])
         shifted[f"{dr},{dc}"] = round(float((c != base).any(-1)[data.mask[sub]].mean()), 4)
+    held_next = _held_next_code(run, model, data) if (run / TRANSITION_FILE).exists() else None
     return {"run": str(run), "effect_model_sha256": effect_model_sha256(run), "objects": int(m.sum()),
             "distinct_codes": int(len(np.unique(codes))),
             "type_purity": majority_share(codes, typ), "location_purity": majority_share(codes, loc),
@@ -65,7 +69,23 @@ def purity(run: Path, data_dir: Path, n_shift: int = 400) -> dict:
             "arrangement_determinism": majority_share(arrangement, codes),
             "arrangement_groups": int(len(np.unique(arrangement))),
             "off_location_share": round(float((dist.min(-1)[m] > 0.05).mean()), 4),
-            "codes_changed_by_pixel_shift": shifted}
+            "codes_changed_by_pixel_shift": shifted, "held_next_code": held_next}
+
+
+def _held_next_code(run: Path, model, data) -> dict:
+    """m(z)'s accuracy on the held object's next code, and the ceiling a (code, release location) table reaches."""
+    td = build_transition_data(model, data)
+    net, _ = load_transition(run / TRANSITION_FILE)
+    pred = predict_bits(net, td.before, td.mask, td.action)
+    k = data.mask.shape[1]
+    held = (data.grasped[:, None] == np.arange(k)[None]) & data.mask
+    rows, cols = np.nonzero(held)
+    ok = (pred == td.after).all(-1)[rows, cols]
+    before = codes_from_bits(td.before.round())[rows, cols]
+    after = codes_from_bits(td.after.round())[rows, cols]
+    release = (data.action[rows] % len(LOCATIONS)).astype(np.int64)
+    return {"held_objects": int(len(rows)), "net_accuracy": round(float(ok.mean()), 4) if len(rows) else None,
+            "majority_share": majority_share(before * 10 + release, after)}
 
 
 def main(argv: list[str] | None = None) -> int:
