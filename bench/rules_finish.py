@@ -48,6 +48,7 @@ def main() -> None:
     ap.add_argument("--run", type=Path, required=True, help="run with best.pt, transition.pt and pddl/rules.json")
     ap.add_argument("--problems", required=True, help="comma-separated problem folders")
     ap.add_argument("--planners", default="rules-bfs,fast-downward-sas", help="rule-based planners to time")
+    ap.add_argument("--min-objects", type=int, default=1)
     ap.add_argument("--max-objects", type=int, default=5)
     ap.add_argument("--max-length", type=int, default=8, help="longest reference plan kept")
     ap.add_argument("--timeout", type=float, default=60.0, help="seconds per planner call")
@@ -58,12 +59,12 @@ def main() -> None:
     torch.set_num_threads(1)
     planners = [p for p in args.planners.split(",") if p]
     folders = [Path(p) for p in args.problems.split(",") if p]
-    problems = [(label, p) for label, p in select(folders, (1, args.max_objects), 0)
+    problems = [(label, p) for label, p in select(folders, (args.min_objects, args.max_objects), 0)
                 if p.generator_length <= args.max_length]
     t0 = time.perf_counter()
     records = time_planners(args.run, problems, planners, args.timeout, float("inf"))
     result = {"run": str(args.run), "problems": [str(d) for d in folders], "n": len(records),
-              "max_objects": args.max_objects, "max_length": args.max_length, "timeout_s": args.timeout,
+              "min_objects": args.min_objects, "max_objects": args.max_objects, "max_length": args.max_length, "timeout_s": args.timeout,
               "wall_time_s": round(time.perf_counter() - t0, 1), "date": time.strftime("%Y-%m-%d"),
               "machine": {"processor": platform.processor() or platform.machine(), "cpus": os.cpu_count(),
                           "python": platform.python_version()},
