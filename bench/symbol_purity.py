@@ -23,6 +23,7 @@ import torch
 
 from pddl_export.symbolic import codes_from_bits
 from symlearn.data.dataset import load_split
+from symlearn.data.statistics import held_mask
 from symlearn.learning.checkpoint import effect_model_sha256, load_effect_model
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, load_transition
 from symlearn.symbolic.transition_data import build_transition_data, encode_crops
@@ -77,8 +78,7 @@ def _held_next_code(run: Path, model, data) -> dict:
     td = build_transition_data(model, data)
     net, _ = load_transition(run / TRANSITION_FILE)
     pred = predict_bits(net, td.before, td.mask, td.action)
-    k = data.mask.shape[1]
-    held = (data.grasped[:, None] == np.arange(k)[None]) & data.mask
+    held = held_mask(data) & data.mask
     rows, cols = np.nonzero(held)
     ok = (pred == td.after).all(-1)[rows, cols]
     before = codes_from_bits(td.before.round())[rows, cols]

@@ -31,11 +31,11 @@ from pddl_export.rules import Rule, RuleSet
 from pddl_export.symbolic import SymbolicGoal
 
 
-def reachable_codes(rules: RuleSet, code: int) -> frozenset[int]:
-    """Every code an object can take from `code`, following rules and ignoring their contexts."""
+def reachable_codes(rules: RuleSet, codes: Sequence[int]) -> list[frozenset[int]]:
+    """Per start code, every code an object can take from it, following rules and ignoring their contexts."""
     graph = nx.DiGraph()
     graph.add_edges_from({(r.code_from, r.code_to) for r in rules.rules})
-    return frozenset(nx.descendants(graph, code) | {code}) if code in graph else frozenset({code})
+    return [frozenset(nx.descendants(graph, c) | {c}) if c in graph else frozenset({c}) for c in map(int, codes)]
 
 
 class _Others:
@@ -76,9 +76,8 @@ def pair_reaches_goal(rules: RuleSet, start: Sequence[int], goal: SymbolicGoal, 
     if by_key is None:
         by_key = _rules_by_key(rules)
     if reach is None:
-        reach = [reachable_codes(rules, int(c)) for c in start]
-    rest = [reach[k] for k in range(len(start)) if k not in (i, j)]
-    others_i, others_j = _Others(rest), _Others(rest)  # the same objects stand outside for i and for j
+        reach = reachable_codes(rules, start)
+    others = _Others([reach[k] for k in range(len(start)) if k not in (i, j)])  # outside the pair, for i and for j
     gi, gj = goal.codes[i], goal.codes[j]
 
     def done(ci: int, cj: int) -> bool:
@@ -92,7 +91,7 @@ def pair_reaches_goal(rules: RuleSet, start: Sequence[int], goal: SymbolicGoal, 
         if done(ci, cj):
             return True
         for a in actions:
-            for nxt in itertools.product(_next_codes(by_key, a, ci, cj, others_i), _next_codes(by_key, a, cj, ci, others_j)):
+            for nxt in itertools.product(_next_codes(by_key, a, ci, cj, others), _next_codes(by_key, a, cj, ci, others)):
                 if nxt not in seen:
                     seen.add(nxt)
                     queue.append(nxt)
@@ -111,7 +110,7 @@ def pair_unreachable(rules: RuleSet, start: Sequence[int], goal: SymbolicGoal) -
     if len(goal.codes) != len(start):
         raise ValueError(f"start codes of {len(start)} objects and a goal of {len(goal.codes)} do not match")
     by_key = _rules_by_key(rules)
-    reach = [reachable_codes(rules, int(c)) for c in start]
+    reach = reachable_codes(rules, start)
     for i, j in itertools.combinations(range(len(start)), 2):
         if goal.codes[i] is None and goal.codes[j] is None:
             continue

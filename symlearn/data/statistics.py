@@ -22,19 +22,20 @@ RIDE_MIN_M = 0.05  # a rider moves with the carried object: 5 cm is far above se
 STACK_MIN_M = 0.02  # an object on another one starts at least its support's height (>= 5 cm) higher
 
 
+def held_mask(data: InteractionData) -> np.ndarray:
+    """(N, K) bool: the object the suction tool held in each sample (none where nothing was grasped)."""
+    return data.grasped[:, None] == np.arange(data.effect.shape[1])[None, :]
+
+
 def rider_mask(data: InteractionData) -> np.ndarray:
     """(N, K) bool: real objects that moved >= 5 cm horizontally while another object was held."""
-    k = data.effect.shape[1]
-    held = data.grasped[:, None] == np.arange(k)[None, :]
     moved = np.linalg.norm(data.effect[..., :2], axis=-1) >= RIDE_MIN_M
-    return data.mask & ~held & moved & (data.grasped[:, None] >= 0)
+    return data.mask & ~held_mask(data) & moved & (data.grasped[:, None] >= 0)
 
 
 def still_mask(data: InteractionData) -> np.ndarray:
     """(N, K) bool: real objects that moved less than STILL_M and were not held: their arrangement is unchanged."""
-    k = data.effect.shape[1]
-    held = data.grasped[:, None] == np.arange(k)[None, :]
-    return data.mask & ~held & (np.linalg.norm(data.effect, axis=-1) < STILL_M)
+    return data.mask & ~held_mask(data) & (np.linalg.norm(data.effect, axis=-1) < STILL_M)
 
 
 def stacked_mask(data: InteractionData) -> np.ndarray:

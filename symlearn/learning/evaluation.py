@@ -42,9 +42,9 @@ def code_stability(model: AttentiveDeepSym, split: SplitTensors, still: np.ndarr
     """Share of still objects ((N, K) bool) whose code is unchanged by the action, and of scenes where all are."""
     model.eval()
     same = []
+    device = next(model.parameters()).device
     for i in range(0, len(split), batch_size):
         idx = torch.arange(i, min(i + batch_size, len(split)))
-        device = next(model.parameters()).device
         crops, mask, _, _ = split.batch(idx)
         before, _ = model.encode(crops.to(device), mask.to(device))
         after, _ = model.encode(split.post_crops(idx).to(device), mask.to(device))
@@ -82,12 +82,11 @@ def evaluate(run_dir: Path, data_dir: Path, baseline_run: Path | None = None) ->
     ablations = {}
     if baseline_run is not None:
         base, bck = load_effect_model(Path(baseline_run), device=analysis_device())
-        tb = to_tensors(test, bck.effect_mean, bck.effect_std)
+        tb = to_tensors(test, bck.effect_mean, bck.effect_std, with_post=True)
         pb_ = predict_effects(base, tb).numpy() * bck.effect_std + bck.effect_mean
         ablations["no_attention"] = {"run": str(baseline_run), "effect_model_sha256": effect_model_sha256(baseline_run),
                                      **_mae_rows(pb_, truth, mask, nobj, riders),
-                                     "code_stability": code_stability(base, to_tensors(test, bck.effect_mean, bck.effect_std,
-                                                                                       with_post=True), still)}
+                                     "code_stability": code_stability(base, tb, still)}
     ablations["mean_effect"] = _mae_rows(np.broadcast_to(mean, truth.shape), truth, mask, nobj, riders)
     result["ablations"] = ablations
     atomic_write_json(run_dir / "eval.json", result)

@@ -132,8 +132,8 @@ def _config_problem(c: TrainConfig) -> str | None:
 class SplitTensors:
     """One split as tensors: float16 depth, crop origins, mask, actions, normalized effects.
 
-    With post=True in to_tensors the post-state crops come along (for the joint next-code loss),
-    and `weight` holds each object's loss weight.
+    With with_post=True in to_tensors the post-state crops and the still-object mask come along (for
+    the next-code and stability losses); `weight` holds each object's loss weight when not all are 1.
     """
 
     depth: torch.Tensor  # (N, K, S, S) float16
