@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import statistics
 import sys
 from pathlib import Path
 
 SUMMARY_STEPS = ("1", "3", "5", "8")
+SEEDED = re.compile(r"(.+)_s(\d+)")  # a run of a seed series: <prefix>_s<seed>
 
 
 def _read(path: Path) -> dict | None:
@@ -85,7 +87,7 @@ def markdown(rows: list[dict]) -> str:
 
 def seed_stats(rows: list[dict], prefix: str) -> dict:
     """Mean and std over the runs named prefix_s<seed> of effect MAE, rider MAE, stability and rollout at 5."""
-    sel = [r for r in rows if r["run"].startswith(prefix + "_s") and r["run"][len(prefix) + 2:].isdigit()]
+    sel = [r for r in rows if (m := SEEDED.fullmatch(r["run"])) and m.group(1) == prefix]
 
     def ms(values):
         values = [v for v in values if v is not None]
@@ -114,7 +116,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: no run folders (with config.json) in {args.runs}", file=sys.stderr)
         return 2
     rows = [run_summary(r) for r in runs]
-    prefixes = sorted({r["run"].rsplit("_s", 1)[0] for r in rows if "_s" in r["run"]})
+    prefixes = sorted({m.group(1) for r in rows if (m := SEEDED.fullmatch(r["run"]))})
     result = {"runs": rows, "over_seeds": {p: seed_stats(rows, p) for p in prefixes}}
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
