@@ -7,9 +7,11 @@ expanded in batches: "astar" is the generic A* (search.astar), popping `batch` s
 successor call, on the summed code distances (code_distances); "bfs" is search.batched_bfs,
 whose plans have optimal length and which proves a goal unreachable when it exhausts the
 reachable states (max_states bounds its memory: about 60 bytes per state). Both skip states
-that code_distances proves dead ends. With pair_proof, both first ask the pair projections
-(search.rule_abstraction) whether the goal is out of reach: a proof in under a second where one
-exists, but on the 5-object depth problems that breadth-first search cannot finish it found none.
+that code_distances proves dead ends and states where two objects the goal tells apart share a
+code, and search one state per permutation of objects with the same goal (search.rule_symmetry).
+With pair_proof, both first ask the pair projections (search.rule_abstraction) whether the goal
+is out of reach: a proof in under a second where one exists, but on the 5-object depth problems
+that breadth-first search could not finish it found none.
 
     >>> from pddl_export.rules import Rule, RuleSet
     >>> rs = RuleSet(bits=2, vocabulary=(1, 2, 3), max_objects=2, n_rules_before_generalization=1,
@@ -23,6 +25,7 @@ exists, but on the 5-object depth problems that breadth-first search cannot fini
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import Sequence
@@ -37,6 +40,7 @@ from search.astar import astar, outcome_result
 from search.batched_bfs import breadth_first
 from search.result import PlanResult, PlanStatus
 from search.rule_abstraction import pair_unreachable
+from search.rule_symmetry import canonical, coincident, goal_classes, replay, split_pairs
 
 METHODS = ("astar", "bfs")
 State = tuple[int, ...]
@@ -76,12 +80,16 @@ def plan_rules(
     max_states: int = 30_000_000,
     planner_name: str = "",
     pair_proof: bool = False,
+    symmetry: bool = True,
 ) -> PlanResult:
     """Plan from start codes (K,) to goal under the rules by `method` ("astar" or "bfs").
 
     batch: states per successor call (A*); weight > 1 scales the heuristic (weighted A*: fewer
     expansions, longer plans). Pass a RuleSuccessors to reuse one compilation across calls.
     pair_proof: first try to prove the goal out of reach on pairs of objects (up to ~1 s on 5 objects).
+    symmetry: search one state per permutation of objects with the same goal (search.rule_symmetry);
+    the plan's predicted states are then replayed on the real objects. Objects that share a code
+    while the goal asks different codes of them end the search (UNSOLVABLE) or prune the state.
     """
     t0 = time.perf_counter()
     if method not in METHODS:
@@ -92,14 +100,26 @@ def plan_rules(
         raise ValueError(f"start codes {start_arr.shape} and goal of {len(goal.codes)} objects do not match")
     if start_arr.size and (start_arr.min() < 0 or start_arr.max() >= 1 << succ.bits):
         raise ValueError(f"start codes {start_arr.tolist()} do not fit in {succ.bits} bits")
-    proof = pair_unreachable(succ.rules, start_arr.tolist(), goal) if pair_proof else None
+    pairs = split_pairs(goal.codes)
+    together = [(int(i), int(j)) for i, j in pairs if start_arr[i] == start_arr[j]]
+    proof = ("coincidence", together[0]) if together else None
+    if proof is None and pair_proof:
+        pair = pair_unreachable(succ.rules, start_arr.tolist(), goal)
+        proof = ("pair", pair) if pair is not None else None
     if proof is not None:
+        kind, (i, j) = proof
+        why = ("hold the same code, which the rules move alike, but have different goal codes" if kind == "coincidence"
+               else "cannot reach their goal codes together (pair projection of the rules)")
         return PlanResult(planner=planner_name or f"rules-{method}", status=PlanStatus.UNSOLVABLE, plan=(),
                           predicted_states=(), expansions=0,
                           planning_time_s=time.perf_counter() - t0,
-                          message=f"objects {proof[0]} and {proof[1]} cannot reach their goal codes together "
-                                  "(pair projection of the rules)",
-                          extra={"generated": 0, "batch": batch if method == "astar" else 0, "proof": "pair"})
+                          message=f"objects {i} and {j} {why}",
+                          extra={"generated": 0, "batch": batch if method == "astar" else 0, "proof": kind})
+    classes = goal_classes(goal.codes) if symmetry else ()
+
+    def step(states: np.ndarray) -> np.ndarray:
+        return canonical(succ(states), classes)
+
     fixed = [(i, c) for i, c in enumerate(goal.codes) if c is not None]
     idx = np.array([i for i, _ in fixed], np.int64)
     val = np.array([c for _, c in fixed], np.int64)
@@ -107,27 +127,32 @@ def plan_rules(
     dist = code_distances(succ.rules, goal)
     objects = np.arange(len(start_arr))
     dist_rows = dist.tolist()
+    pair_rows = pairs.tolist()
+    root = canonical(start_arr, classes)
 
     def heuristic(s: State) -> float:
         h = sum(row[c] for row, c in zip(dist_rows, s))
-        return math.inf if h >= UNREACHABLE else weight * h
+        return math.inf if h >= UNREACHABLE or any(s[i] == s[j] for i, j in pair_rows) else weight * h
 
     if method == "bfs":
-        out = breadth_first(start_arr, succ, succ.actions, lambda s: np.all(s[:, idx] == val, axis=1),
+        out = breadth_first(root, step, succ.actions, lambda s: np.all(s[:, idx] == val, axis=1),
                             bits=succ.bits, timeout_s=timeout_s, max_states=max_states,
-                            dead_end=lambda s: (dist[objects, s] >= UNREACHABLE).any(axis=1))
+                            dead_end=lambda s: (dist[objects, s] >= UNREACHABLE).any(axis=1) | coincident(s, pairs))
         limit = f"max_states={max_states}"
     else:
         def successors_many(states: list[State]) -> list[list[tuple[int, State, float]]]:
-            nxt = succ(np.array(states, np.int64).reshape(len(states), len(start_arr)))  # (B, A, K)
+            nxt = step(np.array(states, np.int64).reshape(len(states), len(start_arr)))  # (B, A, K)
             rows = nxt.tolist()
             return [[(actions[a], t, 1.0) for a, r in enumerate(per) if (t := tuple(r)) != s]
                     for s, per in zip(states, rows)]
 
-        out = astar(tuple(start_arr.tolist()), lambda s: all(s[i] == c for i, c in fixed),
+        out = astar(tuple(root.tolist()), lambda s: all(s[i] == c for i, c in fixed),
                     lambda s: successors_many([s])[0], heuristic,
                     max_expansions=max_expansions, timeout_s=timeout_s, batch=batch,
                     successors_many=successors_many)
         limit = f"max_expansions={max_expansions}"
+    if classes and out.status is PlanStatus.SOLVED:  # the search saw sorted states: the real objects' path
+        out = dataclasses.replace(out, states=replay(succ, succ.actions, start_arr, out.actions))
     return outcome_result(out, planner_name or f"rules-{method}", t0, timeout_s, limit,
-                          f"the {out.generated} states the rules reach", {"batch": batch if method == "astar" else 0})
+                          f"the {out.generated} states the rules reach"
+                          + (" (one per orbit of objects with the same goal)" if classes else ""), {"batch": batch if method == "astar" else 0})
