@@ -17,8 +17,8 @@ from search.result import PlanResult, PlanStatus
 from symlearn.planning import benchmark as bench
 from symlearn.learning.checkpoint import save_checkpoint
 from symlearn.cli.planning import add_planning_commands
-from symlearn.planning.execution import (ExecutionConfig, FailureStage, ObservedTransitions, ProblemRun, execute_plan,
-                                        failure_causes, run_problem)
+from symlearn.planning.execution import (FAILURE_CAUSES, ExecutionConfig, FailureStage, ObservedTransitions, ProblemRun,
+                                        execute_plan, failure_cause, failure_causes, run_problem)
 from symlearn.planning.planners import PLANNERS, PlannerContext, make_planner
 from pddl_export.rules import Rule, RuleSet
 from pddl_export.sas_writer import SASEncoder
@@ -263,6 +263,14 @@ def test_no_plan_stages(sim, encoder, run_dir, problems, status, stage):
     assert row.failure_cause == stage and row.attribution["first_departure_step"] is None
     assert row.attribution["rules_net_disagree"] is None and row.attribution["replans"] == 0
     assert not row.success and row.max_distance_m is None and row.status == status.value
+
+
+def test_a_proof_from_shared_start_codes_is_its_own_cause():
+    proved = PlanResult(planner="rules-bfs", status=PlanStatus.UNSOLVABLE, plan=(), predicted_states=(),
+                        expansions=0, planning_time_s=0.0, extra={"proof": "coincidence"})
+    exhausted = dataclasses.replace(proved, extra={})
+    assert failure_cause(proved, None) == "shared_code" and failure_cause(exhausted, None) == "no_plan"
+    assert "shared_code" in FAILURE_CAUSES
 
 
 def test_raising_planner_becomes_an_error_row(sim, encoder, run_dir, problems):

@@ -262,18 +262,22 @@ def failure_stage(plan: PlanResult, ex: ExecutionResult | None) -> FailureStage 
     return FailureStage.GOAL_MISMATCH if ex.on_prediction else FailureStage.EXECUTION
 
 
-FAILURE_CAUSES = ("no_plan", "timeout", "off_table", "symbol_aliasing", "departure")
+FAILURE_CAUSES = ("no_plan", "shared_code", "timeout", "off_table", "symbol_aliasing", "departure")
 
 
 def failure_cause(plan: PlanResult, ex: ExecutionResult | None) -> str | None:
     """The one cause of a failed run (FAILURE_CAUSES), None on success.
 
-    No plan or a timeout; else an object off the table; else aliasing (the final codes meet the
-    goal codes, the poses do not); else a departure: the codes left the prediction (or, for a plan
-    without predictions, ended away from the goal codes it promised) and did not come back.
+    No plan, split off where the planner proved it from two objects the goal tells apart sharing a
+    start code (aliasing between objects: the rules move them alike, search.rule_symmetry), or a
+    timeout; else an object off the table; else aliasing (the final codes meet the goal codes, the
+    poses do not); else a departure: the codes left the prediction (or, for a plan without
+    predictions, ended away from the goal codes it promised) and did not come back.
     """
     if not plan.found:
-        return "timeout" if plan.status is PlanStatus.TIMEOUT else "no_plan"
+        if plan.status is PlanStatus.TIMEOUT:
+            return "timeout"
+        return "shared_code" if plan.extra.get("proof") == "coincidence" else "no_plan"
     if ex is None or ex.success:
         return None
     if ex.off_table:
