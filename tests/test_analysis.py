@@ -91,3 +91,47 @@ def test_picked_objects_marks_the_object_under_the_pick_location(run):
     # an object the suction tool held was, by construction, under the pick location
     held = d.grasped >= 0
     assert p[np.flatnonzero(held), d.grasped[held]].mean() > 0.95
+
+
+def test_code_stability_counts_still_objects_and_scenes_with_a_shared_code():
+    import torch
+
+    from symlearn.learning.evaluation import code_stability
+
+    # codes before (by scene, object) and after; scene 1 has one object, scene 3 a padded third slot
+    before = torch.tensor([[[0, 1], [0, 1], [1, 1]], [[1, 0], [0, 0], [0, 0]], [[0, 0], [1, 0], [0, 1]],
+                           [[1, 1], [0, 1], [1, 1]]], dtype=torch.float32)
+    after = before.clone()
+    after[2, 1] = torch.tensor([0, 1.0])  # a still object whose code changed
+    mask = torch.tensor([[True, True, True], [True, False, False], [True, True, True], [True, True, False]])
+
+    class Split:
+        def __len__(self):
+            return 4
+
+        def batch(self, idx):
+            return before[idx], mask[idx], None, None  # the stub encoder reads the codes from the "crops"
+
+        def post_crops(self, idx):
+            return after[idx]
+
+    class Model(torch.nn.Module):
+        def __init__(self):
+            super().__init__()
+            self.w = torch.nn.Parameter(torch.zeros(1))
+
+        def encode(self, crops, m):
+            return crops, None
+
+    still = mask.numpy().copy()
+    still[0, 2] = False
+    out = code_stability(Model(), Split(), still, batch_size=3)  # two batches
+    assert out["still_objects"] == int(still.sum()) == 8
+    assert out["code_unchanged"] == pytest.approx(7 / 8, abs=1e-4)
+    assert out["scenes_all_unchanged"] == pytest.approx(3 / 4)
+    # scenes of 2+ objects: 0 (objects 0 and 1 share a code), 2 (all apart), 3 (padding equals object 0: ignored)
+    assert out["multi_object_scenes"] == 3 and out["scenes_with_shared_code"] == pytest.approx(1 / 3, abs=1e-4)
+    assert out["shared_code_by_objects"] == {"2": 0.0, "3": 0.5}
+    assert "shared codes: in 0.333 of 3 scenes" in format_table({
+        "by_objects": {}, "effect_mae_mm": {"x": 1, "y": 1, "z": 1}, "ablations": {},
+        "mean_abs_effect_mm": {"x": 1, "y": 1, "z": 1}, "code_stability": out})

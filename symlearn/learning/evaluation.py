@@ -6,7 +6,8 @@ axis in millimetres over real objects, overall, by number of objects in the scen
 (objects that moved because they stood on a carried one; `symlearn.data.statistics.rider_mask`),
 the relational effect the attention is for. Symbol stability: the share of still objects (moved less
 than 1 cm, not held) whose code is the same before and after the action; a code that changes
-while its object stays put makes the symbolic state depend on more than the arrangement.
+while its object stays put makes the symbolic state depend on more than the arrangement. Shared
+codes: the share of scenes of 2+ objects where two objects hold one code (aliasing between objects).
 """
 from __future__ import annotations
 
@@ -39,9 +40,13 @@ def _mae_rows(pred_m: np.ndarray, true_m: np.ndarray, mask: np.ndarray, n_object
 
 @torch.no_grad()
 def code_stability(model: AttentiveDeepSym, split: SplitTensors, still: np.ndarray, batch_size: int = 256) -> dict:
-    """Share of still objects ((N, K) bool) whose code is unchanged by the action, and of scenes where all are."""
+    """Share of still objects ((N, K) bool) whose code is unchanged by the action, and of scenes where all are.
+
+    Also the share of scenes of 2+ objects where two objects hold the same code: the rules and the
+    transition network move such objects alike, so no plan over these symbols parts them again.
+    """
     model.eval()
-    same = []
+    same, shared, sizes = [], [], []
     device = next(model.parameters()).device
     for i in range(0, len(split), batch_size):
         idx = torch.arange(i, min(i + batch_size, len(split)))
@@ -49,10 +54,20 @@ def code_stability(model: AttentiveDeepSym, split: SplitTensors, still: np.ndarr
         before, _ = model.encode(crops.to(device), mask.to(device))
         after, _ = model.encode(split.post_crops(idx).to(device), mask.to(device))
         same.append((before == after).all(-1).cpu().numpy())
+        both = mask[:, :, None] & mask[:, None, :] & ~torch.eye(mask.shape[1], dtype=torch.bool)  # (B, K, K) pairs
+        equal = (before[:, :, None] == before[:, None, :]).all(-1).cpu() & both
+        shared.append(equal.flatten(1).any(1).numpy())
+        sizes.append(mask.sum(1).numpy())
     same = np.concatenate(same) if same else np.zeros(still.shape, bool)
+    shared, sizes = (np.concatenate(x) if x else np.zeros(0) for x in (shared, sizes))
+    multi = sizes > 1
     n = int(still.sum())
     return {"still_objects": n, "code_unchanged": round(float(same[still].mean()), 4) if n else None,
-            "scenes_all_unchanged": round(float((same | ~still).all(-1).mean()), 4) if len(same) else None}
+            "scenes_all_unchanged": round(float((same | ~still).all(-1).mean()), 4) if len(same) else None,
+            "multi_object_scenes": int(multi.sum()),
+            "scenes_with_shared_code": round(float(shared[multi].mean()), 4) if multi.any() else None,
+            "shared_code_by_objects": {str(k): round(float(shared[sizes == k].mean()), 4)
+                                       for k in sorted(set(sizes[multi].astype(int).tolist()))}}
 
 
 def evaluate(run_dir: Path, data_dir: Path, baseline_run: Path | None = None) -> dict:
@@ -118,4 +133,8 @@ def format_table(result: dict) -> str:
     if cs and cs["code_unchanged"] is not None:
         lines.append(f"symbol stability: {cs['code_unchanged']:.3f} of {cs['still_objects']} still objects keep their "
                      f"code; {cs['scenes_all_unchanged']:.3f} of scenes keep all of them")
+    if cs and cs.get("scenes_with_shared_code") is not None:
+        lines.append(f"shared codes: in {cs['scenes_with_shared_code']:.3f} of {cs['multi_object_scenes']} scenes of 2+ "
+                     "objects two objects hold the same code (no plan over the symbols can part them); by objects: "
+                     + ", ".join(f"{k}: {v:.3f}" for k, v in cs["shared_code_by_objects"].items()))
     return "\n".join(lines)
