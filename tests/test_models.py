@@ -125,6 +125,23 @@ def test_masked_mse_weights_objects():
     assert float(masked_mse(pred, target, mask, torch.tensor([[1.0, 3.0]]))) == pytest.approx((1 + 12) / 2)
 
 
+def test_distinct_loss_asks_one_decisive_differing_bit_per_pair_of_real_objects():
+    from symlearn.learning.models import code_distinct_loss
+
+    mask = torch.tensor([[True, True, True, False]])
+    apart = torch.tensor([[[3.0, 1.0], [-2.5, 1.0], [2.0, -4.0], [3.0, 1.0]]])  # slot 3 is padding, equal to object 0
+    # pairs: (0, 1) bit 0 separated by min(3, 2.5); (0, 2) bit 1 by min(1, 4) = 1; (1, 2) bit 0 by 2
+    assert float(code_distinct_loss(apart, mask, 1.0)) == 0.0
+    assert float(code_distinct_loss(apart, mask, 2.0)) == pytest.approx(1.0 / 3, rel=1e-6)  # pair (0, 2) pays 1
+    same = torch.tensor([[[1.0, -1.0], [1.0, -1.0], [-3.0, 2.0], [0.0, 0.0]]])  # objects 0 and 1 share their code
+    # pair (0, 1): best bit separates by min(1, -1) = -1 -> pays 1 + 1; (0, 2) and (1, 2) by min(1, 2) = 1 on bit 1
+    assert float(code_distinct_loss(same, mask, 1.0)) == pytest.approx(2.0 / 3, rel=1e-6)
+    logits = same.clone().requires_grad_(True)
+    code_distinct_loss(logits, mask, 1.0).backward()
+    assert logits.grad[0, 3].abs().sum() == 0  # padding is never pushed
+    assert logits.grad[0, 0].abs().sum() > 0 and logits.grad[0, 1].abs().sum() > 0
+
+
 def test_stability_loss_is_zero_only_for_agreeing_decisive_bits_of_still_objects():
     from symlearn.learning.models import code_stability_loss
 

@@ -126,13 +126,14 @@ def test_rider_weights_mark_exactly_the_riders(tiny_data):
 
 
 def test_levers_train_and_are_recorded(data, tmp_path):
-    cfg = TrainConfig.from_preset("quick", **TINY, rider_weight=4.0, dynamics_weight=0.5, stability_weight=1.0)
+    cfg = TrainConfig.from_preset("quick", **TINY, rider_weight=4.0, dynamics_weight=0.5, stability_weight=1.0,
+                                  distinct_weight=0.5)
     assert cfg.model.dynamics_head  # a positive dynamics weight switches the head on
     out = train(data, tmp_path / "lev", cfg, show_progress=False)
     assert len(out["history"]) == 2 and np.isfinite(out["history"][-1]["train_loss"])
     saved = json.loads((tmp_path / "lev" / "config.json").read_text())["train_config"]
     assert saved["rider_weight"] == 4.0 and saved["dynamics_weight"] == 0.5 and saved["model"]["dynamics_head"]
-    assert saved["stability_weight"] == 1.0
+    assert saved["stability_weight"] == 1.0 and saved["distinct_weight"] == 0.5
     model, _ = load_effect_model(tmp_path / "lev")
     assert model.dynamics is not None
 
@@ -146,6 +147,10 @@ def test_lever_settings_refused():
         TrainConfig(dynamics_weight=1.0)
     with pytest.raises(ValueError, match="stability_margin"):
         TrainConfig.from_preset("quick", stability_weight=1.0, stability_margin=0.0)
+    with pytest.raises(ValueError, match="distinct_weight"):
+        TrainConfig.from_preset("quick", distinct_weight=float("nan"))
+    with pytest.raises(ValueError, match="distinct_margin"):
+        TrainConfig.from_preset("quick", distinct_weight=1.0, distinct_margin=-1.0)
 
 
 def test_config_from_before_the_levers_still_resumes():
@@ -153,7 +158,8 @@ def test_config_from_before_the_levers_still_resumes():
 
     cfg = TrainConfig.from_preset("quick", **TINY)
     old = cfg.to_json()
-    for key in ("rider_weight", "dynamics_weight", "stability_weight", "stability_margin"):
+    for key in ("rider_weight", "dynamics_weight", "stability_weight", "stability_margin", "distinct_weight",
+                "distinct_margin"):
         del old[key]
     del old["model"]["dynamics_head"]
     assert _resumable(old) == _resumable(cfg.to_json())

@@ -74,7 +74,9 @@ def cmd_train(args: argparse.Namespace) -> int:
                                    max_train_samples=args.max_train_samples, rider_weight=args.rider_weight,
                                    dynamics_weight=args.dynamics_weight,
                                    stability_weight=args.stability_weight,
-                                   stability_margin=args.stability_margin).items() if v is not None}
+                                   stability_margin=args.stability_margin,
+                                   distinct_weight=args.distinct_weight,
+                                   distinct_margin=args.distinct_margin).items() if v is not None}
     if args.no_attention:
         over["attention"] = False
     if args.constant_lr:
@@ -191,6 +193,11 @@ def add_train_command(sub) -> None:
                    help="weight of a loss keeping the codes of objects an action left in place unchanged (default 0)")
     t.add_argument("--stability-margin", type=positive_finite_float,
                    help="logit distance from 0 the stability loss asks of each bit (default 1)")
+    t.add_argument("--distinct-weight", type=non_negative_finite_float,
+                   help="weight of a loss giving every two objects of a scene a code bit on which they differ "
+                        "(objects sharing a code are moved alike by the rules; default 0)")
+    t.add_argument("--distinct-margin", type=positive_finite_float,
+                   help="logit distance from 0, on opposite sides, the distinct loss asks of that bit (default 1)")
     t.add_argument("--constant-lr", action="store_true", help="no cosine decay of the learning rate")
     t.add_argument("--no-bf16", action="store_true", help="plain float32 (bf16 autocast is the default)")
     t.add_argument("--compile", action="store_true", help="torch.compile the model")

@@ -257,3 +257,21 @@ def code_stability_loss(pre_logits: torch.Tensor, post_logits: torch.Tensor, sti
     per_bit = F.relu(margin - side * pre_logits) + F.relu(margin - side * post_logits)  # (B, K, bits)
     m = still[..., None].to(per_bit.dtype)
     return (per_bit * m).sum() / (m.sum() * pre_logits.shape[-1]).clamp_min(1.0)
+
+
+def code_distinct_loss(logits: torch.Tensor, mask: torch.Tensor, margin: float = 1.0) -> torch.Tensor:
+    """Hinge that gives every two real objects of a scene a bit on which their codes differ by a margin.
+
+    Objects holding one code are moved alike by the rules and by the object-symmetric transition
+    network, so no plan parts them again. For a pair (i, j) and bit b, the separation is how far
+    both logits sit on opposite sides of 0 (min(s * l_ib, -s * l_jb), s the sign of l_ib - l_jb);
+    the pair's best bit must reach `margin`. Mean over the pairs of real objects ((B, K) mask).
+    """
+    li, lj = logits[:, :, None, :], logits[:, None, :, :]  # (B, K, 1, bits), (B, 1, K, bits)
+    side = torch.sign(li - lj).detach()
+    side = torch.where(side == 0, torch.ones_like(side), side)
+    separation = torch.minimum(side * li, -side * lj).amax(-1)  # (B, K, K): the pair's best-separated bit
+    k = mask.shape[1]
+    pairs = mask[:, :, None] & mask[:, None, :] & torch.triu(torch.ones(k, k, dtype=torch.bool, device=mask.device), 1)
+    per_pair = F.relu(margin - separation) * pairs.to(separation.dtype)
+    return per_pair.sum() / pairs.sum().clamp_min(1)

@@ -26,8 +26,8 @@ from symlearn.learning.checkpoint import load_checkpoint, load_weights, save_che
 from symlearn.data.dataset import InteractionData, data_fingerprint, load_split
 from symlearn.data.model_input import model_inputs
 from symlearn.data.statistics import rider_mask, still_mask
-from symlearn.learning.models import (AttentiveDeepSym, ModelConfig, code_prediction_loss, code_stability_loss,
-                                     masked_mse)
+from symlearn.learning.models import (AttentiveDeepSym, ModelConfig, code_distinct_loss, code_prediction_loss,
+                                      code_stability_loss, masked_mse)
 from symlearn.provenance import atomic_write_json, versions
 
 
@@ -55,6 +55,8 @@ class TrainConfig:
     dynamics_weight: float = 0.0  # weight of the joint next-code loss (needs model.dynamics_head)
     stability_weight: float = 0.0  # weight of the hinge keeping still objects' codes unchanged by an action
     stability_margin: float = 1.0  # logit distance from 0 the hinge asks of every bit of a still object
+    distinct_weight: float = 0.0  # weight of the hinge giving every two objects of a scene a differing code bit
+    distinct_margin: float = 1.0  # logit distance from 0, on opposite sides, the hinge asks of that bit
 
     @property
     def uses_post_crops(self) -> bool:
@@ -120,6 +122,10 @@ def _config_problem(c: TrainConfig) -> str | None:
          f"stability_weight={c.stability_weight!r} must be finite and >= 0"),
         (_is_real(c.stability_margin) and c.stability_margin > 0,
          f"stability_margin={c.stability_margin!r} must be finite and > 0"),
+        (_is_real(c.distinct_weight) and c.distinct_weight >= 0,
+         f"distinct_weight={c.distinct_weight!r} must be finite and >= 0"),
+        (_is_real(c.distinct_margin) and c.distinct_margin > 0,
+         f"distinct_margin={c.distinct_margin!r} must be finite and > 0"),
         (c.dynamics_weight == 0 or c.model.dynamics_head,
          f"dynamics_weight={c.dynamics_weight!r} needs a model with dynamics_head=True"),
         (c.max_train_samples is None or (_is_int(c.max_train_samples) and c.max_train_samples >= 1),
@@ -388,6 +394,8 @@ def _train_epoch(loop: _Loop, tr: SplitTensors, epoch: int) -> tuple[float, int,
             still = tr.still[idx.to(tr.still.device)].to(loop.device) & mask
             loss = loss + cfg.stability_weight * code_stability_loss(out.logits.float(), out.post_logits.float(), still,
                                                                      cfg.stability_margin)
+        if cfg.distinct_weight > 0:
+            loss = loss + cfg.distinct_weight * code_distinct_loss(out.logits.float(), mask, cfg.distinct_margin)
         if not torch.isfinite(loss):
             raise TrainingError(f"loss became {loss.item()} at epoch {epoch + 1}, step {b + 1}; "
                                 "lower the learning rate or check the data")
