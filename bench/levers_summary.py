@@ -36,7 +36,7 @@ def run_summary(run: Path) -> dict:
     return {
         "run": run.name, "preset": cfg.get("preset"), "seed": cfg.get("seed"),
         "attention": cfg.get("model", {}).get("attention"),
-        "levers": {k: cfg.get(k) for k in ("rider_weight", "dynamics_weight", "stability_weight")},
+        "levers": {k: cfg.get(k) for k in ("rider_weight", "dynamics_weight", "stability_weight", "distinct_weight")},
         "epochs_done": len(metrics.get("history", [])), "epochs": cfg.get("epochs"),
         "effect_mae_mm": (ev or {}).get("effect_mae_mm"),
         "rider_mae_mm": ((ev or {}).get("riders") or {}).get("effect_mae_mm"),
