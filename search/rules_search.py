@@ -88,8 +88,8 @@ def plan_rules(
     expansions, longer plans). Pass a RuleSuccessors to reuse one compilation across calls.
     pair_proof: first try to prove the goal out of reach on pairs of objects (up to ~1 s on 5 objects).
     symmetry: search one state per permutation of objects with the same goal (search.rule_symmetry);
-    the plan's predicted states are then replayed on the real objects. Objects that share a code
-    while the goal asks different codes of them end the search (UNSOLVABLE) or prune the state.
+    the plan's predicted states are then replayed on the real objects. Either way, objects that share
+    a code while the goal asks different codes of them end the search (UNSOLVABLE) or prune the state.
     """
     t0 = time.perf_counter()
     if method not in METHODS:
