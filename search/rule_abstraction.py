@@ -65,16 +65,14 @@ def _can_fire(rule: Rule, partner: int, others: _Others) -> bool:
             and all(least(x) < n for x, n in rule.fewer_than))
 
 
-def _next_codes(by_key: dict, action: int, own: int, partner: int, others: _Others) -> set[int]:
+def _next_codes(rules: RuleSet, action: int, own: int, partner: int, others: _Others) -> set[int]:
     """Codes the object can take under `action`: its own (no rule fired) and every rule's that can fire."""
-    return {own} | {r.code_to for r in by_key.get((action, own), ()) if _can_fire(r, partner, others)}
+    return {own} | {r.code_to for r in rules.rules_for(action, own) if _can_fire(r, partner, others)}
 
 
 def pair_reaches_goal(rules: RuleSet, start: Sequence[int], goal: SymbolicGoal, i: int, j: int,
-                      by_key: dict | None = None, reach: Sequence[frozenset[int]] | None = None) -> bool:
+                      reach: Sequence[frozenset[int]] | None = None) -> bool:
     """Whether the projection onto objects i and j reaches codes meeting both objects' goals."""
-    if by_key is None:
-        by_key = _rules_by_key(rules)
     if reach is None:
         reach = reachable_codes(rules, start)
     others = _Others([reach[k] for k in range(len(start)) if k not in (i, j)])  # outside the pair, for i and for j
@@ -83,7 +81,7 @@ def pair_reaches_goal(rules: RuleSet, start: Sequence[int], goal: SymbolicGoal, 
     def done(ci: int, cj: int) -> bool:
         return (gi is None or ci == gi) and (gj is None or cj == gj)
 
-    actions = sorted({a for a, _ in by_key})
+    actions = rules.actions
     first = (int(start[i]), int(start[j]))
     seen, queue = {first}, deque([first])
     while queue:
@@ -91,29 +89,21 @@ def pair_reaches_goal(rules: RuleSet, start: Sequence[int], goal: SymbolicGoal, 
         if done(ci, cj):
             return True
         for a in actions:
-            for nxt in itertools.product(_next_codes(by_key, a, ci, cj, others), _next_codes(by_key, a, cj, ci, others)):
+            for nxt in itertools.product(_next_codes(rules, a, ci, cj, others), _next_codes(rules, a, cj, ci, others)):
                 if nxt not in seen:
                     seen.add(nxt)
                     queue.append(nxt)
     return False
 
 
-def _rules_by_key(rules: RuleSet) -> dict[tuple[int, int], list[Rule]]:
-    by_key: dict[tuple[int, int], list[Rule]] = defaultdict(list)
-    for r in rules.rules:
-        by_key[(r.action, r.code_from)].append(r)
-    return dict(by_key)
-
-
 def pair_unreachable(rules: RuleSet, start: Sequence[int], goal: SymbolicGoal) -> tuple[int, int] | None:
     """A pair of objects whose projection cannot reach the goal (a proof that no plan exists), or None."""
     if len(goal.codes) != len(start):
         raise ValueError(f"start codes of {len(start)} objects and a goal of {len(goal.codes)} do not match")
-    by_key = _rules_by_key(rules)
     reach = reachable_codes(rules, start)
     for i, j in itertools.combinations(range(len(start)), 2):
         if goal.codes[i] is None and goal.codes[j] is None:
             continue
-        if not pair_reaches_goal(rules, start, goal, i, j, by_key, reach):
+        if not pair_reaches_goal(rules, start, goal, i, j, reach):
             return i, j
     return None
