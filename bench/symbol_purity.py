@@ -25,6 +25,7 @@ from pddl_export.symbolic import codes_from_bits
 from symlearn.data.dataset import load_split
 from symlearn.data.statistics import held_mask
 from symlearn.learning.checkpoint import effect_model_sha256, load_effect_model
+from symlearn.provenance import atomic_write_json
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, load_transition
 from symlearn.symbolic.transition_data import build_transition_data, encode_crops
 from symlearn.symbolic.transition_model import predict_bits
@@ -97,11 +98,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     torch.set_num_threads(args.threads)
     rows = [purity(Path(r), Path(args.data)) for r in args.runs.split(",")]
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps({"data": args.data, "runs": rows}, indent=2))
-    tmp.replace(out)
+    atomic_write_json(args.out, {"data": args.data, "runs": rows})
     for r in rows:
         print(json.dumps(r))
     return 0
