@@ -67,6 +67,35 @@ def code_distances(rules: RuleSet, goal: SymbolicGoal) -> np.ndarray:
     return table
 
 
+def _checked_start(start: Sequence[int], goal: SymbolicGoal, bits: int) -> np.ndarray:
+    """start as an int64 array (K,); ValueError if it does not match the goal or fit in `bits` bits."""
+    arr = np.asarray(start, np.int64)
+    if arr.ndim != 1 or len(goal.codes) != len(arr):
+        raise ValueError(f"start codes {arr.shape} and goal of {len(goal.codes)} objects do not match")
+    if arr.size and (arr.min() < 0 or arr.max() >= 1 << bits):
+        raise ValueError(f"start codes {arr.tolist()} do not fit in {bits} bits")
+    return arr
+
+
+def _start_proof(rules: RuleSet, start: np.ndarray, goal: SymbolicGoal, pairs: np.ndarray,
+                 pair_proof: bool) -> tuple[str, str] | None:
+    """(kind, message) of a proof, before any search, that no plan reaches the goal; None without one.
+
+    "coincidence": two objects the goal tells apart share a start code (search.rule_symmetry);
+    "pair": with pair_proof, a pair projection cannot reach the goal (search.rule_abstraction).
+    """
+    together = [(int(i), int(j)) for i, j in pairs if start[i] == start[j]]
+    if together:
+        i, j = together[0]
+        return "coincidence", (f"objects {i} and {j} hold the same code, which the rules move alike, "
+                               "but have different goal codes")
+    pair = pair_unreachable(rules, start.tolist(), goal) if pair_proof else None
+    if pair is not None:
+        return "pair", (f"objects {pair[0]} and {pair[1]} cannot reach their goal codes together "
+                        "(pair projection of the rules)")
+    return None
+
+
 def plan_rules(
     rules: RuleSet | RuleSuccessors,
     start: Sequence[int],
@@ -95,26 +124,14 @@ def plan_rules(
     if method not in METHODS:
         raise ValueError(f"unknown rule search {method!r}; known: {', '.join(METHODS)}")
     succ = rules if isinstance(rules, RuleSuccessors) else RuleSuccessors(rules)
-    start_arr = np.asarray(start, np.int64)
-    if start_arr.ndim != 1 or len(goal.codes) != len(start_arr):
-        raise ValueError(f"start codes {start_arr.shape} and goal of {len(goal.codes)} objects do not match")
-    if start_arr.size and (start_arr.min() < 0 or start_arr.max() >= 1 << succ.bits):
-        raise ValueError(f"start codes {start_arr.tolist()} do not fit in {succ.bits} bits")
+    start_arr = _checked_start(start, goal, succ.bits)
+    name, batch_used = planner_name or f"rules-{method}", batch if method == "astar" else 0
     pairs = split_pairs(goal.codes)
-    together = [(int(i), int(j)) for i, j in pairs if start_arr[i] == start_arr[j]]
-    proof = ("coincidence", together[0]) if together else None
-    if proof is None and pair_proof:
-        pair = pair_unreachable(succ.rules, start_arr.tolist(), goal)
-        proof = ("pair", pair) if pair is not None else None
+    proof = _start_proof(succ.rules, start_arr, goal, pairs, pair_proof)
     if proof is not None:
-        kind, (i, j) = proof
-        why = ("hold the same code, which the rules move alike, but have different goal codes" if kind == "coincidence"
-               else "cannot reach their goal codes together (pair projection of the rules)")
-        return PlanResult(planner=planner_name or f"rules-{method}", status=PlanStatus.UNSOLVABLE, plan=(),
-                          predicted_states=(), expansions=0,
-                          planning_time_s=time.perf_counter() - t0,
-                          message=f"objects {i} and {j} {why}",
-                          extra={"generated": 0, "batch": batch if method == "astar" else 0, "proof": kind})
+        return PlanResult(planner=name, status=PlanStatus.UNSOLVABLE, plan=(), predicted_states=(), expansions=0,
+                          planning_time_s=time.perf_counter() - t0, message=proof[1],
+                          extra={"generated": 0, "batch": batch_used, "proof": proof[0]})
     classes = goal_classes(goal.codes) if symmetry else ()
 
     def step(states: np.ndarray) -> np.ndarray:
@@ -153,6 +170,6 @@ def plan_rules(
         limit = f"max_expansions={max_expansions}"
     if classes and out.status is PlanStatus.SOLVED:  # the search saw sorted states: the real objects' path
         out = dataclasses.replace(out, states=replay(succ, succ.actions, start_arr, out.actions))
-    return outcome_result(out, planner_name or f"rules-{method}", t0, timeout_s, limit,
-                          f"the {out.generated} states the rules reach"
-                          + (" (one per orbit of objects with the same goal)" if classes else ""), {"batch": batch if method == "astar" else 0})
+    reached = f"the {out.generated} states the rules reach" + (" (one per orbit of objects with the same goal)"
+                                                                 if classes else "")
+    return outcome_result(out, name, t0, timeout_s, limit, reached, {"batch": batch_used})
