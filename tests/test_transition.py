@@ -103,6 +103,40 @@ def test_copy_prior_makes_no_change_the_default():
     assert TransitionConfig.from_json(old).copy_prior == 0.0
 
 
+def test_attention_rounds_extend_the_paper_net_and_keep_its_symmetry(tmp_path):
+    with pytest.raises(ValueError, match="attention_rounds"):
+        TransitionConfig(attention_rounds=0)
+    assert TransitionConfig().attention_rounds == 1  # the paper's single attention layer, for old files
+    assert TransitionConfig.from_preset("quick").attention_rounds == TransitionConfig.from_preset("paper").attention_rounds == 3
+    one, three = _net(seed=5, attention_rounds=1), _net(seed=5, attention_rounds=3)
+    assert not any(k.startswith("rounds.") for k in one.state_dict())
+    assert sum(k.startswith("rounds.") for k in three.state_dict()) > 0
+    g = torch.Generator().manual_seed(2)
+    codes = torch.randint(0, 2, (36, 4, BITS), generator=g).float()
+    mask = torch.tensor([[1, 1, 1, 0]] * 36).bool()
+    act = torch.arange(36)
+    with torch.no_grad():
+        out = three(codes, mask, act).logits
+        perm = torch.tensor([2, 0, 1, 3])
+        torch.testing.assert_close(three(codes[:, perm], mask, act).logits, out[:, perm])  # equivariant
+        noisy = codes.clone()
+        noisy[:, 3] = 1 - noisy[:, 3]
+        torch.testing.assert_close(three(noisy, mask, act).logits, out)  # padding ignored in every round
+        # the first round's weights are the one-round net's: a one-round file loads into the same layers
+        three.load_state_dict({**three.state_dict(), **one.state_dict()})
+        assert not torch.allclose(three(codes, mask, act).logits, one(codes, mask, act).logits)
+    # a checkpoint written before attention_rounds existed loads as the paper's one-round net
+    save_transition(tmp_path / "old.pt", one, {})
+    blob = torch.load(tmp_path / "old.pt", map_location="cpu", weights_only=True)
+    cfg = json.loads(blob["config"])
+    del cfg["attention_rounds"]
+    torch.save({**blob, "config": json.dumps(cfg)}, tmp_path / "old.pt")
+    back, _ = load_transition(tmp_path / "old.pt")
+    assert back.cfg.attention_rounds == 1
+    with torch.no_grad():
+        torch.testing.assert_close(back(codes, mask, act).logits, one(codes, mask, act).logits)
+
+
 def test_rollout_chains_follow_episodes():
     episode = np.array([0, 0, 0, 1, 1, 2])
     step = np.array([0, 1, 2, 0, 1, 0])

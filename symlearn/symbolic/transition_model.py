@@ -4,7 +4,8 @@ As in the paper's "Planning with Discovered Symbols": each object's binary code 
 concatenated with the 36-way one-hot action, passed through two dense layers, one
 self-attention layer over the scene's objects (padding masked out) and two more dense
 layers, giving per-object next-code logits; training minimizes binary cross-entropy per bit
-over the real objects (transition_training.py).
+over the real objects (transition_training.py). The presets add two more attention rounds
+(attention_rounds = 3): multi-step predictions hold longer (docs/DESIGN.md).
 """
 from __future__ import annotations
 
@@ -34,6 +35,7 @@ class TransitionConfig:
     weight_decay: float = 0.0
     encode_batch_size: int = 256  # scenes per encoder forward pass while building the data set
     copy_prior: float = 0.0  # added to each logit toward the input bit, so "no change" is the default
+    attention_rounds: int = 1  # self-attention layers over the scene; the paper has 1 (the presets use more)
 
     def __post_init__(self) -> None:
         if self.hidden % self.n_heads:
@@ -44,6 +46,8 @@ class TransitionConfig:
             raise ValueError("epochs, batch_size and encode_batch_size must be positive")
         if not self.lr > 0:
             raise ValueError(f"lr={self.lr} must be positive")
+        if not (isinstance(self.attention_rounds, int) and self.attention_rounds >= 1):
+            raise ValueError(f"attention_rounds={self.attention_rounds!r} must be an integer >= 1")
 
     @staticmethod
     def from_preset(name: str, **overrides) -> "TransitionConfig":
@@ -63,13 +67,15 @@ class TransitionConfig:
         unknown = set(d) - names
         if unknown:
             raise ValueError(f"unknown transition config fields {sorted(unknown)}")
-        return TransitionConfig(**d)  # a file from before copy_prior gets its default, 0
+        return TransitionConfig(**d)  # a file from before copy_prior (attention_rounds) gets its default, 0 (1)
 
 
 TRANSITION_PRESETS = {
-    # copy_prior 3: on paper24 it raised closed-loop A* success from 0.81 to 0.91 (docs/BENCHMARKS.md)
-    "paper": TransitionConfig(preset="paper", copy_prior=3.0),
-    "quick": TransitionConfig(preset="quick", hidden=64, n_heads=4, epochs=40, batch_size=64, lr=2e-3),
+    # copy_prior 3: on paper24 it raised closed-loop A* success from 0.81 to 0.91 (docs/BENCHMARKS.md);
+    # attention_rounds 3: rollout scene accuracy at 5 steps 0.32 -> 0.41 over 3 seeds (docs/RESULTS.md, "Which lever moves rollouts")
+    "paper": TransitionConfig(preset="paper", copy_prior=3.0, attention_rounds=3),
+    "quick": TransitionConfig(preset="quick", hidden=64, n_heads=4, epochs=40, batch_size=64, lr=2e-3,
+                              attention_rounds=3),
 }
 
 
@@ -79,7 +85,12 @@ class TransitionOutput(NamedTuple):
 
 
 class TransitionNet(nn.Module):
-    """m(z): (code, action) per object -> 2 dense -> self-attention -> 2 dense -> next-code logits."""
+    """m(z): (code, action) per object -> 2 dense -> self-attention -> 2 dense -> next-code logits.
+
+    With attention_rounds > 1, each further round is a residual dense layer and a residual self-attention
+    layer: an object's next code can then depend on what another object's context says (what lies under
+    the place a held object is released on), which one round of attention cannot compose.
+    """
 
     def __init__(self, cfg: TransitionConfig) -> None:
         super().__init__()
@@ -87,6 +98,7 @@ class TransitionNet(nn.Module):
         h = cfg.hidden
         self.pre = nn.Sequential(nn.Linear(cfg.bits + N_ACTIONS, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU())
         self.attn = nn.MultiheadAttention(h, cfg.n_heads, batch_first=True)
+        self.rounds = nn.ModuleList(_AttentionRound(h, cfg.n_heads) for _ in range(cfg.attention_rounds - 1))
         self.post = nn.Sequential(nn.Linear(h, h), nn.ReLU(), nn.Linear(h, cfg.bits))
 
     def forward(self, codes: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor) -> TransitionOutput:
@@ -105,11 +117,27 @@ class TransitionNet(nn.Module):
         pad[:, 0] &= mask.any(dim=1)
         att, _ = self.attn(h, h, h, key_padding_mask=pad, need_weights=False)  # (B, K, H)
         h = h + att  # residual: an object keeps its own code's features beside the scene context
+        for r in self.rounds:
+            h = r(h, pad)
         logits = self.post(h)
         if self.cfg.copy_prior:  # most (object, action) pairs leave the code as it is
             logits = logits + self.cfg.copy_prior * (2 * codes - 1)
         logits = logits * mask[..., None]  # (B, K, bits)
         return TransitionOutput(logits, (logits > 0).to(codes.dtype) * mask[..., None])
+
+
+class _AttentionRound(nn.Module):
+    """A further round of m(z): residual dense layer, then residual self-attention over the scene."""
+
+    def __init__(self, hidden: int, n_heads: int) -> None:
+        super().__init__()
+        self.dense = nn.Sequential(nn.Linear(hidden, hidden), nn.ReLU())
+        self.attn = nn.MultiheadAttention(hidden, n_heads, batch_first=True)
+
+    def forward(self, h: torch.Tensor, pad: torch.Tensor) -> torch.Tensor:
+        h = h + self.dense(h)
+        att, _ = self.attn(h, h, h, key_padding_mask=pad, need_weights=False)
+        return h + att
 
 
 def masked_bce(logits: torch.Tensor, target: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
