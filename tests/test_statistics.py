@@ -2,7 +2,8 @@
 import numpy as np
 
 from symlearn.data.dataset import ARRAY_NAMES, InteractionData
-from symlearn.data.statistics import object_shares, rider_mask, stacked_mask
+from symlearn.data.statistics import arrangement_labels, object_shares, rider_mask, stacked_mask
+from symlearn.world import LOCATIONS
 
 
 def _data(effect, grasped, obj_type, z):
@@ -30,3 +31,15 @@ def test_riders_are_unheld_objects_carried_along():
     s = object_shares(d)
     assert (s["objects"], s["sticks"], s["riders"], s["riders_on_stick"], s["stacked"]) == (8, 1, 1, 1, 2)
     assert s["scenes_with_stick_by_objects"] == {"2": 0.0, "3": 0.5}
+
+
+def test_arrangement_labels_name_type_location_and_level():
+    d = _data(effect=np.zeros((1, 3, 3)), grasped=[-1], obj_type=[[1, 0, 0]], z=[[.425, .50, .55]])
+    d.pre_pose[0, :, :2] = [LOCATIONS[4], np.add(LOCATIONS[4], .01), np.add(LOCATIONS[2], -.02)]
+    d.post_pose[0, :, :2] = [LOCATIONS[1]] * 3
+    d.post_pose[0, :, 2] = [.425, .50, .45]
+    # a stick on the table at 4, a cube on it (one level up), a cube two levels up near 2
+    np.testing.assert_array_equal(arrangement_labels(d), [[1040, 41, 22]])
+    np.testing.assert_array_equal(arrangement_labels(d, after=True), [[1010, 11, 10]])
+    pad = _data(effect=np.zeros((1, 3, 3)), grasped=[-1], obj_type=[[0, -1, -1]], z=[[.45, 0, 0]])
+    assert arrangement_labels(pad)[0, 1:].tolist() == [-1, -1]

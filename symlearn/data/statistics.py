@@ -15,11 +15,12 @@ from __future__ import annotations
 import numpy as np
 
 from symlearn.data.dataset import InteractionData
-from symlearn.world import OBJECT_SIZE, TABLE_TOP_Z, ObjectType
+from symlearn.world import LOCATIONS, OBJECT_SIZE, TABLE_TOP_Z, ObjectType
 
 STILL_M = 0.01  # an object that moved less than this (and was not held) stayed where it was
 RIDE_MIN_M = 0.05  # a rider moves with the carried object: 5 cm is far above settling jitter (< 1 cm)
 STACK_MIN_M = 0.02  # an object on another one starts at least its support's height (>= 5 cm) higher
+LEVEL_M = 0.05  # height step of an arrangement label: a cube is 5 cm tall
 
 
 def held_mask(data: InteractionData) -> np.ndarray:
@@ -44,6 +45,22 @@ def stacked_mask(data: InteractionData) -> np.ndarray:
     for t in ObjectType:
         rest[data.obj_type == t] = TABLE_TOP_Z + OBJECT_SIZE[t][2] / 2
     return data.mask & (data.pre_pose[..., 2] - rest >= STACK_MIN_M)
+
+
+def arrangement_labels(data: InteractionData, after: bool = False) -> np.ndarray:
+    """(N, K) int64 name of each object's arrangement read from its pose: type, nearest location, height level.
+
+    type * 1000 + location * 10 + level, the level counting 5 cm steps above the type's resting height
+    on the table (0..9); -1 for padding. Symbols an ideal observer would give; the models never see poses.
+    """
+    pose = data.post_pose if after else data.pre_pose
+    dist = np.linalg.norm(pose[..., None, :2] - np.asarray(LOCATIONS, np.float32)[None, None], axis=-1)  # (N, K, 6)
+    rest = np.zeros(data.obj_type.shape, np.float32)
+    for t in ObjectType:
+        rest[data.obj_type == t] = TABLE_TOP_Z + OBJECT_SIZE[t][2] / 2
+    level = np.clip(np.round((pose[..., 2] - rest) / LEVEL_M), 0, 9).astype(np.int64)
+    label = data.obj_type.astype(np.int64) * 1000 + dist.argmin(-1) * 10 + level
+    return np.where(data.mask, label, -1)
 
 
 def object_shares(data: InteractionData) -> dict:
