@@ -107,7 +107,7 @@ def test_attention_rounds_extend_the_paper_net_and_keep_its_symmetry(tmp_path):
     with pytest.raises(ValueError, match="attention_rounds"):
         TransitionConfig(attention_rounds=0)
     assert TransitionConfig().attention_rounds == 1  # the paper's single attention layer, for old files
-    assert TransitionConfig.from_preset("quick").attention_rounds == TransitionConfig.from_preset("paper").attention_rounds == 3
+    assert TransitionConfig.from_preset("quick").attention_rounds == TransitionConfig.from_preset("paper").attention_rounds == 1
     one, three = _net(seed=5, attention_rounds=1), _net(seed=5, attention_rounds=3)
     assert not any(k.startswith("rounds.") for k in one.state_dict())
     assert sum(k.startswith("rounds.") for k in three.state_dict()) > 0

@@ -48,7 +48,8 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
     over = {k: v for k, v in (("epochs", args.epochs), ("copy_prior", args.copy_prior),
                               ("attention_rounds", args.attention_rounds)) if v is not None}
     cfg = TransitionConfig.from_preset(args.preset, **over)
-    print(f"train-transition: preset {cfg.preset}, {cfg.attention_rounds} attention rounds, {cfg.epochs} epochs, seed {args.seed}, run {args.run}, "
+    print(f"train-transition: preset {cfg.preset}, {cfg.attention_rounds} attention round(s), {cfg.epochs} epochs, "
+          f"seed {args.seed}, run {args.run}, "
           f"data {args.data}", file=sys.stderr)
     m = train_transition(Path(args.run), Path(args.data), cfg, seed=args.seed, show_progress=not args.quiet)
     test = m["test"]
@@ -180,7 +181,7 @@ def add_train_transition_command(sub) -> None:
     t.add_argument("--epochs", type=int)
     t.add_argument("--copy-prior", type=float, help="logit bias toward keeping each input bit (preset's if unset)")
     t.add_argument("--attention-rounds", type=positive_int,
-                   help="self-attention rounds over the scene (the paper: 1; preset's if unset)")
+                   help="self-attention rounds over the scene (the paper and the presets: 1)")
     t.add_argument("--seed", type=int, default=0)
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=cmd_train_transition)

@@ -4,8 +4,8 @@ As in the paper's "Planning with Discovered Symbols": each object's binary code 
 concatenated with the 36-way one-hot action, passed through two dense layers, one
 self-attention layer over the scene's objects (padding masked out) and two more dense
 layers, giving per-object next-code logits; training minimizes binary cross-entropy per bit
-over the real objects (transition_training.py). The presets add two more attention rounds
-(attention_rounds = 3): multi-step predictions hold longer (docs/DESIGN.md).
+over the real objects (transition_training.py). attention_rounds > 1 adds further rounds of
+attention (docs/DESIGN.md); the presets keep the paper's one.
 """
 from __future__ import annotations
 
@@ -35,7 +35,7 @@ class TransitionConfig:
     weight_decay: float = 0.0
     encode_batch_size: int = 256  # scenes per encoder forward pass while building the data set
     copy_prior: float = 0.0  # added to each logit toward the input bit, so "no change" is the default
-    attention_rounds: int = 1  # self-attention layers over the scene; the paper has 1 (the presets use more)
+    attention_rounds: int = 1  # self-attention rounds over the scene; the paper has 1 (docs/DESIGN.md on more)
 
     def __post_init__(self) -> None:
         if self.hidden % self.n_heads:
@@ -71,11 +71,11 @@ class TransitionConfig:
 
 
 TRANSITION_PRESETS = {
-    # copy_prior 3: on paper24 it raised closed-loop A* success from 0.81 to 0.91 (docs/BENCHMARKS.md);
-    # attention_rounds 3: rollout scene accuracy at 5 steps 0.32 -> 0.41 over 3 seeds (docs/RESULTS.md, "Which lever moves rollouts")
-    "paper": TransitionConfig(preset="paper", copy_prior=3.0, attention_rounds=3),
-    "quick": TransitionConfig(preset="quick", hidden=64, n_heads=4, epochs=40, batch_size=64, lr=2e-3,
-                              attention_rounds=3),
+    # copy_prior 3: on paper24 it raised closed-loop A* success from 0.81 to 0.91 (docs/BENCHMARKS.md).
+    # attention_rounds stays 1: 3 rounds helped one effect model's rollouts and planning, not the other two
+    # (docs/RESULTS.md, "More attention rounds in m(z)").
+    "paper": TransitionConfig(preset="paper", copy_prior=3.0),
+    "quick": TransitionConfig(preset="quick", hidden=64, n_heads=4, epochs=40, batch_size=64, lr=2e-3),
 }
 
 
