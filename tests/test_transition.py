@@ -122,7 +122,7 @@ def test_attention_rounds_extend_the_paper_net_and_keep_its_symmetry(tmp_path):
         noisy = codes.clone()
         noisy[:, 3] = 1 - noisy[:, 3]
         torch.testing.assert_close(three(noisy, mask, act).logits, out)  # padding ignored in every round
-        # the first round's weights are the one-round net's: a one-round file loads into the same layers
+        # with its first round copied from the one-round net (same layer names), the further rounds still act
         three.load_state_dict({**three.state_dict(), **one.state_dict()})
         assert not torch.allclose(three(codes, mask, act).logits, one(codes, mask, act).logits)
     # a checkpoint written before attention_rounds existed loads as the paper's one-round net
