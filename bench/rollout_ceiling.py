@@ -135,6 +135,73 @@ def fit_on_rollouts(cfg, train, val, seed: int, steps: int):
     return net.eval()
 
 
+def sweep_rounds(splits: dict, rounds: list[int], seeds: list[int]) -> dict:
+    """Rollout scene accuracies of m(z) (quick preset) for each number of attention rounds and seed, with mean ± std."""
+    from symlearn.symbolic.transition_metrics import evaluate_transition
+    from symlearn.symbolic.transition_model import TransitionConfig
+    from symlearn.symbolic.transition_training import fit_transition
+
+    nets = {}
+    for r in rounds:
+        per_seed = {}
+        for seed in seeds:
+            cfg = TransitionConfig.from_preset("quick", attention_rounds=r)
+            net, _, _ = fit_transition(cfg, splits["train"], splits["val"], seed)
+            m = evaluate_transition(net, splits["test"])
+            per_seed[str(seed)] = {n: v["scene_accuracy"] for n, v in m["rollout"].items()}
+            print(f"m(z), {r} attention rounds, seed {seed}: 1 step {per_seed[str(seed)]['1']:.3f}, "
+                  f"5 steps {per_seed[str(seed)]['5']:.3f}", flush=True)
+        summary = {n: {"mean": round(statistics.mean(v[n] for v in per_seed.values()), 4),
+                       "std": round(statistics.pstdev(v[n] for v in per_seed.values()), 4)}
+                   for n in next(iter(per_seed.values()))}
+        nets[str(r)] = {"seeds": per_seed, "mean_std": summary}
+    return nets
+
+
+def sweep_rollout_training(splits: dict, rounds: int, seeds: list[int], steps: int) -> dict:
+    """Rollout scene accuracies of m(z) with `rounds` attention rounds trained on `steps`-action chains, per seed."""
+    from symlearn.symbolic.transition_metrics import evaluate_transition
+    from symlearn.symbolic.transition_model import TransitionConfig
+
+    cfg = TransitionConfig.from_preset("quick", attention_rounds=rounds)
+    per_seed = {}
+    for seed in seeds:
+        net = fit_on_rollouts(cfg, splits["train"], splits["val"], seed, steps)
+        per_seed[str(seed)] = {n: v["scene_accuracy"]
+                               for n, v in evaluate_transition(net, splits["test"])["rollout"].items()}
+        print(f"m(z), {rounds} rounds, trained on {steps}-step rollouts, seed {seed}: "
+              f"5 steps {per_seed[str(seed)]['5']:.3f}", flush=True)
+    return {"seeds": per_seed}
+
+
+def symbol_tables(splits: dict, data_dir: Path, min_count: int) -> dict:
+    """Determinism and table scores for the run's codes and for the pose-read arrangement labels."""
+    from pddl_export.symbolic import codes_from_bits
+    from symlearn.data.dataset import load_split
+    from symlearn.data.statistics import arrangement_labels
+    from symlearn.symbolic.transition_metrics import ROLLOUT_STEPS, rollout_chains
+
+    test = splits["test"]
+    chains = {n: rollout_chains(test, n) for n in range(1, ROLLOUT_STEPS + 1)}
+    raw = {s: load_split(data_dir, s) for s in ("train", "val", "test")}
+
+    def codes(s: str, after: bool) -> np.ndarray:
+        d = splits[s]
+        return np.where(d.mask, codes_from_bits((d.after if after else d.before).round()), -1)
+
+    out = {}
+    for name, sym in (("codes", codes), ("arrangement", lambda s, after: arrangement_labels(raw[s], after))):
+        fit_b = np.concatenate([sym("train", False), sym("val", False)])
+        fit_a = np.concatenate([sym("train", True), sym("val", True)])
+        fit_act = np.concatenate([splits["train"].action, splits["val"].action])
+        table = fit_table(fit_b, fit_a, fit_act)
+        out[name] = {"distinct": int(len(np.unique(fit_b[fit_b >= 0]))),
+                     "train_determinism": determinism(table, fit_b, fit_a, fit_act, min_count),
+                     **table_scores(table, sym("test", False), sym("test", True), test.action, chains)}
+        print(name, json.dumps(out[name]), flush=True)
+    return out
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--run", type=Path, required=True)
@@ -150,65 +217,21 @@ def main() -> int:
 
     torch.set_num_threads(1)
     from pddl_export.files import atomic_write_json
-    from pddl_export.symbolic import codes_from_bits
-    from symlearn.data.dataset import load_split
-    from symlearn.data.statistics import arrangement_labels
     from symlearn.learning.checkpoint import load_effect_model
     from symlearn.provenance import versions
-    from symlearn.symbolic.transition_metrics import ROLLOUT_STEPS, evaluate_transition, rollout_chains
-    from symlearn.symbolic.transition_model import TransitionConfig
-    from symlearn.symbolic.transition_training import encode_splits, fit_transition
+    from symlearn.symbolic.transition_training import encode_splits
 
     t0 = time.perf_counter()
     encoder, _ = load_effect_model(args.run)
     splits = encode_splits(encoder, args.data, 512)
     rounds = [int(r) for r in args.rounds.split(",")]
-    seeds = [int(s) for s in args.seeds.split(",")]
-    nets = {}
-    for r in rounds:
-        per_seed = {}
-        for seed in seeds:
-            cfg = TransitionConfig.from_preset("quick", attention_rounds=r)
-            net, _, _ = fit_transition(cfg, splits["train"], splits["val"], seed)
-            m = evaluate_transition(net, splits["test"])
-            per_seed[str(seed)] = {n: v["scene_accuracy"] for n, v in m["rollout"].items()}
-            print(f"m(z), {r} attention rounds, seed {seed}: 1 step {per_seed[str(seed)]['1']:.3f}, "
-                  f"5 steps {per_seed[str(seed)]['5']:.3f}", flush=True)
-        summary = {n: {"mean": round(statistics.mean(v[n] for v in per_seed.values()), 4),
-                       "std": round(statistics.pstdev(v[n] for v in per_seed.values()), 4)}
-                   for n in next(iter(per_seed.values()))}
-        nets[str(r)] = {"seeds": per_seed, "mean_std": summary}
+    nets = sweep_rounds(splits, rounds, [int(s) for s in args.seeds.split(",")])
     if args.rollout_train > 1:
-        cfg = TransitionConfig.from_preset("quick", attention_rounds=rounds[-1])
-        per_seed = {}
-        for seed in (int(s) for s in args.rollout_seeds.split(",")):
-            net = fit_on_rollouts(cfg, splits["train"], splits["val"], seed, args.rollout_train)
-            per_seed[str(seed)] = {n: v["scene_accuracy"]
-                                   for n, v in evaluate_transition(net, splits["test"])["rollout"].items()}
-            print(f"m(z), {rounds[-1]} rounds, trained on {args.rollout_train}-step rollouts, seed {seed}: "
-                  f"5 steps {per_seed[str(seed)]['5']:.3f}", flush=True)
-        nets[f"{rounds[-1]}, trained on {args.rollout_train}-step rollouts"] = {"seeds": per_seed}
-
-    test = splits["test"]
-    chains = {n: rollout_chains(test, n) for n in range(1, ROLLOUT_STEPS + 1)}
-    raw = {s: load_split(args.data, s) for s in ("train", "val", "test")}
-    symbols = {}
-    for name in ("codes", "arrangement"):
-        def sym(s: str, after: bool) -> np.ndarray:
-            if name == "arrangement":
-                return arrangement_labels(raw[s], after)
-            d = splits[s]
-            return np.where(d.mask, codes_from_bits((d.after if after else d.before).round()), -1)
-        fit_b = np.concatenate([sym("train", False), sym("val", False)])
-        fit_a = np.concatenate([sym("train", True), sym("val", True)])
-        fit_act = np.concatenate([splits["train"].action, splits["val"].action])
-        table = fit_table(fit_b, fit_a, fit_act)
-        symbols[name] = {"distinct": int(len(np.unique(fit_b[fit_b >= 0]))),
-                         "train_determinism": determinism(table, fit_b, fit_a, fit_act, args.min_count),
-                         **table_scores(table, sym("test", False), sym("test", True), test.action, chains)}
-        print(name, json.dumps(symbols[name]), flush=True)
+        nets[f"{rounds[-1]}, trained on {args.rollout_train}-step rollouts"] = sweep_rollout_training(
+            splits, rounds[-1], [int(s) for s in args.rollout_seeds.split(",")], args.rollout_train)
     result = {"run": str(args.run), "data": str(args.data), "min_count": args.min_count,
-              "transition_net_by_attention_rounds": nets, "symbol_tables": symbols,
+              "transition_net_by_attention_rounds": nets,
+              "symbol_tables": symbol_tables(splits, args.data, args.min_count),
               "machine": f"{platform.machine()}, {platform.processor() or 'cpu'}",
               "date": time.strftime("%Y-%m-%d"), "versions": versions(), "wall_s": round(time.perf_counter() - t0, 1)}
     atomic_write_json(args.out, result)
