@@ -39,12 +39,17 @@ def still_mask(data: InteractionData) -> np.ndarray:
     return data.mask & ~held_mask(data) & (np.linalg.norm(data.effect, axis=-1) < STILL_M)
 
 
-def stacked_mask(data: InteractionData) -> np.ndarray:
-    """(N, K) bool: real objects that start on top of another object rather than on the table."""
+def _rest_z(data: InteractionData) -> np.ndarray:
+    """(N, K) height of each object's centre lying on the table (inf for padding)."""
     rest = np.full(data.obj_type.shape, np.inf, np.float32)
     for t in ObjectType:
         rest[data.obj_type == t] = TABLE_TOP_Z + OBJECT_SIZE[t][2] / 2
-    return data.mask & (data.pre_pose[..., 2] - rest >= STACK_MIN_M)
+    return rest
+
+
+def stacked_mask(data: InteractionData) -> np.ndarray:
+    """(N, K) bool: real objects that start on top of another object rather than on the table."""
+    return data.mask & (data.pre_pose[..., 2] - _rest_z(data) >= STACK_MIN_M)
 
 
 def arrangement_labels(data: InteractionData, after: bool = False) -> np.ndarray:
@@ -55,10 +60,7 @@ def arrangement_labels(data: InteractionData, after: bool = False) -> np.ndarray
     """
     pose = data.post_pose if after else data.pre_pose
     dist = np.linalg.norm(pose[..., None, :2] - np.asarray(LOCATIONS, np.float32)[None, None], axis=-1)  # (N, K, 6)
-    rest = np.zeros(data.obj_type.shape, np.float32)
-    for t in ObjectType:
-        rest[data.obj_type == t] = TABLE_TOP_Z + OBJECT_SIZE[t][2] / 2
-    level = np.clip(np.round((pose[..., 2] - rest) / LEVEL_M), 0, 9).astype(np.int64)
+    level = np.clip(np.round((pose[..., 2] - _rest_z(data)) / LEVEL_M), 0, 9).astype(np.int64)
     label = data.obj_type.astype(np.int64) * 1000 + dist.argmin(-1) * 10 + level
     return np.where(data.mask, label, -1)
 
