@@ -29,6 +29,14 @@ class TransitionFn(Protocol):
         ...
 
 
+class ScoredTransitionFn(TransitionFn, Protocol):
+    """A transition function that also says how likely each of its predictions is."""
+
+    def scored(self, codes: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """As __call__, plus (B,) float -log P(predicted next state) under the model (0: certain)."""
+        ...
+
+
 def code_str(code: int, bits: int) -> str:
     """Integer code -> its bit string, most significant bit first ('00011011')."""
     if not 0 <= int(code) < (1 << bits):

@@ -259,6 +259,27 @@ def test_learned_transition_protocol():
     assert m(np.zeros((0, 3), np.int64), np.zeros(0, np.int64)).shape == (0, 3)
 
 
+def test_scored_predictions_are_the_most_likely_codes_and_their_probability():
+    net = _net(seed=4)
+    m = LearnedTransition(net)
+    rng = np.random.default_rng(1)
+    codes, actions = rng.integers(0, 1 << BITS, (36, 3)), np.arange(36)
+    nxt, nll = m.scored(codes, actions)
+    np.testing.assert_array_equal(nxt, m(codes, actions))
+    bits = torch.from_numpy(((codes[..., None] >> np.arange(BITS - 1, -1, -1)) & 1).astype(np.float32))
+    with torch.no_grad():
+        p = torch.sigmoid(net(bits, torch.ones(36, 3, dtype=torch.bool), torch.from_numpy(actions)).logits).double()
+    # P(codes) is the product over objects and bits of the probability of the predicted bit
+    expect = -torch.log(torch.where(p > 0.5, p, 1 - p)).sum((1, 2)).numpy()
+    np.testing.assert_allclose(nll, expect, rtol=1e-5, atol=1e-6)
+    assert nll.shape == (36,) and nll.dtype == np.float64 and (nll > 0).all()
+    # a padded object adds nothing: scoring objects 0-1 with slot 2 masked equals scoring the 2-object scene
+    from symlearn.symbolic.transition_model import predict_scored
+    _, nll_pad = predict_scored(net, bits.numpy(), np.array([[1, 1, 0]] * 36, bool), actions)
+    np.testing.assert_allclose(nll_pad, m.scored(codes[:, :2], actions)[1], rtol=1e-5)
+    assert m.scored(np.zeros((0, 3), np.int64), np.zeros(0, np.int64))[1].shape == (0,)
+
+
 @pytest.mark.parametrize("codes, actions, match", [
     (np.zeros(3, np.int64), np.zeros(1, np.int64), "codes must be"),
     (np.zeros((2, 3), np.int64), np.zeros(3, np.int64), "codes must be"),

@@ -4,7 +4,8 @@
     >>> m(np.array([[3, 17]]), np.array([action_id(3, 4)]))   # (B, K) codes, (B,) actions      # doctest: +SKIP
     array([[ 3, 19]])
 
-A* (search.learned_astar) and the PDDL export call it.
+A* (search.learned_astar) and the PDDL export call it; `scored` adds how likely each prediction is
+(the most-likely-plan planner, `astar-likely`, charges it).
 """
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ import numpy as np
 from pddl_export.symbolic import bits_from_codes, codes_from_bits
 from symlearn.learning.checkpoint import effect_model_sha256
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, TransitionError, load_transition
-from symlearn.symbolic.transition_model import TransitionNet, predict_bits
+from symlearn.symbolic.transition_model import TransitionNet, predict_scored
 from symlearn.world import N_ACTIONS
 
 
@@ -41,6 +42,10 @@ class LearnedTransition:
 
     def __call__(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
         """(B, K) int codes and (B,) action ids -> (B, K) int64 next codes."""
+        return self.scored(codes, actions)[0]
+
+    def scored(self, codes: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """As __call__, plus each row's -log P(predicted next codes) under the network, (B,) float64."""
         codes = np.asarray(codes)
         actions = np.asarray(actions)
         if codes.ndim != 2 or actions.shape != codes.shape[:1]:
@@ -52,8 +57,8 @@ class LearnedTransition:
         if actions.size and (actions.min() < 0 or actions.max() >= N_ACTIONS):
             raise ValueError(f"action ids must lie in 0..{N_ACTIONS - 1}")
         if codes.size == 0:
-            return codes.astype(np.int64)
+            return codes.astype(np.int64), np.zeros(codes.shape[0])
         bits = bits_from_codes(codes, self.bits)  # (B, K, bits)
         mask = np.ones(codes.shape, bool)
-        nxt = predict_bits(self.net, bits, mask, actions.astype(np.int64), self.batch_size)
-        return codes_from_bits(nxt)
+        nxt, nll = predict_scored(self.net, bits, mask, actions.astype(np.int64), self.batch_size)
+        return codes_from_bits(nxt), nll

@@ -151,12 +151,26 @@ def masked_bce(logits: torch.Tensor, target: torch.Tensor, mask: torch.Tensor) -
 def predict_bits(net: TransitionNet, before: np.ndarray, mask: np.ndarray, action: np.ndarray,
                  batch_size: int = 4096) -> np.ndarray:
     """(N, K, bits) codes, (N, K) mask, (N,) actions -> (N, K, bits) float32 thresholded next codes."""
+    return predict_scored(net, before, mask, action, batch_size)[0]
+
+
+@torch.no_grad()
+def predict_scored(net: TransitionNet, before: np.ndarray, mask: np.ndarray, action: np.ndarray,
+                   batch_size: int = 4096) -> tuple[np.ndarray, np.ndarray]:
+    """Thresholded next codes (N, K, bits) and each row's -log P(those codes), (N,) float64.
+
+    The bits are independent Bernoullis given the input, so the thresholded codes are the most
+    likely next state and -log P sums softplus(-|logit|) over the real objects' bits.
+    """
     net.eval()
-    out = []
+    codes, nll = [], []
     for i in range(0, before.shape[0], batch_size):
-        o = net(torch.from_numpy(np.asarray(before[i:i + batch_size], np.float32)),
-                torch.from_numpy(np.asarray(mask[i:i + batch_size], bool)),
+        m = torch.from_numpy(np.asarray(mask[i:i + batch_size], bool))
+        o = net(torch.from_numpy(np.asarray(before[i:i + batch_size], np.float32)), m,
                 torch.from_numpy(np.asarray(action[i:i + batch_size], np.int64)))
-        out.append(o.codes.numpy())
-    return np.concatenate(out) if out else np.zeros_like(before, np.float32)
+        codes.append(o.codes.numpy())
+        nll.append((F.softplus(-o.logits.abs()) * m[..., None]).sum((1, 2)).double().numpy())
+    if not codes:
+        return np.zeros_like(before, np.float32), np.zeros(before.shape[0])
+    return np.concatenate(codes), np.concatenate(nll)
 
