@@ -18,6 +18,14 @@ admissible in general: one action can change several objects at once (pushing a 
 the cube riding on it), so h can exceed the remaining plan length and A* may return a longer
 plan than needed. A* stays complete with it (finite state space, re-opening on cheaper paths).
 Pass uniform_cost=True (h = 0, breadth-first order) for plans of optimal length.
+
+Most likely plans: with risk_weight w > 0 an action costs 1 + w * (-log P(its predicted next
+state)), read from a ScoredTransitionFn's `scored`. Among plans of similar length A* then
+prefers those whose every prediction the model is sure of, the plans most likely to unfold in
+the world as predicted (m(z)'s confidence is calibrated on held-out steps: docs/RESULTS.md).
+The mismatch heuristic is then counted in cost units, times the median cost of the start's actions,
+so that the search stays as greedy as with unit costs. The result's extra["log_p"] is the plan's
+summed log-probability.
 """
 from __future__ import annotations
 
@@ -27,7 +35,7 @@ import numpy as np
 
 from search.astar import astar, outcome_result
 from search.result import PlanResult
-from pddl_export.symbolic import N_ACTIONS, SymbolicGoal, TransitionFn
+from pddl_export.symbolic import N_ACTIONS, ScoredTransitionFn, SymbolicGoal, TransitionFn
 
 State = tuple[int, ...]
 
@@ -44,12 +52,25 @@ def _check_codes(codes: np.ndarray, shape: tuple[int, ...], bits: int, what: str
 
 def symbolic_successors(transition: TransitionFn, state: State) -> list[tuple[int, State]]:
     """(action, next_state) for each action that changes state; one batched call of 36 rows."""
+    return [(a, nxt) for a, nxt, _ in scored_successors(transition, state, scored=False)]
+
+
+def scored_successors(transition: TransitionFn | ScoredTransitionFn, state: State,
+                      scored: bool = True) -> list[tuple[int, State, float]]:
+    """(action, next_state, -log P(next_state)) for each action that changes state (0.0 when not scored)."""
     batch = np.repeat(np.asarray(state, np.int64)[None], N_ACTIONS, 0)  # (36, K)
-    nxt = np.asarray(transition(batch, np.arange(N_ACTIONS, dtype=np.int64)))  # (36, K)
+    actions = np.arange(N_ACTIONS, dtype=np.int64)
+    if scored:
+        nxt, nll = transition.scored(batch, actions)
+        nxt, nll = np.asarray(nxt), np.asarray(nll, np.float64)
+        if nll.shape != (N_ACTIONS,) or not np.all(np.isfinite(nll)) or nll.min() < 0:
+            raise ValueError(f"transition scores must be (36,) finite and >= 0, got {nll.shape}")
+    else:
+        nxt, nll = np.asarray(transition(batch, actions)), np.zeros(N_ACTIONS)
     _check_codes(nxt, (N_ACTIONS, len(state)), int(transition.bits), "transition output")
     moved = np.flatnonzero(np.any(nxt != batch, axis=1))  # self-loops dropped
     rows = nxt.tolist()
-    return [(int(a), tuple(rows[a])) for a in moved]
+    return [(int(a), tuple(rows[a]), float(nll[a])) for a in moved]
 
 
 def plan_symbolic(
@@ -60,9 +81,13 @@ def plan_symbolic(
     max_expansions: int = 20000,
     timeout_s: float = 30.0,
     uniform_cost: bool = False,
+    risk_weight: float = 0.0,
     planner_name: str = "astar",
 ) -> PlanResult:
-    """Plan from start_codes (K,) to a (partial) goal; one batched transition call per expansion."""
+    """Plan from start_codes (K,) to a (partial) goal; one batched transition call per expansion.
+
+    risk_weight > 0 charges each action w * (-log P) on top of its unit cost (module docstring).
+    """
     t0 = time.perf_counter()
     bits = int(transition.bits)
     start_arr = np.asarray(start_codes)
@@ -74,18 +99,40 @@ def plan_symbolic(
     _check_codes(start_arr, (k,), bits, "start_codes")
     if any(c is not None and not 0 <= c < 1 << bits for c in goal.codes):
         raise ValueError(f"goal {goal.codes} holds codes outside 0..{(1 << bits) - 1}")
+    if not (np.isfinite(risk_weight) and risk_weight >= 0):
+        raise ValueError(f"risk_weight must be a finite number >= 0, got {risk_weight}")
+    scored = risk_weight > 0
+    if scored and not callable(getattr(transition, "scored", None)):
+        raise ValueError(f"risk_weight {risk_weight} needs a transition that scores its predictions "
+                         f"(a `scored` method); {type(transition).__name__} has none")
     fixed = [(i, c) for i, c in enumerate(goal.codes) if c is not None]
+    step_nll: dict[tuple[State, int], float] = {}
 
     def is_goal(state: State) -> bool:
         return all(state[i] == c for i, c in fixed)
 
+    start = tuple(start_arr.tolist())
+    first = scored_successors(transition, start) if scored and not is_goal(start) else []
+    # With risk, an action costs more than 1, so h is put in cost units (the median cost of the start's
+    # actions); else A* would fall back towards breadth-first order and run out of time on bigger scenes.
+    scale = float(np.median([1.0 + risk_weight * nll for *_, nll in first])) if first else 1.0
+
     def heuristic(state: State) -> float:
-        return float(sum(state[i] != c for i, c in fixed))
+        return scale * sum(state[i] != c for i, c in fixed)
 
     def successors(state: State) -> list[tuple[int, State, float]]:
-        return [(a, nxt, 1.0) for a, nxt in symbolic_successors(transition, state)]
+        out = []
+        for a, nxt, nll in (first if state == start and first else scored_successors(transition, state, scored)):
+            step_nll[state, a] = nll
+            out.append((a, nxt, 1.0 + risk_weight * nll))
+        return out
 
-    out = astar(tuple(start_arr.tolist()), is_goal, successors, heuristic,
+    out = astar(start, is_goal, successors, heuristic,
                 max_expansions=max_expansions, timeout_s=timeout_s, uniform_cost=uniform_cost)
+    extra: dict = {"uniform_cost": uniform_cost, "risk_weight": risk_weight}
+    if scored:
+        extra["heuristic_scale"] = round(scale, 6)
+    if scored and out.states:
+        extra["log_p"] = round(-sum(step_nll[s, a] for s, a in zip(out.states, out.actions)), 6)
     return outcome_result(out, planner_name, t0, timeout_s, f"max_expansions={max_expansions}",
-                          f"the {out.expansions} reachable states", {"uniform_cost": uniform_cost})
+                          f"the {out.expansions} reachable states", extra)

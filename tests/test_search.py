@@ -329,6 +329,51 @@ def test_plan_symbolic_result_survives_json():
     assert PlanResult.from_json(json.loads(json.dumps(result.to_json()))) == result
 
 
+@dataclass(frozen=True)
+class Shortcut:
+    """One object; from code 0, action 0 jumps to 3 (a prediction the model doubts, -log P = 3) and
+    actions 1 then 2 reach 3 through 1, each step nearly certain (-log P = 0.1); all else stays put."""
+
+    bits: int = 2
+    jump_nll: float = 3.0
+
+    def scored(self, codes: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        out, nll = codes.copy(), np.full(len(codes), 0.1)
+        c = codes[:, 0]
+        jump, via, land = (c == 0) & (actions == 0), (c == 0) & (actions == 1), (c == 1) & (actions == 2)
+        out[jump, 0], out[via, 0], out[land, 0] = 3, 1, 3
+        nll[jump] = self.jump_nll
+        return out, nll
+
+    def __call__(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        return self.scored(codes, actions)[0]
+
+
+@pytest.mark.parametrize("uniform", [False, True])
+def test_risk_weight_trades_a_doubtful_step_for_two_sure_ones(uniform):
+    start, goal = np.array([0]), SymbolicGoal((3,))
+    plain = plan_symbolic(Shortcut(), start, goal, uniform_cost=uniform)
+    assert plain.plan == (0,) and "log_p" not in plain.extra
+    likely = plan_symbolic(Shortcut(), start, goal, uniform_cost=uniform, risk_weight=1.0)
+    assert likely.plan == (1, 2) and likely.predicted_states == ((0,), (1,), (3,))
+    assert likely.extra["log_p"] == pytest.approx(-0.2) and likely.extra["risk_weight"] == 1.0
+    # a weight too small to pay for the extra step keeps the short plan: 1 + 0.1 * 3 < 2 + 0.1 * 0.2
+    small = plan_symbolic(Shortcut(), start, goal, uniform_cost=uniform, risk_weight=0.1)
+    assert small.plan == (0,) and small.extra["log_p"] == pytest.approx(-3.0)
+
+
+@pytest.mark.parametrize("transition, weight, match", [
+    (Shortcut(), -1.0, "risk_weight must be"),
+    (Shortcut(), float("nan"), "risk_weight must be"),
+    (Counter(k=1), 1.0, "scores its predictions"),
+    (Shortcut(jump_nll=-1.0), 1.0, "scores must be"),
+    (Shortcut(jump_nll=float("inf")), 1.0, "scores must be"),
+])
+def test_risk_weight_refuses_bad_weights_and_unscored_models(transition, weight, match):
+    with pytest.raises(ValueError, match=match):
+        plan_symbolic(transition, np.array([0]), SymbolicGoal((3,)), risk_weight=weight)
+
+
 # ---------------------------------------------------------------------------------------------
 # Generic astar
 
