@@ -197,6 +197,10 @@ class _Shift:
         out[:, 0] = np.where(actions == 0, out[:, 0] + 1, np.where(actions == 1, out[:, 0] + 2, out[:, 0])) % 16
         return out
 
+    def scored(self, codes, actions):
+        """Every prediction with -log P = 0.5 (enough for ObservedTransitions to show which it answers itself)."""
+        return self(codes, actions), np.full(len(codes), 0.5)
+
 
 def test_observed_transitions_override_only_what_was_seen():
     from search.learned_astar import plan_symbolic
@@ -208,6 +212,11 @@ def test_observed_transitions_override_only_what_was_seen():
     assert memory(codes, actions).tolist() == [[4, 5], [5, 5], [5, 5], [3, 5]]
     memory.record((3, 5), 0, (3, 5))  # in (3, 5) action 0 was seen to do nothing
     assert memory(codes, actions).tolist() == [[3, 5], [5, 5], [5, 5], [3, 5]]
+    memory.record((4, 5), 0, (4, 5))
+    nxt, nll = memory.scored(codes, actions)  # observed steps: their outcome, with certainty
+    assert nxt.tolist() == [[3, 5], [5, 5], [4, 5], [3, 5]] and nll.tolist() == [0.0, 0.5, 0.0, 0.5]
+    with pytest.raises(ValueError, match="does not score"):
+        ObservedTransitions(_Still()).scored(codes, actions)
     goal = SymbolicGoal((4, None))
     assert plan_symbolic(_Shift(), np.array([3, 5]), goal, uniform_cost=True).plan == (0,)
     replanned = plan_symbolic(memory, np.array([3, 5]), goal, uniform_cost=True)
@@ -351,21 +360,35 @@ def test_benchmark_writes_summary_and_rows(tmp_path, sim, run_dir, problems):
         assert all(r["plan_length"] is None or r["plan_length"] >= 0 for r in saved["rows"])
     assert {r["closed_loop"] for r in saved["rows"]} == {False, True}
     assert "astar-ucs" in bench.format_table(res)
+    assert "risk_weight" not in saved  # no planner here depends on it
+
+
+def test_benchmark_records_the_risk_weight_of_astar_likely(tmp_path, sim, run_dir):
+    pdir = tmp_path / "problems"
+    generate_problems(pdir, 2, objects=(1, 2), length=(1, 2), seed=12, sim=sim)
+    res = bench.benchmark(run_dir, pdir, ["astar-likely"], tmp_path / "b.json", timeout_s=2.0,
+                          show_progress=False, risk_weight=2.5)
+    assert res["risk_weight"] == 2.5 and len(res["rows"]) == 2
+    assert all(r["planner"] == "astar-likely" for r in res["rows"])
+    # an interrupted run resumes only under the same weight: the weight is part of the settings
+    problems = bench.load_sets([pdir])
+    settings = [bench._settings(run_dir, [pdir], problems, ["astar-likely"], False, 2.0, 3, w) for w in (1.0, 2.5)]
+    assert settings[0]["risk_weight"] == 1.0 and settings[0] != settings[1]
 
 
 def test_unknown_planner_lists_every_planner(tmp_path, run_dir):
-    with pytest.raises(ValueError, match="unknown planner 'ghost'; known: astar, astar-ucs, fast-downward, ") as info:
+    with pytest.raises(ValueError, match="unknown planner 'ghost'; known: astar, astar-ucs, astar-likely, fast-downward, ") as info:
         bench.benchmark(run_dir, tmp_path, ["astar", "ghost"], tmp_path / "b.json")
     msg = str(info.value)
     assert "\n" not in msg and all(name in msg for name in PLANNERS)
 
 
 def test_registry_holds_every_planner_and_is_immutable():
-    assert list(PLANNERS) == ["astar", "astar-ucs", "fast-downward", "symk", "pyperplan", "fast-downward-opt",
+    assert list(PLANNERS) == ["astar", "astar-ucs", "astar-likely", "fast-downward", "symk", "pyperplan", "fast-downward-opt",
                               "fast-downward-blind", "fast-downward-sas", "fast-downward-sas-opt", "symk-sas",
                               "symk-sas-topk", "fast-downward-sas-ms", "fast-downward-sas-lama",
                               "rules-astar", "rules-bfs"]
-    assert [n for n, s in PLANNERS.items() if not s.needs_rules] == ["astar", "astar-ucs"]
+    assert [n for n, s in PLANNERS.items() if not s.needs_rules] == ["astar", "astar-ucs", "astar-likely"]
     assert all(s.name == n and s.description for n, s in PLANNERS.items())
     with pytest.raises(TypeError):
         PLANNERS["mine"] = PLANNERS["astar"]  # type: ignore[index]
@@ -376,11 +399,25 @@ def test_registry_holds_every_planner_and_is_immutable():
 def test_make_planner_builds_and_refuses(tmp_path, run_dir):
     res = make_planner("astar-ucs")(LearnedTransition.from_run(run_dir), np.array([0]), SymbolicGoal((0,)), 2.0)
     assert res.planner == "astar-ucs" and res.found and res.plan == ()
+    m = LearnedTransition.from_run(run_dir)
+    start = np.array([0, 0])
+    nxt = m(np.repeat(start[None], 36, 0), np.arange(36))
+    moved = np.flatnonzero((nxt != start).any(1))
+    if len(moved):  # a goal one step away: the likely plan's log_p is that step's log P under the network
+        goal = tuple(int(c) for c in nxt[moved[0]])
+        res = make_planner("astar-likely")(m, start, SymbolicGoal(goal), 5.0)
+        assert res.planner == "astar-likely" and res.found and res.predicted_states[-1] == goal
+        _, nll = m.scored(np.array(res.predicted_states[:-1]), np.array(res.plan))
+        assert res.extra["log_p"] == pytest.approx(-nll.sum(), abs=1e-5)
     with pytest.raises(ValueError, match="plans on the exported rules, and none were given"):
         make_planner("fast-downward", PlannerContext())
     with pytest.raises(ValueError, match="no exported rules"):  # rules are read only when a planner needs them
         PlannerContext.for_run(tmp_path, ["astar", "symk-sas"])
     assert PlannerContext.for_run(tmp_path, ["astar", "astar-ucs"]).rules is None
+    assert PlannerContext.for_run(tmp_path, ["astar-likely"], risk_weight=3.0).risk_weight == 3.0
+    for bad in (0.0, -1.0, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="risk weight"):
+            PlannerContext(risk_weight=bad)
 
 
 def test_failure_stage_values_are_the_json_strings():
@@ -405,6 +442,12 @@ def test_cli_parses_planning_commands():
     assert a.planners == ["astar", "astar-ucs"] and a.closed_loop and a.func.__name__ == "cmd_benchmark"
     a = p.parse_args(["plan", "--run", "r", "--problem", "f.json", "--planner", "astar-ucs", "--timeout", "5"])
     assert a.planner == "astar-ucs" and a.timeout == 5.0 and not a.closed_loop and a.func.__name__ == "cmd_plan"
+    assert a.risk_weight == 1.0
+    a = p.parse_args(["plan", "--run", "r", "--problem", "f.json", "--planner", "astar-likely", "--risk-weight", "2"])
+    assert a.planner == "astar-likely" and a.risk_weight == 2.0
+    for bad in ("0", "-1", "nan"):
+        with pytest.raises(SystemExit):
+            p.parse_args(["benchmark", "--run", "r", "--problems", "d", "--out", "o", "--risk-weight", bad])
     a = p.parse_args(["train-transition", "--run", "r", "--data", "d", "--preset", "quick", "--epochs", "4"])
     assert (a.preset, a.epochs, a.seed) == ("quick", 4, 0) and a.func.__name__ == "cmd_train_transition"
 

@@ -24,7 +24,7 @@ import math
 import sys
 from pathlib import Path
 
-from symlearn.cli.args import int_range, non_negative_int, planner_list, positive_int
+from symlearn.cli.args import int_range, non_negative_int, planner_list, positive_finite_float, positive_int
 
 
 MAX_TIMEOUT_S = 86_400.0  # one day: larger values are typos, and the SAS+ planners need a finite limit
@@ -119,7 +119,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     _set_threads(args)
     problem = load_problem(Path(args.problem))
     write_dir = path_under(Path(args.run) / "pddl" / "problems", problem.name)  # the name is checked at load
-    fn = make_planners([args.planner], Path(args.run), write_dir=write_dir)[args.planner]
+    fn = make_planners([args.planner], Path(args.run), write_dir=write_dir, risk_weight=args.risk_weight)[args.planner]
     encoder, _ = load_effect_model(Path(args.run))
     transition = LearnedTransition.from_run(Path(args.run))
     cfg = ExecutionConfig(closed_loop=args.closed_loop, max_replans=args.max_replans, timeout_s=args.timeout)
@@ -150,7 +150,7 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
     _set_threads(args)
     res = benchmark(Path(args.run), args.problems, args.planners, Path(args.out), closed_loop=args.closed_loop,
                     timeout_s=args.timeout, max_replans=args.max_replans, show_progress=not args.quiet,
-                    record_dir=Path(args.record) if args.record else None)
+                    record_dir=Path(args.record) if args.record else None, risk_weight=args.risk_weight)
     print(format_table(res))
     print()
     print(format_grid(res["grid"]))
@@ -219,6 +219,8 @@ def _add_execution_flags(c: argparse.ArgumentParser) -> None:
     # search-time inference runs the networks on small batches, many times slower on 2 threads than on 1 when
     # another busy process shares the cores (docs/BENCHMARKS.md), so one thread unless asked for more
     c.add_argument("--threads", type=positive_int, default=1, help="torch CPU threads for the networks (default 1)")
+    c.add_argument("--risk-weight", type=positive_finite_float, default=1.0,
+                   help="astar-likely only: each action costs 1 + W * (-log P(its predicted next state)) (default 1)")
 
 
 def add_plan_command(sub) -> None:

@@ -25,7 +25,7 @@ from typing import Sequence
 from pddl_export.files import finite_or_null
 from pddl_export.rules_io import PDDL_DIR, RULES_FILE
 from symlearn.planning.execution import ExecutionConfig, ProblemRun, failure_causes, run_problem
-from symlearn.planning.planners import make_planners
+from symlearn.planning.planners import RISK_PLANNER, make_planners
 from symlearn.planning.problem import RANDOM_WALK, Problem, load_problems
 from symlearn.planning.recording import PlanRecorder
 from symlearn.provenance import atomic_write_json, atomic_write_text, sha256_bytes, sha256_file, versions
@@ -235,7 +235,7 @@ def load_sets(sets: Sequence[Path]) -> list[SetProblem]:
 
 
 def _settings(run_dir: Path, sets: list[Path], problems: list[SetProblem], planners: list[str], closed_loop: bool,
-              timeout_s: float, max_replans: int) -> dict:
+              timeout_s: float, max_replans: int, risk_weight: float = 1.0) -> dict:
     """What a benchmark's result depends on: a partial run resumes only under the very same settings."""
     from symlearn.planning.planners import planner_spec
     from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
@@ -243,12 +243,15 @@ def _settings(run_dir: Path, sets: list[Path], problems: list[SetProblem], plann
     rules = run_dir / PDDL_DIR / RULES_FILE
     needs_rules = any(planner_spec(n).needs_rules for n in planners)
     folders = [str(d.resolve()) for d in sets]
-    return {"run": str(run_dir.resolve()), "problems": folders[0] if len(folders) == 1 else folders,
-            "planners": list(planners), "closed_loop": closed_loop, "timeout_s": timeout_s,
-            "max_replans": max_replans, "transition_sha256": sha256_file(run_dir / TRANSITION_FILE)[:16],
-            "rules_sha256": sha256_file(rules)[:16] if needs_rules else None,
-            "problems_sha256": sha256_bytes(b"".join(sha256_bytes(p.path.read_bytes()).encode()
-                                                     for p in problems))[:16]}
+    out = {"run": str(run_dir.resolve()), "problems": folders[0] if len(folders) == 1 else folders,
+           "planners": list(planners), "closed_loop": closed_loop, "timeout_s": timeout_s,
+           "max_replans": max_replans, "transition_sha256": sha256_file(run_dir / TRANSITION_FILE)[:16],
+           "rules_sha256": sha256_file(rules)[:16] if needs_rules else None,
+           "problems_sha256": sha256_bytes(b"".join(sha256_bytes(p.path.read_bytes()).encode()
+                                                    for p in problems))[:16]}
+    if RISK_PLANNER in planners:  # only then does the weight change a result
+        out["risk_weight"] = risk_weight
+    return out
 
 
 class _first_call_kept:
@@ -328,7 +331,7 @@ def _run_rows(run_dir: Path, problems: list[SetProblem], fns: dict, log: RowLog,
 
 def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners: list[str], out_file: Path,
               closed_loop: bool = False, timeout_s: float = 30.0, max_replans: int = 3,
-              show_progress: bool = True, record_dir: Path | None = None) -> dict:
+              show_progress: bool = True, record_dir: Path | None = None, risk_weight: float = 1.0) -> dict:
     """Plan and execute every problem with every planner (closed loop too if asked); write out_file.
 
     problems_dir is one problem folder or several (see problem_sets): with several, each row's key and
@@ -336,16 +339,18 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
     once; a run interrupted (killed) and started again with the same settings resumes there, and its
     final JSON equals an uninterrupted run's (its timings aside). The log is removed once out_file is
     written. With record_dir, each failed open-loop run is saved as record_dir/<problem>_<planner>.gif.
+    risk_weight is astar-likely's (symlearn.planning.planners.PlannerContext), recorded when it plans.
     """
     if not planners:
         raise ValueError("no planners given")
     if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
         raise ValueError(f"timeout {timeout_s!r} must be a finite positive number of seconds")
     run_dir, out_file = Path(run_dir), Path(out_file)
-    fns = make_planners(list(planners), run_dir)  # refuses unknown names (and missing or stale rules) first
+    # refuses unknown names (and missing or stale rules) first
+    fns = make_planners(list(planners), run_dir, risk_weight=risk_weight)
     sets = problem_sets(problems_dir)
     problems = load_sets(sets)
-    settings = _settings(run_dir, sets, problems, list(planners), closed_loop, timeout_s, max_replans)
+    settings = _settings(run_dir, sets, problems, list(planners), closed_loop, timeout_s, max_replans, risk_weight)
     t0 = time.perf_counter()
     out_file.parent.mkdir(parents=True, exist_ok=True)
     log = RowLog(rows_path(out_file), settings)
@@ -357,7 +362,9 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
         log.close()
     result = {"run": str(run_dir), "problems": str(sets[0]) if len(sets) == 1 else [str(d) for d in sets],
               "n_problems": len(problems), "planners": list(planners), "closed_loop": closed_loop,
-              "timeout_s": timeout_s, "max_replans": max_replans, "transition_sha256": settings["transition_sha256"],
+              "timeout_s": timeout_s, "max_replans": max_replans,
+              **({"risk_weight": risk_weight} if "risk_weight" in settings else {}),
+              "transition_sha256": settings["transition_sha256"],
               "problems_sha256": settings["problems_sha256"],
               "versions": versions(), "wall_time_s": round(time.perf_counter() - t0, 2),
               "summary": summarize_rows(rows), "grid": summary_grid(rows),

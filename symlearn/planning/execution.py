@@ -117,18 +117,34 @@ class ObservedTransitions:
 
     def __call__(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
         out = np.array(self.inner(codes, actions), np.int64)
+        for i, nxt in self._observed_rows(codes, actions):
+            out[i] = nxt
+        return out
+
+    def scored(self, codes: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The inner model's scored predictions; an observed step is answered from memory with -log P = 0."""
+        if not callable(getattr(self.inner, "scored", None)):
+            raise ValueError(f"{type(self.inner).__name__} does not score its predictions")
+        out, nll = self.inner.scored(codes, actions)
+        out, nll = np.array(out, np.int64), np.array(nll, np.float64)
+        for i, nxt in self._observed_rows(codes, actions):
+            out[i], nll[i] = nxt, 0.0
+        return out, nll
+
+    def _observed_rows(self, codes: np.ndarray, actions: np.ndarray) -> list[tuple[int, tuple[int, ...]]]:
+        """(row, observed next state) for every row whose (state, action) execution has seen."""
         if not self.seen or len(codes) == 0:
-            return out
+            return []
         codes, actions = np.asarray(codes), np.asarray(actions)
         states, inverse = np.unique(codes, axis=0, return_inverse=True)  # an A* expansion: one state
+        rows = []
         for j, state in enumerate(states.tolist()):
             known = self.seen.get(tuple(state))
             if not known:
                 continue
-            rows = np.flatnonzero((inverse.reshape(-1) == j) & np.isin(actions, list(known)))
-            for i in rows:
-                out[i] = known[int(actions[i])]
-        return out
+            hit = np.flatnonzero((inverse.reshape(-1) == j) & np.isin(actions, list(known)))
+            rows += [(int(i), known[int(actions[i])]) for i in hit]
+        return rows
 
 
 def _codes(sim, encoder) -> tuple[int, ...]:

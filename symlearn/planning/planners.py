@@ -6,7 +6,8 @@ timeout_s) -> PlanResult from a PlannerContext. The registry is built once and c
 changed at run time; `make_planner(name, context)` is the one way to get a planner function.
 
 The learned-net A* ("astar", greedy-ish with the mismatch heuristic) and its uniform-cost
-variant ("astar-ucs", shortest plans) search with the transition network. The classical
+variant ("astar-ucs", shortest plans) search with the transition network; "astar-likely" charges
+each action the network's -log P of its prediction too, preferring plans it is sure of. The classical
 planners write the problem for the start and goal codes (and, for STRIPS-only planners, the
 grounded STRIPS form of the domain for this problem) and call the planner through
 unified-planning (search.classical), or, for the `-sas` planners, write the rules for this
@@ -22,6 +23,7 @@ marked `rules_vs_net`. PDDL writing time and the planner's own time are reported
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 import types
 from dataclasses import dataclass
@@ -57,16 +59,23 @@ class PlannerContext:
     rules: RuleSet | None = None  # RUN/pddl/rules.json, needed by every spec with needs_rules
     model_hash: str = ""  # the transition model's hash recorded with the rules
     write_dir: Path | None = None  # save every problem/task a planner writes here (None: keep nothing)
+    risk_weight: float = 1.0  # astar-likely: an action costs 1 + risk_weight * (-log P(its predicted next state))
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.risk_weight, (int, float)) and math.isfinite(self.risk_weight)
+                and self.risk_weight > 0):
+            raise ValueError(f"risk weight {self.risk_weight!r} must be a finite number > 0")
 
     @staticmethod
-    def for_run(run_dir: Path, names: list[str], write_dir: Path | None = None) -> "PlannerContext":
+    def for_run(run_dir: Path, names: list[str], write_dir: Path | None = None,
+                risk_weight: float = 1.0) -> "PlannerContext":
         """A context for the named planners of a run: loads RUN/pddl/rules.json only when one of them needs it."""
         specs = [planner_spec(n) for n in names]  # refuse unknown names before reading anything
         if not any(s.needs_rules for s in specs):
-            return PlannerContext(write_dir=write_dir)
+            return PlannerContext(write_dir=write_dir, risk_weight=risk_weight)
         rules, model_hash = load_rules(Path(run_dir))
         check_rules_current(Path(run_dir), model_hash)
-        return PlannerContext(rules=rules, model_hash=model_hash, write_dir=write_dir)
+        return PlannerContext(rules=rules, model_hash=model_hash, write_dir=write_dir, risk_weight=risk_weight)
 
 
 def check_rules_current(run_dir: Path, model_hash: str) -> None:
@@ -102,6 +111,15 @@ def _astar(transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, time
 
 def _astar_ucs(transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
     return plan_symbolic(transition, start, goal, timeout_s=timeout_s, uniform_cost=True, planner_name="astar-ucs")
+
+
+RISK_PLANNER = "astar-likely"  # the one planner whose plans depend on PlannerContext.risk_weight
+
+
+def _astar_likely(risk_weight: float, transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal,
+                  timeout_s: float) -> PlanResult:
+    return plan_symbolic(transition, start, goal, timeout_s=timeout_s, risk_weight=risk_weight,
+                         planner_name=RISK_PLANNER)
 
 
 # ------------------------------------------------------------------------------- planners on the exported rules
@@ -286,7 +304,10 @@ def _build_rules_planner(name: str, context: PlannerContext) -> PlannerFn:
 
 def _registry() -> Mapping[str, PlannerSpec]:
     specs = [PlannerSpec("astar", "learned-net A* with the mismatch heuristic", False, lambda _: _astar),
-             PlannerSpec("astar-ucs", "learned-net uniform-cost search (shortest plans)", False, lambda _: _astar_ucs)]
+             PlannerSpec("astar-ucs", "learned-net uniform-cost search (shortest plans)", False, lambda _: _astar_ucs),
+             PlannerSpec(RISK_PLANNER, "learned-net A*, each action costing 1 - w log P(its prediction): "
+                         "the plans most likely to unfold as predicted", False,
+                         lambda context: partial(_astar_likely, context.risk_weight))]
     specs += [PlannerSpec(n, desc, True, partial(_build_rules_planner, n)) for n, (_, _, desc) in _RULES_PLANNERS.items()]
     return types.MappingProxyType({s.name: s for s in specs})
 
@@ -306,7 +327,8 @@ def make_planner(name: str, context: PlannerContext = PlannerContext()) -> Plann
     return planner_spec(name).build(context)
 
 
-def make_planners(names: list[str], run_dir: Path, write_dir: Path | None = None) -> dict[str, PlannerFn]:
+def make_planners(names: list[str], run_dir: Path, write_dir: Path | None = None,
+                  risk_weight: float = 1.0) -> dict[str, PlannerFn]:
     """name -> planner function for a run (its rules loaded once, only if needed); every name is checked first."""
-    context = PlannerContext.for_run(run_dir, names, write_dir)
+    context = PlannerContext.for_run(run_dir, names, write_dir, risk_weight)
     return {name: make_planner(name, context) for name in names}
