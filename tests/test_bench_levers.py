@@ -51,3 +51,35 @@ def test_levers_summary_reads_runs_and_refuses_an_empty_folder(tiny_run, tmp_pat
     (tmp_path / "empty").mkdir()
     assert ls.main([str(tmp_path / "empty"), "--out", str(tmp_path / "x.json")]) == 2
     assert "no run folders" in capsys.readouterr().err
+
+
+def test_calibration_of_perfect_and_of_uninformative_probabilities():
+    tc = _load("transition_calibration")
+    right = np.array([True] * 6 + [False] * 4)
+    # right predictions said to be certain, wrong ones impossible: separated and calibrated
+    sure = tc.calibration(np.where(right, 1.0, 0.0), right)
+    assert sure["auc"] == 1.0 and sure["expected_calibration_error"] == 0.0
+    assert sure["accuracy_most_probable_half"] == 1.0 and sure["accuracy_least_probable_half"] == 0.2
+    # one probability for all: no ranking (AUC 0.5), off by |0.9 - 0.6| on average
+    flat = tc.calibration(np.full(10, 0.9), right)
+    assert flat["auc"] == 0.5 and flat["expected_calibration_error"] == pytest.approx(0.3)
+    assert flat["reliability"] == [{"p": [0.9, 1.0], "n": 10, "mean_p": 0.9, "accuracy": 0.6}]
+    assert tc.calibration(np.full(3, 0.5), np.ones(3, bool))["auc"] is None  # one class: no AUC
+
+
+def test_rollout_scores_on_a_trained_run(tiny_run):
+    from symlearn.data.dataset import load_split
+    from symlearn.learning.checkpoint import load_effect_model
+    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, load_transition
+    from symlearn.symbolic.transition_data import build_transition_data
+    from symlearn.symbolic.transition_metrics import rollout_accuracy
+
+    tc = _load("transition_calibration")
+    encoder, _ = load_effect_model(tiny_run.path)
+    net, _ = load_transition(tiny_run.path / TRANSITION_FILE)
+    data = build_transition_data(encoder, load_split(tiny_run.data, "test"), 64)
+    for n in (1, 2):
+        p, right = tc.rollout_scores(net, data, n)
+        assert p.shape == right.shape and len(p) > 0 and ((p > 0) & (p <= 1)).all()
+        # the same rollouts as the rollout accuracy m(z) reports
+        assert right.mean() == pytest.approx(rollout_accuracy(net, data, n)["scene_accuracy"], abs=1e-5)
