@@ -24,7 +24,7 @@ from pddl_export.rules import Rule, RuleSet
 from pddl_export.sas_writer import SASEncoder
 from pddl_export.symbolic import SymbolicGoal
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig
-from symlearn.planning.problem import GOAL_TOLERANCE_M, load_problem
+from symlearn.planning.problem import GOAL_TOLERANCE_M, load_problem, load_problems
 from symlearn.planning.problem_generation import generate_problems
 from symlearn.planning.scenes import goal_codes, scene_codes
 from pddl_export.files import sha256_file
@@ -361,6 +361,18 @@ def test_benchmark_writes_summary_and_rows(tmp_path, sim, run_dir, problems):
     assert {r["closed_loop"] for r in saved["rows"]} == {False, True}
     assert "astar-ucs" in bench.format_table(res)
     assert "risk_weight" not in saved  # no planner here depends on it
+    # every row knows how many goal objects lie off the locations; the split adds up to the problems
+    offs = {r["problem"]: r["goal_off_locations"] for r in saved["rows"]}
+    assert offs == {pr.name: pr.goal_off_locations for _, pr in load_problems(pdir)}
+    for name in ("astar", "astar-ucs"):
+        parts = saved["goal_placement"][name]
+        assert sum(c["n_problems"] for c in parts.values()) == 2
+        for key, c in parts.items():
+            mine = [r for r in saved["rows"] if r["planner"] == name and r["closed_loop"]
+                    and (r["goal_off_locations"] > 0) == (key == "off_locations")]
+            assert c["success_rate_closed_loop"] == pytest.approx(np.mean([r["success"] for r in mine]), abs=1e-4)
+            assert sum(c["closed_loop_failure_causes"].values()) == sum(not r["success"] for r in mine)
+    assert bench.format_goal_placement(res).startswith("astar: success open/closed, goals o")
 
 
 def test_benchmark_records_the_risk_weight_of_astar_likely(tmp_path, sim, run_dir):

@@ -178,3 +178,19 @@ def test_problem_validation_fails_on_purpose(problem_dir):
         Problem(pr.name, pr.seed, pr.spec, Scene(), pr.actions, pr.goal)
     with pytest.raises(ValueError, match="objects"):
         Problem(pr.name, pr.seed, (), Scene(), pr.actions, Scene())
+
+
+def test_goal_off_locations_counts_judged_objects_away_from_every_location():
+    from symlearn.planning.problem import ON_LOCATION_M
+    from symlearn.world import LOCATIONS, ObjectState
+
+    def problem(dy: float, free: tuple[int, ...] = ()) -> Problem:
+        """Two cubes on locations 3 and 4; in the goal on locations 0 and 1, cube 0 shifted sideways by dy."""
+        at = lambda loc, d=0.0: ObjectState(ObjectType.CUBE, (LOCATIONS[loc][0], LOCATIONS[loc][1] + d, 0.425))
+        return Problem("p", 0, ((ObjectType.CUBE, 3), (ObjectType.CUBE, 4)), Scene((at(3), at(4))), (0,),
+                       Scene((at(0, dy), at(1))), free=free)
+
+    assert problem(0.0).goal_off_locations == 0
+    assert problem(ON_LOCATION_M - 0.01).goal_off_locations == 0
+    assert problem(-(ON_LOCATION_M + 0.01)).goal_off_locations == 1  # 6 cm from location 0, 24 cm from 1
+    assert problem(-(ON_LOCATION_M + 0.01), free=(0,)).goal_off_locations == 0  # a free object is not judged

@@ -144,7 +144,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 
 def cmd_benchmark(args: argparse.Namespace) -> int:
-    from symlearn.planning.benchmark import benchmark, format_table
+    from symlearn.planning.benchmark import benchmark, format_goal_placement, format_table
     from symlearn.planning.benchmark_plots import format_grid, write_plots
 
     _set_threads(args)
@@ -152,6 +152,7 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
                     timeout_s=args.timeout, max_replans=args.max_replans, show_progress=not args.quiet,
                     record_dir=Path(args.record) if args.record else None, risk_weight=args.risk_weight)
     print(format_table(res))
+    print(format_goal_placement(res))
     print()
     print(format_grid(res["grid"]))
     print(f"wrote {args.out}")

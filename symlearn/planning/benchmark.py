@@ -122,6 +122,26 @@ def summary_failure_causes(rows: list[ProblemRun]) -> dict:
     return out
 
 
+def summary_goal_placement(rows: list[ProblemRun]) -> dict:
+    """planner -> "on_locations"/"off_locations" -> n, open and closed success, closed-loop failure causes.
+
+    A goal with an object off the table locations (Problem.goal_off_locations) asks for a pose that symbols of
+    place and level cannot name; success there and elsewhere are kept apart. Rows without the count are left out.
+    """
+    out: dict = {}
+    for planner in dict.fromkeys(r.planner for r in rows):
+        mine = [r for r in rows if r.planner == planner and r.goal_off_locations is not None]
+        for name, off in (("on_locations", False), ("off_locations", True)):
+            part = [r for r in mine if (r.goal_off_locations > 0) == off]
+            opened, closed = [r for r in part if not r.closed_loop], [r for r in part if r.closed_loop]
+            if part:
+                out.setdefault(planner, {})[name] = {
+                    "n_problems": len(opened or closed), "success_rate": _rate(opened, "success"),
+                    "success_rate_closed_loop": _rate(closed, "success"),
+                    "closed_loop_failure_causes": failure_causes(closed) if closed else None}
+    return out
+
+
 def summary_tasks(rows: list[ProblemRun]) -> dict:
     """planner -> "open"/"closed" -> structure-suite task -> cell; random-walk problems are left to the grid."""
     out: dict = {}
@@ -369,11 +389,27 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
               "versions": versions(), "wall_time_s": round(time.perf_counter() - t0, 2),
               "summary": summarize_rows(rows), "grid": summary_grid(rows),
               "failure_causes": summary_failure_causes(rows), "tasks": summary_tasks(rows),
+              "goal_placement": summary_goal_placement(rows),
               "rows": [r.to_json() for r in rows]}
     result = finite_or_null(result)
     atomic_write_json(out_file, result)
     log.path.unlink()
     return result
+
+
+def format_goal_placement(result: dict) -> str:
+    """One line per planner: success on goals every object of which rests on a table location, and on the rest."""
+    lines = []
+    for planner, parts in result.get("goal_placement", {}).items():
+        cells = []
+        for name, label in (("on_locations", "goals on the locations"), ("off_locations", "goals off them")):
+            c = parts.get(name)
+            if c:
+                rates = "/".join("-" if v is None else f"{v:.3f}" for v in (c["success_rate"],
+                                                                             c["success_rate_closed_loop"]))
+                cells.append(f"{label} {rates} ({c['n_problems']})")
+        lines.append(f"{planner}: success open/closed, " + "; ".join(cells))
+    return "\n".join(lines)
 
 
 def format_table(result: dict) -> str:
