@@ -83,3 +83,18 @@ def test_rollout_scores_on_a_trained_run(tiny_run):
         assert p.shape == right.shape and len(p) > 0 and ((p > 0) & (p <= 1)).all()
         # the same rollouts as the rollout accuracy m(z) reports
         assert right.mean() == pytest.approx(rollout_accuracy(net, data, n)["scene_accuracy"], abs=1e-5)
+
+
+def test_goal_placement_split_by_objects_and_placement():
+    gp = _load("goal_placement")
+    row = lambda p, k, loop, ok, cause=None: {"problem": p, "planner": "astar", "n_objects": k,  # noqa: E731
+                                               "closed_loop": loop, "success": ok, "failure_cause": cause}
+    rows = [row("a", 2, False, True), row("a", 2, True, True),
+            row("b", 3, False, False, "departure"), row("b", 3, True, False, "symbol_aliasing"),
+            row("c", 5, False, False, "timeout"), row("c", 5, True, True)]
+    out = gp.split(rows, {"a": 0, "b": 1, "c": 0})["astar"]
+    assert out["1-3 objects"]["on_locations"] == {"n_problems": 1, "success_rate": 1.0,
+                                                  "success_rate_closed_loop": 1.0, "closed_loop_failure_causes": {}}
+    assert out["1-3 objects"]["off_locations"]["closed_loop_failure_causes"] == {"symbol_aliasing": 1}
+    assert out["4-5 objects"]["on_locations"]["success_rate"] == 0.0
+    assert out["4-5 objects"]["off_locations"]["n_problems"] == 0
