@@ -170,6 +170,12 @@ def test_report_symbols_benchmark_and_data_equal_their_sources(report, tiny_run)
     s = bench["summary"]["astar"]
     assert (int(brow[0]), float(brow[1]), float(brow[2])) == (s["n_problems"], s["success_rate"], s["found_rate"])
     assert float(brow[3]) == pytest.approx(s["median_time_s"], abs=5e-4)
+    placed = [r for r in p.tables["goal_placement"][1:]]  # (planner, goals, problems, success, closed-loop success)
+    parts = bench["goal_placement"]["astar"]
+    assert sorted(r[1] for r in placed) == sorted(k.replace("_", " ") for k in parts)
+    assert sum(int(r[2]) for r in placed) == s["n_problems"]
+    for r in placed:
+        assert float(r[3]) == pytest.approx(parts[r[1].replace(" ", "_")]["success_rate"], abs=5e-4)
     summary, shares = summarize(tiny_run.data), object_shares(load_split(tiny_run.data, "all"))
     data = _rows(p, "data")
     assert data["path"][0] == str(tiny_run.data)  # found through RUN/config.json

@@ -173,10 +173,17 @@ def benchmark_section(bench: dict | None, why: str = "") -> Section:
                   s.get("success_rate_closed_loop"), s.get("mean_plan_length"))
                  for name, s in (bench.get("summary") or {}).items())
     text = [f"{bench.get('n_problems')} problems from {bench.get('problems')}, timeout {bench.get('timeout_s')} s"]
-    return Section("benchmark", title, text=text,
-                   tables=[Table("Success per planner", ("planner", "problems", "success", "found", "median time (s)",
-                                                         "closed-loop success", "mean plan length"), rows,
-                                 key="benchmark")])
+    tables = [Table("Success per planner", ("planner", "problems", "success", "found", "median time (s)",
+                                            "closed-loop success", "mean plan length"), rows, key="benchmark")]
+    placement = tuple((name, part.replace("_", " "), c.get("n_problems"), c.get("success_rate"),
+                       c.get("success_rate_closed_loop"))
+                      for name, parts in (bench.get("goal_placement") or {}).items() for part, c in parts.items())
+    if placement:  # benchmarks written before the split have none
+        tables.append(Table("Success on goals whose objects all rest on table locations, and on the rest "
+                            "(a stick left across two places cannot be named by the symbols)",
+                            ("planner", "goals", "problems", "success", "closed-loop success"), placement,
+                            key="goal_placement"))
+    return Section("benchmark", title, text=text, tables=tables)
 
 
 def plan_section(filmstrip: Path | None, gif: Path | None) -> Section:
