@@ -123,7 +123,8 @@ def plan_symbolic(
     def successors(state: State) -> list[tuple[int, State, float]]:
         out = []
         for a, nxt, nll in (first if state == start and first else scored_successors(transition, state, scored)):
-            step_nll[state, a] = nll
+            if scored:  # kept for the plan's log_p; unit-cost search needs none of it
+                step_nll[state, a] = nll
             out.append((a, nxt, 1.0 + risk_weight * nll))
         return out
 
