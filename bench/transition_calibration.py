@@ -48,17 +48,10 @@ def calibration(p: np.ndarray, right: np.ndarray) -> dict:
 
 def rollout_scores(net, data, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Probability of each n-step rollout along a test episode and whether its final scene is right."""
-    from symlearn.symbolic.transition_metrics import rollout_chains
-    from symlearn.symbolic.transition_model import predict_scored
+    from symlearn.symbolic.transition_metrics import rollout
 
-    chains = rollout_chains(data, n)
-    mask = data.mask[chains[:, 0]]
-    state, nll = data.before[chains[:, 0]], np.zeros(len(chains))
-    for j in range(n):
-        state, step = predict_scored(net, state, mask, data.action[chains[:, j]])
-        nll += step
-    truth = data.after[chains[:, -1]]
-    right = ((state == truth).all(-1) | ~mask).all(-1)
+    chains, state, nll = rollout(net, data, n)
+    right = ((state == data.after[chains[:, -1]]).all(-1) | ~data.mask[chains[:, 0]]).all(-1)
     return np.exp(-nll), right
 
 

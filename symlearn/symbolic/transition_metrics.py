@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from symlearn.symbolic.transition_data import TransitionData
-from symlearn.symbolic.transition_model import TransitionNet, predict_bits
+from symlearn.symbolic.transition_model import TransitionNet, predict_bits, predict_scored
 
 ROLLOUT_STEPS = 8  # multi-step accuracy is reported for 1..ROLLOUT_STEPS actions (the depth benchmark goes to 8)
 
@@ -43,16 +43,24 @@ def rollout_chains(data: TransitionData, n: int) -> np.ndarray:
     return np.asarray(chains, np.int64).reshape(-1, n)
 
 
+def rollout(net: TransitionNet, data: TransitionData, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """m(z) rolled n actions along every n-step run of an episode: chains (M, n), predicted codes (M, K, bits)
+    after the last action, and each rollout's -log P (M,), its steps scored on the predicted states they start from."""
+    chains = rollout_chains(data, n)
+    mask = data.mask[chains[:, 0]]
+    state, nll = data.before[chains[:, 0]], np.zeros(len(chains))
+    for j in range(n):
+        state, step = predict_scored(net, state, mask, data.action[chains[:, j]])
+        nll += step
+    return chains, state, nll
+
+
 def rollout_accuracy(net: TransitionNet, data: TransitionData, n: int) -> dict[str, float | int]:
     """Roll m(z) n actions forward from the encoder's codes at t; compare with the codes of the real state at t+n."""
-    chains = rollout_chains(data, n)
+    chains, state, _ = rollout(net, data, n)
     if len(chains) == 0:
         return {"object_accuracy": math.nan, "scene_accuracy": math.nan, "bit_accuracy": math.nan, "n": 0}
-    mask = data.mask[chains[:, 0]]
-    state = data.before[chains[:, 0]]
-    for j in range(n):
-        state = predict_bits(net, state, mask, data.action[chains[:, j]])
-    return accuracies(state, data.after[chains[:, -1]], mask)
+    return accuracies(state, data.after[chains[:, -1]], data.mask[chains[:, 0]])
 
 
 def evaluate_transition(net: TransitionNet, data: TransitionData) -> dict:
