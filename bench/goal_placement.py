@@ -19,21 +19,26 @@ import time
 from pathlib import Path
 
 
-def split(rows: list[dict], off: dict[str, int]) -> dict:
-    """planner -> objects group -> "on_locations"/"off_locations" -> n, success open / closed, failure causes."""
-    from symlearn.planning.execution import failure_causes
+EMPTY = {"n_problems": 0, "success_rate": None, "success_rate_closed_loop": None, "closed_loop_failure_causes": {}}
 
+
+def split(rows: list[dict], off: dict[str, int]) -> dict:
+    """planner -> objects group -> "on_locations"/"off_locations" -> n, success open / closed, failure causes.
+
+    Each group is summarised by the benchmark's own summary_goal_placement; a part without problems is EMPTY.
+    """
+    import dataclasses
+
+    from symlearn.planning.benchmark import summary_goal_placement
+    from symlearn.planning.execution import ProblemRun
+
+    runs = [dataclasses.replace(ProblemRun(**r), goal_off_locations=off[r["problem"]]) for r in rows]
     out: dict = {}
-    for planner in dict.fromkeys(r["planner"] for r in rows):
+    for planner in dict.fromkeys(r.planner for r in runs):
         for group, ks in (("1-3 objects", (1, 2, 3)), ("4-5 objects", (4, 5))):
-            for name, is_off in (("on_locations", False), ("off_locations", True)):
-                part = [r for r in rows if r["planner"] == planner and r["n_objects"] in ks
-                        and (off[r["problem"]] > 0) == is_off]
-                opened, closed = [r for r in part if not r["closed_loop"]], [r for r in part if r["closed_loop"]]
-                rate = lambda rs: round(sum(r["success"] for r in rs) / len(rs), 4) if rs else None  # noqa: E731
-                out.setdefault(planner, {}).setdefault(group, {})[name] = {
-                    "n_problems": len(opened or closed), "success_rate": rate(opened),
-                    "success_rate_closed_loop": rate(closed), "closed_loop_failure_causes": failure_causes(closed)}
+            parts = summary_goal_placement([r for r in runs if r.planner == planner and r.n_objects in ks])
+            out.setdefault(planner, {})[group] = {name: parts.get(planner, {}).get(name, EMPTY)
+                                                  for name in ("on_locations", "off_locations")}
     return out
 
 

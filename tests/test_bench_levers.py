@@ -87,8 +87,13 @@ def test_rollout_scores_on_a_trained_run(tiny_run):
 
 def test_goal_placement_split_by_objects_and_placement():
     gp = _load("goal_placement")
-    row = lambda p, k, loop, ok, cause=None: {"problem": p, "planner": "astar", "n_objects": k,  # noqa: E731
-                                               "closed_loop": loop, "success": ok, "failure_cause": cause}
+    def row(p, k, loop, ok, cause=None):  # a benchmark JSON row, as bench.benchmark writes them
+        return {"problem": p, "planner": "astar", "found": True, "status": "solved", "plan_length": 1,
+                "planning_time_s": 0.01, "expansions": 1, "success": ok, "symbolic_match": ok,
+                "max_distance_m": 0.0, "closed_loop": loop, "replans": 0,
+                "failure_stage": None if ok else "execution", "generator_length": 1, "n_objects": k,
+                "failure_cause": cause}
+
     rows = [row("a", 2, False, True), row("a", 2, True, True),
             row("b", 3, False, False, "departure"), row("b", 3, True, False, "symbol_aliasing"),
             row("c", 5, False, False, "timeout"), row("c", 5, True, True)]
