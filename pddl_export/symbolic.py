@@ -37,6 +37,18 @@ class ScoredTransitionFn(TransitionFn, Protocol):
         ...
 
 
+class OutcomeTransitionFn(TransitionFn, Protocol):
+    """A transition function whose bits are independent given the input, with each bit's probability.
+
+    The most likely next state thresholds them at 0.5; every other next state has a probability too,
+    which the all-outcomes planner (search.learned_astar, `astar-outcomes`) reads.
+    """
+
+    def bit_probabilities(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        """(B, K) int64 codes and (B,) action ids -> (B, K, bits) float P(each next bit is 1), MSB first."""
+        ...
+
+
 def code_str(code: int, bits: int) -> str:
     """Integer code -> its bit string, most significant bit first ('00011011')."""
     if not 0 <= int(code) < (1 << bits):

@@ -26,6 +26,15 @@ the world as predicted (m(z)'s confidence is calibrated on held-out steps: docs/
 The mismatch heuristic is then counted in cost units, times the median cost of the start's actions,
 so that the search stays as greedy as with unit costs. The result's extra["log_p"] is the plan's
 summed log-probability.
+
+All outcomes: with max_outcomes n > 1 (and w > 0), an action leads not only to the network's most
+likely next state but to each of its n most likely outcomes that is at least min_outcome_ratio times
+as likely, each costing 1 + w * (-log P(that outcome)): the all-outcomes determinization of
+FF-Replan (Yoon, Fern and Givan, ICAPS 2007), read from an OutcomeTransitionFn's bit probabilities.
+A goal that the network's most likely predictions never reach, but a likely enough other outcome
+does, then gets a plan; execution checks each step and replans when the world picks another outcome.
+The bits are independent given the input, so the n most likely outcomes are the likeliest state with
+subsets of its n - 1 least certain bits flipped (exact: any other flip is less likely than each of these).
 """
 from __future__ import annotations
 
@@ -35,7 +44,8 @@ import numpy as np
 
 from search.astar import astar, outcome_result
 from search.result import PlanResult
-from pddl_export.symbolic import N_ACTIONS, ScoredTransitionFn, SymbolicGoal, TransitionFn
+from pddl_export.symbolic import (N_ACTIONS, OutcomeTransitionFn, ScoredTransitionFn, SymbolicGoal, TransitionFn,
+                                  codes_from_bits)
 
 State = tuple[int, ...]
 
@@ -73,6 +83,47 @@ def scored_successors(transition: TransitionFn | ScoredTransitionFn, state: Stat
     return [(int(a), tuple(rows[a]), float(nll[a])) for a in moved]
 
 
+def likely_outcomes(probs: np.ndarray, max_outcomes: int, min_ratio: float) -> list[list[tuple[State, float]]]:
+    """Per row of (A, K, bits) bit probabilities: its most likely next states with their -log P, likeliest first.
+
+    At most max_outcomes per row, each at least min_ratio times as likely as the row's likeliest state
+    (which always comes first). Bits are independent, so flipping bit b multiplies P by q_b / (1 - q_b),
+    q_b the probability of the value it does not take in the likeliest state.
+    """
+    probs = np.asarray(probs, np.float64)
+    n_rows, k, bits = probs.shape
+    top = probs >= 0.5
+    q = np.where(top, 1.0 - probs, probs)  # each bit's chance of the other value
+    with np.errstate(divide="ignore"):
+        base = -np.log1p(-q).sum((1, 2))  # (A,) -log P(likeliest state)
+        flip = (np.log1p(-q) - np.log(q)).reshape(n_rows, k * bits)  # extra -log P of one flip, >= 0, inf if q=0
+    n_cand = min(max_outcomes - 1, k * bits)
+    cand = np.argsort(flip, axis=1, kind="stable")[:, :n_cand]  # (A, n_cand) the least certain bits
+    subsets = ((np.arange(1 << n_cand)[:, None] >> np.arange(n_cand)) & 1).astype(bool)  # (S, n_cand), [0] = none
+    extra = np.where(subsets[None], np.take_along_axis(flip, cand, 1)[:, None, :], 0.0).sum(-1)  # (A, S)
+    # each subset's flips as one XOR mask per object: candidates are distinct bits, so summing them is XOR
+    value = np.left_shift(1, bits - 1 - cand % bits)[..., None] * (cand[..., None] // bits == np.arange(k))  # (A, n_cand, K)
+    states = codes_from_bits(top)[:, None, :] ^ (subsets[None, :, :, None] * value[:, None]).sum(2)  # (A, S, K)
+    order = np.argsort(extra, axis=1, kind="stable")[:, :max_outcomes]  # (A, <= max_outcomes), likeliest first
+    nll = base[:, None] + np.take_along_axis(extra, order, 1)
+    keep = np.take_along_axis(extra, order, 1) <= -np.log(min_ratio)
+    picked = np.take_along_axis(states, order[..., None], 1).tolist()
+    return [[(tuple(picked[r][j]), float(nll[r, j])) for j in range(order.shape[1]) if keep[r, j]]
+            for r in range(n_rows)]
+
+
+def outcome_successors(transition: OutcomeTransitionFn, state: State, max_outcomes: int,
+                       min_ratio: float) -> list[tuple[int, State, float]]:
+    """(action, next_state, -log P) for each likely outcome of each action that changes state; one batched call."""
+    batch = np.repeat(np.asarray(state, np.int64)[None], N_ACTIONS, 0)  # (36, K)
+    bits = int(transition.bits)
+    probs = np.asarray(transition.bit_probabilities(batch, np.arange(N_ACTIONS, dtype=np.int64)), np.float64)
+    if probs.shape != (N_ACTIONS, len(state), bits) or not np.all((probs >= 0) & (probs <= 1)):
+        raise ValueError(f"bit probabilities must be (36, {len(state)}, {bits}) in [0, 1], got shape {probs.shape}")
+    return [(a, nxt, nll) for a, row in enumerate(likely_outcomes(probs, max_outcomes, min_ratio))
+            for nxt, nll in row if nxt != state]
+
+
 def plan_symbolic(
     transition: TransitionFn,
     start_codes: np.ndarray,
@@ -82,11 +133,14 @@ def plan_symbolic(
     timeout_s: float = 30.0,
     uniform_cost: bool = False,
     risk_weight: float = 0.0,
+    max_outcomes: int = 1,
+    min_outcome_ratio: float = 0.05,
     planner_name: str = "astar",
 ) -> PlanResult:
     """Plan from start_codes (K,) to a (partial) goal; one batched transition call per expansion.
 
-    risk_weight > 0 charges each action w * (-log P) on top of its unit cost (module docstring).
+    risk_weight > 0 charges each action w * (-log P) on top of its unit cost; max_outcomes > 1 also
+    branches on each action's other likely outcomes (module docstring).
     """
     t0 = time.perf_counter()
     bits = int(transition.bits)
@@ -105,35 +159,54 @@ def plan_symbolic(
     if scored and not callable(getattr(transition, "scored", None)):
         raise ValueError(f"risk_weight {risk_weight} needs a transition that scores its predictions "
                          f"(a `scored` method); {type(transition).__name__} has none")
+    if not (isinstance(max_outcomes, (int, np.integer)) and max_outcomes >= 1):
+        raise ValueError(f"max_outcomes must be an integer >= 1, got {max_outcomes!r}")
+    if not 0 < min_outcome_ratio <= 1:
+        raise ValueError(f"min_outcome_ratio must lie in (0, 1], got {min_outcome_ratio}")
+    if max_outcomes > 1 and not scored:
+        raise ValueError("max_outcomes > 1 needs risk_weight > 0: unlikely outcomes must cost their improbability")
+    if max_outcomes > 1 and not callable(getattr(transition, "bit_probabilities", None)):
+        raise ValueError(f"max_outcomes {max_outcomes} needs a transition with bit probabilities "
+                         f"(a `bit_probabilities` method); {type(transition).__name__} has none")
     fixed = [(i, c) for i, c in enumerate(goal.codes) if c is not None]
-    step_nll: dict[tuple[State, int], float] = {}
+    step_nll: dict[tuple[State, int, State], float] = {}
+
+    def expand(state: State) -> list[tuple[int, State, float]]:
+        if max_outcomes > 1:
+            return outcome_successors(transition, state, max_outcomes, min_outcome_ratio)  # type: ignore[arg-type]
+        return scored_successors(transition, state, scored)
 
     def is_goal(state: State) -> bool:
         return all(state[i] == c for i, c in fixed)
 
     start = tuple(start_arr.tolist())
-    first = scored_successors(transition, start) if scored and not is_goal(start) else []
+    first = expand(start) if scored and not is_goal(start) else []
     # With risk, an action costs more than 1, so h is put in cost units (the median cost of the start's
     # actions); else A* would fall back towards breadth-first order and run out of time on bigger scenes.
-    scale = float(np.median([1.0 + risk_weight * nll for *_, nll in first])) if first else 1.0
+    likeliest: dict[int, float] = {}  # action -> -log P of its likeliest outcome (the only one unless max_outcomes > 1)
+    for a, _, nll in first:
+        likeliest[a] = min(nll, likeliest.get(a, np.inf))
+    scale = float(np.median([1.0 + risk_weight * nll for nll in likeliest.values()])) if first else 1.0
 
     def heuristic(state: State) -> float:
         return scale * sum(state[i] != c for i, c in fixed)
 
     def successors(state: State) -> list[tuple[int, State, float]]:
         out = []
-        for a, nxt, nll in (first if state == start and first else scored_successors(transition, state, scored)):
+        for a, nxt, nll in (first if state == start and first else expand(state)):
             if scored:  # kept for the plan's log_p; unit-cost search needs none of it
-                step_nll[state, a] = nll
+                step_nll[state, a, nxt] = nll
             out.append((a, nxt, 1.0 + risk_weight * nll))
         return out
 
     out = astar(start, is_goal, successors, heuristic,
                 max_expansions=max_expansions, timeout_s=timeout_s, uniform_cost=uniform_cost)
     extra: dict = {"uniform_cost": uniform_cost, "risk_weight": risk_weight}
+    if max_outcomes > 1:
+        extra.update(max_outcomes=max_outcomes, min_outcome_ratio=min_outcome_ratio)
     if scored:
         extra["heuristic_scale"] = round(scale, 6)
     if scored and out.states:
-        extra["log_p"] = round(-sum(step_nll[s, a] for s, a in zip(out.states, out.actions)), 6)
+        extra["log_p"] = round(-sum(step_nll[s, a, n] for s, a, n in zip(out.states, out.actions, out.states[1:])), 6)
     return outcome_result(out, planner_name, t0, timeout_s, f"max_expansions={max_expansions}",
                           f"the {out.expansions} reachable states", extra)

@@ -103,3 +103,29 @@ def test_goal_placement_split_by_objects_and_placement():
     assert out["1-3 objects"]["off_locations"]["closed_loop_failure_causes"] == {"symbol_aliasing": 1}
     assert out["4-5 objects"]["on_locations"]["success_rate"] == 0.0
     assert out["4-5 objects"]["off_locations"]["n_problems"] == 0
+
+
+class _Coin:
+    """One object, 2 bits: action 0 sets the low bit with P 0.3 (the likeliest outcome keeps it clear),
+    action 1 surely sets the high bit; nothing else changes."""
+
+    bits = 2
+
+    def bit_probabilities(self, codes, actions):
+        out = ((np.asarray(codes)[..., None] >> np.array([1, 0])) & 1).astype(float)
+        out[np.asarray(actions) == 0, 0, 1] = np.where(out[np.asarray(actions) == 0, 0, 1] == 1, 1.0, 0.3)
+        out[np.asarray(actions) == 1, 0, 0] = 1.0
+        return out
+
+    def __call__(self, codes, actions):
+        return ((self.bit_probabilities(codes, actions) >= 0.5) * np.array([2, 1])).sum(-1)
+
+
+def test_outcome_reach_tells_the_likeliest_chain_from_the_likely_outcomes():
+    orr = _load("outcome_reach")
+    # the goal 3 needs the unlikely low bit: not on the likeliest chain, second in the beam (P 0.3 < 0.7)
+    assert orr.reach(_Coin(), (0,), (0, 1), {0: 3}, beam=4, max_outcomes=4, min_ratio=0.05) == (False, 1)
+    assert orr.reach(_Coin(), (0,), (0, 1), {0: 2}, beam=4, max_outcomes=4, min_ratio=0.05) == (True, 0)
+    # outcomes below the ratio, or a beam of one chain, leave only the likeliest
+    assert orr.reach(_Coin(), (0,), (0, 1), {0: 3}, beam=4, max_outcomes=4, min_ratio=0.5) == (False, None)
+    assert orr.reach(_Coin(), (0,), (0, 1), {0: 3}, beam=1, max_outcomes=4, min_ratio=0.05) == (False, None)

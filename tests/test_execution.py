@@ -201,6 +201,12 @@ class _Shift:
         """Every prediction with -log P = 0.5 (enough for ObservedTransitions to show which it answers itself)."""
         return self(codes, actions), np.full(len(codes), 0.5)
 
+    def bit_probabilities(self, codes, actions):
+        """Every bit of object 0 a coin flip, 0.25 to be set; object 1's bits as they are (certain)."""
+        out = ((np.asarray(codes)[..., None] >> np.arange(3, -1, -1)) & 1).astype(float)
+        out[:, 0] = 0.25
+        return out
+
 
 def test_observed_transitions_override_only_what_was_seen():
     from search.learned_astar import plan_symbolic
@@ -217,6 +223,13 @@ def test_observed_transitions_override_only_what_was_seen():
     assert nxt.tolist() == [[3, 5], [5, 5], [4, 5], [3, 5]] and nll.tolist() == [0.0, 0.5, 0.0, 0.5]
     with pytest.raises(ValueError, match="does not score"):
         ObservedTransitions(_Still()).scored(codes, actions)
+    # bit probabilities: an observed step's are its observed bits, certain; the rest are the network's
+    p = memory.bit_probabilities(codes, actions)
+    assert p.shape == (4, 2, 4)
+    assert p[0].tolist() == [[0, 0, 1, 1], [0, 1, 0, 1]] and p[2].tolist() == [[0, 1, 0, 0], [0, 1, 0, 1]]
+    assert p[1, 0].tolist() == [0.25] * 4 and p[3, 0].tolist() == [0.25] * 4
+    with pytest.raises(ValueError, match="no bit probabilities"):
+        ObservedTransitions(_Still()).bit_probabilities(codes, actions)
     goal = SymbolicGoal((4, None))
     assert plan_symbolic(_Shift(), np.array([3, 5]), goal, uniform_cost=True).plan == (0,)
     replanned = plan_symbolic(memory, np.array([3, 5]), goal, uniform_cost=True)
@@ -386,21 +399,23 @@ def test_benchmark_records_the_risk_weight_of_astar_likely(tmp_path, sim, run_di
     problems = bench.load_sets([pdir])
     settings = [bench._settings(run_dir, [pdir], problems, ["astar-likely"], False, 2.0, 3, w) for w in (1.0, 2.5)]
     assert settings[0]["risk_weight"] == 1.0 and settings[0] != settings[1]
+    assert bench._settings(run_dir, [pdir], problems, ["astar-outcomes"], False, 2.0, 3, 2.5)["risk_weight"] == 2.5
+    assert "risk_weight" not in bench._settings(run_dir, [pdir], problems, ["astar"], False, 2.0, 3, 2.5)
 
 
 def test_unknown_planner_lists_every_planner(tmp_path, run_dir):
-    with pytest.raises(ValueError, match="unknown planner 'ghost'; known: astar, astar-ucs, astar-likely, fast-downward, ") as info:
+    with pytest.raises(ValueError, match="unknown planner 'ghost'; known: astar, astar-ucs, astar-likely, astar-outcomes, ") as info:
         bench.benchmark(run_dir, tmp_path, ["astar", "ghost"], tmp_path / "b.json")
     msg = str(info.value)
     assert "\n" not in msg and all(name in msg for name in PLANNERS)
 
 
 def test_registry_holds_every_planner_and_is_immutable():
-    assert list(PLANNERS) == ["astar", "astar-ucs", "astar-likely", "fast-downward", "symk", "pyperplan", "fast-downward-opt",
+    assert list(PLANNERS) == ["astar", "astar-ucs", "astar-likely", "astar-outcomes", "fast-downward", "symk", "pyperplan", "fast-downward-opt",
                               "fast-downward-blind", "fast-downward-sas", "fast-downward-sas-opt", "symk-sas",
                               "symk-sas-topk", "fast-downward-sas-ms", "fast-downward-sas-lama",
                               "rules-astar", "rules-bfs"]
-    assert [n for n, s in PLANNERS.items() if not s.needs_rules] == ["astar", "astar-ucs", "astar-likely"]
+    assert [n for n, s in PLANNERS.items() if not s.needs_rules] == ["astar", "astar-ucs", "astar-likely", "astar-outcomes"]
     assert all(s.name == n and s.description for n, s in PLANNERS.items())
     with pytest.raises(TypeError):
         PLANNERS["mine"] = PLANNERS["astar"]  # type: ignore[index]
@@ -421,6 +436,13 @@ def test_make_planner_builds_and_refuses(tmp_path, run_dir):
         assert res.planner == "astar-likely" and res.found and res.predicted_states[-1] == goal
         _, nll = m.scored(np.array(res.predicted_states[:-1]), np.array(res.plan))
         assert res.extra["log_p"] == pytest.approx(-nll.sum(), abs=1e-5)
+        # every outcome the all-outcomes planner may follow from the start, the likeliest first
+        res = make_planner("astar-outcomes")(m, start, SymbolicGoal(goal), 5.0)
+        assert res.planner == "astar-outcomes" and res.found and res.predicted_states[-1] == goal
+        assert res.extra["max_outcomes"] == 4 and res.extra["log_p"] <= 0
+        p = m.bit_probabilities(np.array(res.predicted_states[:-1]), np.array(res.plan))
+        step = np.array([[((c >> np.arange(m.bits - 1, -1, -1)) & 1) for c in s] for s in res.predicted_states[1:]])
+        assert res.extra["log_p"] == pytest.approx(np.log(np.where(step == 1, p, 1 - p)).sum(), abs=1e-5)
     with pytest.raises(ValueError, match="plans on the exported rules, and none were given"):
         make_planner("fast-downward", PlannerContext())
     with pytest.raises(ValueError, match="no exported rules"):  # rules are read only when a planner needs them

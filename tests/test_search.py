@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 from search.astar import astar
-from search.learned_astar import plan_symbolic, symbolic_successors
+from search.learned_astar import likely_outcomes, plan_symbolic, symbolic_successors
 from search.result import PlanResult, PlanStatus
-from pddl_export.symbolic import N_ACTIONS, SymbolicGoal, TransitionFn
+from pddl_export.symbolic import N_ACTIONS, SymbolicGoal, TransitionFn, codes_from_bits
 
 
 # ---------------------------------------------------------------------------------------------
@@ -372,6 +372,89 @@ def test_risk_weight_trades_a_doubtful_step_for_two_sure_ones(uniform):
 def test_risk_weight_refuses_bad_weights_and_unscored_models(transition, weight, match):
     with pytest.raises(ValueError, match=match):
         plan_symbolic(transition, np.array([0]), SymbolicGoal((3,)), risk_weight=weight)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_likely_outcomes_are_the_most_likely_states_by_enumeration(seed):
+    """Against every one of the 2**(K*bits) next states, scored as a product of independent bits."""
+    import itertools
+
+    rng = np.random.default_rng(seed)
+    k, bits = int(rng.integers(1, 3)), int(rng.integers(1, 4))
+    probs = rng.uniform(0, 1, (5, k, bits))
+    probs[rng.uniform(size=probs.shape) < 0.3] = 1.0  # some certain bits: their flips are impossible
+    probs[rng.uniform(size=probs.shape) < 0.1] = 0.0
+    n, ratio = int(rng.integers(1, 6)), float(rng.uniform(0.02, 0.9))
+    got = likely_outcomes(probs, n, ratio)
+    assert len(got) == 5
+    for row, p in zip(got, probs):
+        every = sorted(((float(np.prod(np.where(b, p, 1 - p))), int(i)) for i, b in
+                        enumerate(np.array(list(itertools.product([0, 1], repeat=k * bits))).reshape(-1, k, bits))),
+                       key=lambda t: -t[0])
+        prob_of = {tuple(codes_from_bits(b).tolist()): pr for pr, b in
+                   ((float(np.prod(np.where(b, p, 1 - p))), b)
+                    for b in np.array(list(itertools.product([0, 1], repeat=k * bits))).reshape(-1, k, bits))}
+        want = [pr for pr, _ in every if pr >= ratio * every[0][0] * (1 + 1e-9)][:n]
+        assert len(want) <= len(row) <= n  # ties at the ratio may add one
+        assert [np.exp(-nll) for _, nll in row][:len(want)] == pytest.approx(want, abs=1e-9)
+        assert all(prob_of[state] == pytest.approx(np.exp(-nll), abs=1e-9) for state, nll in row)
+        assert len({state for state, _ in row}) == len(row)  # distinct states, the likeliest first
+        assert row[0][0] == tuple(codes_from_bits(p >= 0.5).tolist())
+
+
+@dataclass(frozen=True)
+class Sticky:
+    """One object, 2 bits. From code 0, action 0 most likely does nothing (P 0.7) but may set the low bit
+    (P 0.3, code 1); action 1 surely sets the high bit (code 2); from 2 action 2 surely gives 3; all else stays."""
+
+    bits: int = 2
+    p_low: float = 0.3
+
+    def bit_probabilities(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        out = ((codes[..., None] >> np.array([1, 0])) & 1).astype(float)
+        c = codes[:, 0]
+        out[(c == 0) & (actions == 0), 0, 1] = self.p_low
+        out[(c == 0) & (actions == 1), 0, 0] = 1.0
+        out[(c == 2) & (actions == 2), 0, 1] = 1.0
+        return out
+
+    def scored(self, codes: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        p = self.bit_probabilities(codes, actions)
+        return codes_from_bits(p >= 0.5), -np.log(np.where(p >= 0.5, p, 1 - p)).sum((1, 2))
+
+    def __call__(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        return self.scored(codes, actions)[0]
+
+
+def test_outcomes_plan_for_a_goal_only_a_less_likely_outcome_reaches():
+    start = np.array([0])
+    likely = plan_symbolic(Sticky(), start, SymbolicGoal((1,)), risk_weight=1.0)
+    assert likely.status is PlanStatus.UNSOLVABLE  # the likeliest predictions never reach code 1
+    out = plan_symbolic(Sticky(), start, SymbolicGoal((1,)), risk_weight=1.0, max_outcomes=2)
+    assert out.found and out.plan == (0,) and out.predicted_states == ((0,), (1,))
+    assert out.extra["log_p"] == pytest.approx(np.log(0.3)) and out.extra["max_outcomes"] == 2
+    # an outcome less likely than min_outcome_ratio times the likeliest is not followed: 0.3 / 0.7 < 0.5
+    assert plan_symbolic(Sticky(), start, SymbolicGoal((1,)), risk_weight=1.0, max_outcomes=2,
+                         min_outcome_ratio=0.5).status is PlanStatus.UNSOLVABLE
+    # where the likeliest predictions reach the goal, the sure route is kept: 2 sure steps cost 2, and the
+    # doubtful outcome 1 leads nowhere
+    sure = plan_symbolic(Sticky(), start, SymbolicGoal((3,)), risk_weight=1.0, max_outcomes=2)
+    assert sure.plan == (1, 2) and sure.extra["log_p"] == pytest.approx(0.0)
+
+
+@pytest.mark.parametrize("transition, kwargs, match", [
+    (Sticky(), dict(max_outcomes=0), "max_outcomes must be"),
+    (Sticky(), dict(max_outcomes=2.0), "max_outcomes must be"),
+    (Sticky(), dict(max_outcomes=2, min_outcome_ratio=0.0), "min_outcome_ratio"),
+    (Sticky(), dict(max_outcomes=2, min_outcome_ratio=1.5), "min_outcome_ratio"),
+    (Sticky(), dict(max_outcomes=2, risk_weight=0.0), "needs risk_weight > 0"),
+    (Shortcut(), dict(max_outcomes=2), "bit probabilities"),
+    (Sticky(p_low=1.5), dict(max_outcomes=2), "must be \\(36, 1, 2\\) in \\[0, 1\\]"),
+])
+def test_outcomes_refuse_bad_settings_and_models(transition, kwargs, match):
+    kwargs = {"risk_weight": 1.0, **kwargs}
+    with pytest.raises(ValueError, match=match):
+        plan_symbolic(transition, np.array([0]), SymbolicGoal((1,)), **kwargs)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -280,6 +280,27 @@ def test_scored_predictions_are_the_most_likely_codes_and_their_probability():
     assert m.scored(np.zeros((0, 3), np.int64), np.zeros(0, np.int64))[1].shape == (0,)
 
 
+def test_bit_probabilities_are_the_networks_sigmoids_and_agree_with_its_predictions():
+    net = _net(seed=5)
+    m = LearnedTransition(net)
+    rng = np.random.default_rng(2)
+    codes, actions = rng.integers(0, 1 << BITS, (36, 3)), np.arange(36)
+    p = m.bit_probabilities(codes, actions)
+    bits = torch.from_numpy(((codes[..., None] >> np.arange(BITS - 1, -1, -1)) & 1).astype(np.float32))
+    with torch.no_grad():
+        expect = torch.sigmoid(net(bits, torch.ones(36, 3, dtype=torch.bool), torch.from_numpy(actions)).logits)
+    assert p.shape == (36, 3, BITS) and p.dtype == np.float64
+    np.testing.assert_allclose(p, expect.double().numpy(), rtol=1e-6, atol=1e-7)
+    # thresholded they are the network's prediction, and their product its probability
+    nxt, nll = m.scored(codes, actions)
+    weights = 1 << np.arange(BITS - 1, -1, -1)
+    np.testing.assert_array_equal(((p >= 0.5) * weights).sum(-1), nxt)
+    np.testing.assert_allclose(-np.log(np.maximum(p, 1 - p)).sum((1, 2)), nll, rtol=1e-5, atol=1e-6)
+    assert m.bit_probabilities(np.zeros((0, 3), np.int64), np.zeros(0, np.int64)).shape == (0, 3, BITS)
+    with pytest.raises(ValueError, match="action ids"):
+        m.bit_probabilities(codes, actions + 1)
+
+
 @pytest.mark.parametrize("codes, actions, match", [
     (np.zeros(3, np.int64), np.zeros(1, np.int64), "codes must be"),
     (np.zeros((2, 3), np.int64), np.zeros(3, np.int64), "codes must be"),

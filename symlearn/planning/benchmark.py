@@ -25,7 +25,7 @@ from typing import Sequence
 from pddl_export.files import finite_or_null
 from pddl_export.rules_io import PDDL_DIR, RULES_FILE
 from symlearn.planning.execution import ExecutionConfig, ProblemRun, failure_causes, run_problem
-from symlearn.planning.planners import RISK_PLANNER, make_planners
+from symlearn.planning.planners import RISK_PLANNERS, make_planners
 from symlearn.planning.problem import RANDOM_WALK, Problem, load_problems
 from symlearn.planning.recording import PlanRecorder
 from symlearn.provenance import atomic_write_json, atomic_write_text, sha256_bytes, sha256_file, versions
@@ -269,7 +269,7 @@ def _settings(run_dir: Path, sets: list[Path], problems: list[SetProblem], plann
            "rules_sha256": sha256_file(rules)[:16] if needs_rules else None,
            "problems_sha256": sha256_bytes(b"".join(sha256_bytes(p.path.read_bytes()).encode()
                                                     for p in problems))[:16]}
-    if RISK_PLANNER in planners:  # only then does the weight change a result
+    if any(p in RISK_PLANNERS for p in planners):  # only then does the weight change a result
         out["risk_weight"] = risk_weight
     return out
 
@@ -359,7 +359,7 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
     once; a run interrupted (killed) and started again with the same settings resumes there, and its
     final JSON equals an uninterrupted run's (its timings aside). The log is removed once out_file is
     written. With record_dir, each failed open-loop run is saved as record_dir/<problem>_<planner>.gif.
-    risk_weight is astar-likely's (symlearn.planning.planners.PlannerContext), recorded when it plans.
+    risk_weight is astar-likely's and astar-outcomes' (symlearn.planning.planners.PlannerContext), recorded when one plans.
     """
     if not planners:
         raise ValueError("no planners given")

@@ -37,7 +37,7 @@ import numpy as np
 
 from search.result import PlanResult, PlanStatus, failed
 from pddl_export.rules import RuleSet, apply_rules
-from pddl_export.symbolic import SymbolicGoal, TransitionFn
+from pddl_export.symbolic import SymbolicGoal, TransitionFn, bits_from_codes
 from symlearn.planning.problem import GOAL_TOLERANCE_M, Problem
 from symlearn.planning.recovery import Progress, Segment, recover, replanned
 from symlearn.planning.scenes import max_goal_distance, place_scene, symbolic_goal
@@ -130,6 +130,15 @@ class ObservedTransitions:
         for i, nxt in self._observed_rows(codes, actions):
             out[i], nll[i] = nxt, 0.0
         return out, nll
+
+    def bit_probabilities(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        """The inner model's bit probabilities; an observed step's are its observed next bits (0 or 1)."""
+        if not callable(getattr(self.inner, "bit_probabilities", None)):
+            raise ValueError(f"{type(self.inner).__name__} gives no bit probabilities")
+        p = np.array(self.inner.bit_probabilities(codes, actions), np.float64)
+        for i, nxt in self._observed_rows(codes, actions):
+            p[i] = bits_from_codes(np.asarray(nxt, np.int64), self.bits)
+        return p
 
     def _observed_rows(self, codes: np.ndarray, actions: np.ndarray) -> list[tuple[int, tuple[int, ...]]]:
         """(row, observed next state) for every row whose (state, action) execution has seen."""

@@ -7,7 +7,9 @@ changed at run time; `make_planner(name, context)` is the one way to get a plann
 
 The learned-net A* ("astar", greedy-ish with the mismatch heuristic) and its uniform-cost
 variant ("astar-ucs", shortest plans) search with the transition network; "astar-likely" charges
-each action the network's -log P of its prediction too, preferring plans it is sure of. The classical
+each action the network's -log P of its prediction too, preferring plans it is sure of, and
+"astar-outcomes" also follows each action's other likely outcomes at their -log P (all-outcomes
+determinization: a goal the network's likeliest predictions miss can still be planned for). The classical
 planners write the problem for the start and goal codes (and, for STRIPS-only planners, the
 grounded STRIPS form of the domain for this problem) and call the planner through
 unified-planning (search.classical), or, for the `-sas` planners, write the rules for this
@@ -59,7 +61,7 @@ class PlannerContext:
     rules: RuleSet | None = None  # RUN/pddl/rules.json, needed by every spec with needs_rules
     model_hash: str = ""  # the transition model's hash recorded with the rules
     write_dir: Path | None = None  # save every problem/task a planner writes here (None: keep nothing)
-    risk_weight: float = 1.0  # astar-likely: an action costs 1 + risk_weight * (-log P(its predicted next state))
+    risk_weight: float = 1.0  # astar-likely/-outcomes: an action costs 1 + risk_weight * (-log P(its predicted next state))
 
     def __post_init__(self) -> None:
         if not (isinstance(self.risk_weight, (int, float)) and math.isfinite(self.risk_weight)
@@ -113,13 +115,24 @@ def _astar_ucs(transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, 
     return plan_symbolic(transition, start, goal, timeout_s=timeout_s, uniform_cost=True, planner_name="astar-ucs")
 
 
-RISK_PLANNER = "astar-likely"  # the one planner whose plans depend on PlannerContext.risk_weight
+RISK_PLANNER = "astar-likely"
+OUTCOMES_PLANNER = "astar-outcomes"
+RISK_PLANNERS = (RISK_PLANNER, OUTCOMES_PLANNER)  # the planners whose plans depend on PlannerContext.risk_weight
+OUTCOMES_PER_ACTION = 4  # astar-outcomes: an action's likeliest next state and up to 3 other outcomes ...
+MIN_OUTCOME_RATIO = 0.05  # ... each at least this fraction as likely as the likeliest
 
 
 def _astar_likely(risk_weight: float, transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal,
                   timeout_s: float) -> PlanResult:
     return plan_symbolic(transition, start, goal, timeout_s=timeout_s, risk_weight=risk_weight,
                          planner_name=RISK_PLANNER)
+
+
+def _astar_outcomes(risk_weight: float, transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal,
+                    timeout_s: float) -> PlanResult:
+    return plan_symbolic(transition, start, goal, timeout_s=timeout_s, risk_weight=risk_weight,
+                         max_outcomes=OUTCOMES_PER_ACTION, min_outcome_ratio=MIN_OUTCOME_RATIO,
+                         planner_name=OUTCOMES_PLANNER)
 
 
 # ------------------------------------------------------------------------------- planners on the exported rules
@@ -307,7 +320,10 @@ def _registry() -> Mapping[str, PlannerSpec]:
              PlannerSpec("astar-ucs", "learned-net uniform-cost search (shortest plans)", False, lambda _: _astar_ucs),
              PlannerSpec(RISK_PLANNER, "learned-net A*, each action costing 1 - w log P(its prediction): "
                          "the plans most likely to unfold as predicted", False,
-                         lambda context: partial(_astar_likely, context.risk_weight))]
+                         lambda context: partial(_astar_likely, context.risk_weight)),
+             PlannerSpec(OUTCOMES_PLANNER, "learned-net A* over each action's likely outcomes (all-outcomes "
+                         "determinization), each costing 1 - w log P(that outcome)", False,
+                         lambda context: partial(_astar_outcomes, context.risk_weight))]
     specs += [PlannerSpec(n, desc, True, partial(_build_rules_planner, n)) for n, (_, _, desc) in _RULES_PLANNERS.items()]
     return types.MappingProxyType({s.name: s for s in specs})
 

@@ -5,7 +5,8 @@
     array([[ 3, 19]])
 
 A* (search.learned_astar) and the PDDL export call it; `scored` adds how likely each prediction is
-(the most-likely-plan planner, `astar-likely`, charges it).
+(the most-likely-plan planner, `astar-likely`, charges it), and `bit_probabilities` gives every bit's
+probability, from which `astar-outcomes` draws the other likely outcomes of an action.
 """
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ import numpy as np
 from pddl_export.symbolic import bits_from_codes, codes_from_bits
 from symlearn.learning.checkpoint import effect_model_sha256
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, TransitionError, load_transition
-from symlearn.symbolic.transition_model import TransitionNet, predict_scored
+from symlearn.symbolic.transition_model import TransitionNet, predict_probabilities, predict_scored
 from symlearn.world import N_ACTIONS
 
 
@@ -46,6 +47,24 @@ class LearnedTransition:
 
     def scored(self, codes: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """As __call__, plus each row's -log P(predicted next codes) under the network, (B,) float64."""
+        codes, actions = self._checked(codes, actions)
+        if codes.size == 0:
+            return codes.astype(np.int64), np.zeros(codes.shape[0])
+        bits = bits_from_codes(codes, self.bits)  # (B, K, bits)
+        mask = np.ones(codes.shape, bool)
+        nxt, nll = predict_scored(self.net, bits, mask, actions.astype(np.int64), self.batch_size)
+        return codes_from_bits(nxt), nll
+
+    def bit_probabilities(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        """(B, K) int codes and (B,) action ids -> (B, K, bits) float64 P(each next bit is 1), MSB first."""
+        codes, actions = self._checked(codes, actions)
+        if codes.size == 0:
+            return np.zeros((*codes.shape, self.bits))
+        return predict_probabilities(self.net, bits_from_codes(codes, self.bits), np.ones(codes.shape, bool),
+                                     actions.astype(np.int64), self.batch_size)
+
+    def _checked(self, codes: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Refuse codes and actions of the wrong shape, dtype or range."""
         codes = np.asarray(codes)
         actions = np.asarray(actions)
         if codes.ndim != 2 or actions.shape != codes.shape[:1]:
@@ -56,9 +75,4 @@ class LearnedTransition:
             raise ValueError(f"codes must lie in 0..{(1 << self.bits) - 1}")
         if actions.size and (actions.min() < 0 or actions.max() >= N_ACTIONS):
             raise ValueError(f"action ids must lie in 0..{N_ACTIONS - 1}")
-        if codes.size == 0:
-            return codes.astype(np.int64), np.zeros(codes.shape[0])
-        bits = bits_from_codes(codes, self.bits)  # (B, K, bits)
-        mask = np.ones(codes.shape, bool)
-        nxt, nll = predict_scored(self.net, bits, mask, actions.astype(np.int64), self.batch_size)
-        return codes_from_bits(nxt), nll
+        return codes, actions

@@ -174,3 +174,16 @@ def predict_scored(net: TransitionNet, before: np.ndarray, mask: np.ndarray, act
         return np.zeros_like(before, np.float32), np.zeros(before.shape[0])
     return np.concatenate(codes), np.concatenate(nll)
 
+
+@torch.no_grad()
+def predict_probabilities(net: TransitionNet, before: np.ndarray, mask: np.ndarray, action: np.ndarray,
+                          batch_size: int = 4096) -> np.ndarray:
+    """(N, K, bits) float64 P(each next bit is 1), 0 in padded slots: every outcome's probability, not just the likeliest."""
+    net.eval()
+    out = []
+    for i in range(0, before.shape[0], batch_size):
+        m = torch.from_numpy(np.asarray(mask[i:i + batch_size], bool))
+        o = net(torch.from_numpy(np.asarray(before[i:i + batch_size], np.float32)), m,
+                torch.from_numpy(np.asarray(action[i:i + batch_size], np.int64)))
+        out.append((torch.sigmoid(o.logits.double()) * m[..., None]).numpy())
+    return np.concatenate(out) if out else np.zeros(before.shape, np.float64)
