@@ -48,6 +48,7 @@ from pddl_export.symbolic import (N_ACTIONS, OutcomeTransitionFn, ScoredTransiti
                                   codes_from_bits)
 
 State = tuple[int, ...]
+MAX_OUTCOMES = 9  # likely_outcomes enumerates 2**(max_outcomes - 1) flip subsets per action
 
 
 def _check_codes(codes: np.ndarray, shape: tuple[int, ...], bits: int, what: str) -> None:
@@ -159,8 +160,8 @@ def plan_symbolic(
     if scored and not callable(getattr(transition, "scored", None)):
         raise ValueError(f"risk_weight {risk_weight} needs a transition that scores its predictions "
                          f"(a `scored` method); {type(transition).__name__} has none")
-    if not (isinstance(max_outcomes, (int, np.integer)) and max_outcomes >= 1):
-        raise ValueError(f"max_outcomes must be an integer >= 1, got {max_outcomes!r}")
+    if not (isinstance(max_outcomes, (int, np.integer)) and 1 <= max_outcomes <= MAX_OUTCOMES):
+        raise ValueError(f"max_outcomes must be an integer in 1..{MAX_OUTCOMES}, got {max_outcomes!r}")
     if not 0 < min_outcome_ratio <= 1:
         raise ValueError(f"min_outcome_ratio must lie in (0, 1], got {min_outcome_ratio}")
     if max_outcomes > 1 and not scored:

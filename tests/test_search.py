@@ -445,6 +445,7 @@ def test_outcomes_plan_for_a_goal_only_a_less_likely_outcome_reaches():
 @pytest.mark.parametrize("transition, kwargs, match", [
     (Sticky(), dict(max_outcomes=0), "max_outcomes must be"),
     (Sticky(), dict(max_outcomes=2.0), "max_outcomes must be"),
+    (Sticky(), dict(max_outcomes=10), "max_outcomes must be an integer in 1..9"),
     (Sticky(), dict(max_outcomes=2, min_outcome_ratio=0.0), "min_outcome_ratio"),
     (Sticky(), dict(max_outcomes=2, min_outcome_ratio=1.5), "min_outcome_ratio"),
     (Sticky(), dict(max_outcomes=2, risk_weight=0.0), "needs risk_weight > 0"),
