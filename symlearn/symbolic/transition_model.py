@@ -154,6 +154,15 @@ def predict_bits(net: TransitionNet, before: np.ndarray, mask: np.ndarray, actio
     return predict_scored(net, before, mask, action, batch_size)[0]
 
 
+def _batched_outputs(net: TransitionNet, before: np.ndarray, mask: np.ndarray, action: np.ndarray, batch_size: int):
+    """Yield (mask, network output) per batch of rows, in eval mode (the caller holds no_grad)."""
+    net.eval()
+    for i in range(0, before.shape[0], batch_size):
+        m = torch.from_numpy(np.asarray(mask[i:i + batch_size], bool))
+        yield m, net(torch.from_numpy(np.asarray(before[i:i + batch_size], np.float32)), m,
+                     torch.from_numpy(np.asarray(action[i:i + batch_size], np.int64)))
+
+
 @torch.no_grad()
 def predict_scored(net: TransitionNet, before: np.ndarray, mask: np.ndarray, action: np.ndarray,
                    batch_size: int = 4096) -> tuple[np.ndarray, np.ndarray]:
@@ -162,12 +171,8 @@ def predict_scored(net: TransitionNet, before: np.ndarray, mask: np.ndarray, act
     The bits are independent Bernoullis given the input, so the thresholded codes are the most
     likely next state and -log P sums softplus(-|logit|) over the real objects' bits.
     """
-    net.eval()
     codes, nll = [], []
-    for i in range(0, before.shape[0], batch_size):
-        m = torch.from_numpy(np.asarray(mask[i:i + batch_size], bool))
-        o = net(torch.from_numpy(np.asarray(before[i:i + batch_size], np.float32)), m,
-                torch.from_numpy(np.asarray(action[i:i + batch_size], np.int64)))
+    for m, o in _batched_outputs(net, before, mask, action, batch_size):
         codes.append(o.codes.numpy())
         nll.append((F.softplus(-o.logits.abs()) * m[..., None]).sum((1, 2)).double().numpy())
     if not codes:
@@ -179,11 +184,6 @@ def predict_scored(net: TransitionNet, before: np.ndarray, mask: np.ndarray, act
 def predict_probabilities(net: TransitionNet, before: np.ndarray, mask: np.ndarray, action: np.ndarray,
                           batch_size: int = 4096) -> np.ndarray:
     """(N, K, bits) float64 P(each next bit is 1), 0 in padded slots: every outcome's probability, not just the likeliest."""
-    net.eval()
-    out = []
-    for i in range(0, before.shape[0], batch_size):
-        m = torch.from_numpy(np.asarray(mask[i:i + batch_size], bool))
-        o = net(torch.from_numpy(np.asarray(before[i:i + batch_size], np.float32)), m,
-                torch.from_numpy(np.asarray(action[i:i + batch_size], np.int64)))
-        out.append((torch.sigmoid(o.logits.double()) * m[..., None]).numpy())
+    out = [(torch.sigmoid(o.logits.double()) * m[..., None]).numpy()
+           for m, o in _batched_outputs(net, before, mask, action, batch_size)]
     return np.concatenate(out) if out else np.zeros(before.shape, np.float64)
