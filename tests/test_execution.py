@@ -492,6 +492,13 @@ def test_cli_problems_command(tmp_path):
     args = p.parse_args(["problems", "--out", str(tmp_path / "pp"), "--n", "1", "--objects", "1-2", "--seed", "2"])
     assert args.func(args) == 0
     assert load_problem(tmp_path / "pp" / "problem_0000.json").k in (1, 2)
+    args = p.parse_args(["problems", "--out", str(tmp_path / "on"), "--n", "2", "--objects", "1-2", "--seed", "2",
+                         "--length", "2-3", "--on-locations"])
+    assert args.on_locations and args.func(args) == 0
+    assert [load_problem(f).goal_off_locations for f in sorted((tmp_path / "on").glob("*.json"))] == [0, 0]
+    args = p.parse_args(["problems", "--out", str(tmp_path / "s"), "--suite", "structures", "--on-locations"])
+    with pytest.raises(ValueError, match="--on-locations applies to random-walk problems only"):
+        args.func(args)
 
 
 # ------------------------------------------------------------------------------- recovery and attribution

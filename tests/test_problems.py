@@ -85,6 +85,23 @@ def test_stratified_sets_fill_every_cell(tmp_path, sim):
         generate_problems(tmp_path / "grid", 1, objects=(2, 3), length=(2, 5), seed=4, sim=sim)
 
 
+def test_on_locations_redraws_a_walk_that_leaves_a_stick_off_the_locations(tmp_path, sim):
+    # the depth benchmark's k1_len1-2_0000 (this seed and cell) ends with its stick 18 cm past location 5
+    off = load_problem(generate_problems(tmp_path / "all", 1, objects=(1, 1), length=(1, 2), seed=0, sim=sim,
+                                         stratify=True)[0])
+    assert off.goal_off_locations == 1
+    paths = generate_problems(tmp_path / "on", 1, objects=(1, 1), length=(1, 2), seed=0, sim=sim, stratify=True,
+                              on_locations=True)
+    on = load_problem(paths[0])
+    assert on.name == off.name and on.goal_off_locations == 0 and on.actions != off.actions
+    assert max_goal_distance(_replay(sim, on), on.goal) <= GOAL_TOLERANCE_M
+    manifest = json.loads((tmp_path / "on" / "problems.manifest").read_text())
+    assert manifest["on_locations"] is True and "on_locations" not in json.loads(
+        (tmp_path / "all" / "problems.manifest").read_text())
+    with pytest.raises(ValueError, match="other settings"):  # the flag is part of the set's settings
+        generate_problems(tmp_path / "on", 1, objects=(1, 1), length=(1, 2), seed=0, sim=sim, stratify=True)
+
+
 @pytest.mark.parametrize("objects, length", [((0, 2), (1, 2)), ((3, 6), (1, 2)), ((2, 1), (1, 2)),
                                              ((1, 3), (0, 2)), ((1, 3), (3, 2))])
 def test_problem_config_refuses_bad_ranges(objects, length):

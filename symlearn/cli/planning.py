@@ -64,16 +64,17 @@ def cmd_problems(args: argparse.Namespace) -> int:
     from symlearn.planning.problem_generation import generate_problems
 
     if args.suite or args.goal:
-        if args.stratify:
-            raise ValueError("--stratify applies to random-walk problems only")
+        if args.stratify or args.on_locations:
+            raise ValueError(f"--{'stratify' if args.stratify else 'on-locations'} applies to random-walk problems only")
         return _cmd_structure_problems(args)
     args.n, args.objects = args.n or 20, args.objects or (1, 3)
     args.length, args.seed = args.length or (1, 4), 0 if args.seed is None else args.seed
     per = " per cell" if args.stratify else ""
+    placed = ", goals on the table locations" if args.on_locations else ""
     print(f"problems: {args.n} problems{per}, objects {args.objects[0]}-{args.objects[1]}, length "
-          f"{args.length[0]}-{args.length[1]}, seed {args.seed} -> {args.out}", file=sys.stderr)
+          f"{args.length[0]}-{args.length[1]}{placed}, seed {args.seed} -> {args.out}", file=sys.stderr)
     paths = generate_problems(Path(args.out), args.n, objects=args.objects, length=args.length, seed=args.seed,
-                              overwrite=args.overwrite, stratify=args.stratify)
+                              overwrite=args.overwrite, stratify=args.stratify, on_locations=args.on_locations)
     print(f"wrote {len(paths)} problems to {args.out}")
     return 0
 
@@ -200,6 +201,9 @@ def add_problems_command(sub) -> None:
     p.add_argument("--stratify", action="store_true",
                    help="--n random-walk problems per cell of object count x horizon bucket (1-2, 3-4, 5-6, 7-8 "
                         "actions) within --objects and --length, named by cell (k3_len5-6_0007)")
+    p.add_argument("--on-locations", action="store_true",
+                   help="random walks only: redraw a walk whose goal leaves an object more than 5 cm from every table "
+                        "location (a stick across two places), so every goal is one place-and-level symbols can name")
     kind = p.add_mutually_exclusive_group()
     kind.add_argument("--suite", choices=["structures"],
                       help="named structure tasks (towers, cubes on the stick, ...; docs/PROBLEMS.md) instead of "

@@ -36,6 +36,7 @@ class ProblemConfig:
     max_step_tries: int = 20  # draws per step before giving up on the scene
     max_scene_tries: int = 20  # fresh scenes per problem before giving up
     min_goal_distance_m: float = GOAL_TOLERANCE_M  # some object must end farther than this from its start
+    on_locations: bool = False  # redraw a walk whose goal leaves an object off the table locations (goal_off_locations)
 
     def __post_init__(self) -> None:
         lo, hi = self.objects
@@ -92,8 +93,11 @@ def generate_problem(sim, rng: np.random.Generator, cfg: ProblemConfig, name: st
             else:
                 break
         if len(actions) == length:
-            return Problem(name, seed, tuple(spec), initial, tuple(actions), sim.get_scene())
-    raise RuntimeError(f"problem {name}: no valid action sequence after {cfg.max_scene_tries} scenes")
+            problem = Problem(name, seed, tuple(spec), initial, tuple(actions), sim.get_scene())
+            if not (cfg.on_locations and problem.goal_off_locations):
+                return problem
+    where = " ending on the table locations" if cfg.on_locations else ""
+    raise RuntimeError(f"problem {name}: no valid action sequence{where} after {cfg.max_scene_tries} scenes")
 
 
 PROBLEMS_MANIFEST = "problems.manifest"  # JSON (not *.json, so load_problems never reads it as a problem)
@@ -105,6 +109,8 @@ def _settings(n: int, cfg: ProblemConfig, seed: int, stratify: bool = False) -> 
          "length": list(cfg.length), "seed": seed}
     if stratify:
         d["stratify"] = True
+    if cfg.on_locations:
+        d["on_locations"] = True
     return d
 
 
@@ -179,11 +185,14 @@ def _done(path: Path, name: str) -> bool:
 
 
 def generate_problems(out_dir: Path, n: int, objects: tuple[int, int] = (1, 3), length: tuple[int, int] = (1, 4),
-                      seed: int = 0, sim=None, overwrite: bool = False, stratify: bool = False) -> list[Path]:
+                      seed: int = 0, sim=None, overwrite: bool = False, stratify: bool = False,
+                      on_locations: bool = False) -> list[Path]:
     """Write n problems to out_dir/problem_NNNN.json (problem i drawn from seed (seed, i)).
 
     With `stratify`, n problems per cell of object count x horizon bucket (HORIZON_BUCKETS cut to the
     length range) instead, named by cell (cell_name) and drawn from seed (seed, k, lo, hi, i).
+    With `on_locations`, only goals that leave every object within ON_LOCATION_M of a table location
+    are kept (a walk ending elsewhere is redrawn): the goals place-and-level symbols can name.
 
     Everything is validated before anything is created. A folder already holding the same set
     (same settings, recorded in out_dir/problems.manifest) is completed: problems already written
@@ -195,11 +204,12 @@ def generate_problems(out_dir: Path, n: int, objects: tuple[int, int] = (1, 3), 
         raise ValueError(f"n={n!r} must be an integer of at least 1")
     if not _is_count(seed, least=0):
         raise ValueError(f"seed={seed!r} must be a non-negative integer")
-    cfg = ProblemConfig(objects=tuple(objects), length=tuple(length))
+    cfg = ProblemConfig(objects=tuple(objects), length=tuple(length), on_locations=bool(on_locations))
     out_dir = Path(out_dir)
     prepare_problem_dir(out_dir, _settings(n, cfg, seed, stratify), overwrite)
     if stratify:
-        jobs = [(cell_name(k, b, i), ProblemConfig(objects=(k, k), length=b), [seed, k, b[0], b[1], i])
+        jobs = [(cell_name(k, b, i), ProblemConfig(objects=(k, k), length=b, on_locations=cfg.on_locations),
+                 [seed, k, b[0], b[1], i])
                 for k, b in stratified_cells(cfg) for i in range(n)]
     else:
         jobs = [(f"problem_{i:04d}", cfg, [seed, i]) for i in range(n)]
