@@ -14,8 +14,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import platform
-import time
 from pathlib import Path
 
 
@@ -51,7 +49,7 @@ def main() -> int:
     args = ap.parse_args()
     from pddl_export.files import atomic_write_json
     from symlearn.planning.problem import ON_LOCATION_M, load_problems
-    from symlearn.provenance import versions
+    from symlearn.provenance import bench_context
 
     off = {}
     for folder in sorted(p for p in args.problems.iterdir() if p.is_dir()):
@@ -72,8 +70,7 @@ def main() -> int:
     n_off = sum(v > 0 for v in off.values())
     atomic_write_json(args.out, {"problems": str(args.problems), "on_location_m": ON_LOCATION_M,
                                  "n_problems": len(off), "n_goals_off_locations": n_off, "grids": grids,
-                                 "machine": f"{platform.machine()}, {platform.processor() or 'cpu'}",
-                                 "date": time.strftime("%Y-%m-%d"), "versions": versions()})
+                                 **bench_context()})
     print(f"{n_off} of {len(off)} goals put an object off the locations; wrote {args.out}")
     return 0
 

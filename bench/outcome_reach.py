@@ -15,8 +15,6 @@ goal lies in the graph each planner searches along one route known to work. Writ
 from __future__ import annotations
 
 import argparse
-import platform
-import time
 from pathlib import Path
 
 
@@ -60,7 +58,7 @@ def main() -> int:
     from symlearn.planning.planners import MIN_OUTCOME_RATIO, OUTCOMES_PER_ACTION
     from symlearn.planning.problem import load_problems
     from symlearn.planning.scenes import scene_codes
-    from symlearn.provenance import versions
+    from symlearn.provenance import bench_context
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.learned_transition import LearnedTransition
 
@@ -90,8 +88,7 @@ def main() -> int:
     atomic_write_json(args.out, {"run": args.run.name, "effect_model_sha256": effect_model_sha256(args.run),
                                  "problems": args.problems, "beam": args.beam, "max_outcomes": OUTCOMES_PER_ACTION,
                                  "min_outcome_ratio": MIN_OUTCOME_RATIO, "groups": groups, "rows": rows,
-                                 "machine": f"{platform.machine()}, {platform.processor() or 'cpu'}",
-                                 "date": time.strftime("%Y-%m-%d"), "versions": versions()})
+                                 **bench_context()})
     print(f"wrote {args.out}")
     return 0
 

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import platform
 import statistics
 import time
 from collections import Counter, defaultdict
@@ -218,7 +217,7 @@ def main() -> int:
     torch.set_num_threads(1)
     from pddl_export.files import atomic_write_json
     from symlearn.learning.checkpoint import load_effect_model
-    from symlearn.provenance import versions
+    from symlearn.provenance import bench_context
     from symlearn.symbolic.transition_training import encode_splits
 
     t0 = time.perf_counter()
@@ -232,8 +231,7 @@ def main() -> int:
     result = {"run": str(args.run), "data": str(args.data), "min_count": args.min_count,
               "transition_net_by_attention_rounds": nets,
               "symbol_tables": symbol_tables(splits, args.data, args.min_count),
-              "machine": f"{platform.machine()}, {platform.processor() or 'cpu'}",
-              "date": time.strftime("%Y-%m-%d"), "versions": versions(), "wall_s": round(time.perf_counter() - t0, 1)}
+              **bench_context(), "wall_s": round(time.perf_counter() - t0, 1)}
     atomic_write_json(args.out, result)
     print(f"wrote {args.out}")
     return 0

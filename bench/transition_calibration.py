@@ -14,7 +14,6 @@ probability, accuracy) with its expected calibration error. Writes JSON.
 from __future__ import annotations
 
 import argparse
-import platform
 import time
 from pathlib import Path
 
@@ -66,7 +65,7 @@ def main() -> int:
     torch.set_num_threads(1)
     from pddl_export.files import atomic_write_json
     from symlearn.learning.checkpoint import load_effect_model
-    from symlearn.provenance import versions
+    from symlearn.provenance import bench_context
     from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, load_transition
     from symlearn.symbolic.transition_data import build_transition_data
     from symlearn.data.dataset import load_split
@@ -84,8 +83,7 @@ def main() -> int:
                   f"most/least probable half {c['accuracy_most_probable_half']}/{c['accuracy_least_probable_half']} "
                   f"ECE {c['expected_calibration_error']}")
     atomic_write_json(args.out, {"data": str(args.data), "split": "test", "runs": runs,
-                                 "machine": f"{platform.machine()}, {platform.processor() or 'cpu'}",
-                                 "date": time.strftime("%Y-%m-%d"), "versions": versions(),
+                                 **bench_context(),
                                  "wall_s": round(time.perf_counter() - t0, 1)})
     print(f"wrote {args.out}")
     return 0

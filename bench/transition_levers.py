@@ -15,8 +15,6 @@ is right there. Writes JSON.
 from __future__ import annotations
 
 import argparse
-import json
-import platform
 import time
 from collections import Counter, defaultdict
 from pathlib import Path
@@ -96,7 +94,7 @@ def main() -> int:
     torch.set_num_threads(1)
     from pddl_export.files import atomic_write_json
     from symlearn.learning.checkpoint import load_effect_model
-    from symlearn.provenance import versions
+    from symlearn.provenance import bench_context
     from symlearn.symbolic.learned_transition import LearnedTransition
     from symlearn.symbolic.transition_training import encode_splits
 
@@ -108,8 +106,7 @@ def main() -> int:
     result = {"run": str(args.run), "data": str(args.data), "table_entries": len(table),
               "rollout_scene_accuracy": rollouts(transition, table, splits["test"], args.steps),
               "one_step_on_table_states": consistency(transition, table, splits["test"]),
-              "machine": f"{platform.machine()}, {platform.processor() or 'cpu'}",
-              "date": time.strftime("%Y-%m-%d"), "versions": versions(), "wall_s": round(time.perf_counter() - t0, 1)}
+              **bench_context(), "wall_s": round(time.perf_counter() - t0, 1)}
     atomic_write_json(args.out, result)
     for n, r in result["rollout_scene_accuracy"].items():
         print(f"{n} steps: net {r['net']:.3f}  table+net {r['table+net']:.3f}  (table hits {r['table_hit_rate']:.2f})")

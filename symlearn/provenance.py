@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import platform
+import time
 from importlib import metadata
 
 from pddl_export.files import (atomic_write_bytes, atomic_write_json, atomic_write_text,  # noqa: F401 (re-exported)
@@ -20,3 +21,8 @@ def versions() -> dict[str, str]:
             out[name] = "not installed"
     return out
 
+
+def bench_context() -> dict:
+    """Where and when a bench script ran, and with what: the machine, today's date and versions()."""
+    return {"machine": f"{platform.machine()}, {platform.processor() or 'cpu'}", "date": time.strftime("%Y-%m-%d"),
+            "versions": versions()}

@@ -79,3 +79,15 @@ def test_transition_metrics_record_config_seed_versions_and_hashes(run):
     assert saved["versions"] == json.loads(json.dumps(versions()))
     assert saved["effect_model_sha256"] == _file_hash(run / "run" / "best.pt")
     assert saved["data_fingerprint"] == _data_hash(run / "data")
+
+
+def test_bench_context_names_the_machine_the_date_and_the_versions():
+    import platform
+    import re
+
+    from symlearn.provenance import bench_context
+
+    ctx = bench_context()
+    assert list(ctx) == ["machine", "date", "versions"]
+    assert ctx["machine"].startswith(platform.machine() + ", ") and re.fullmatch(r"\d{4}-\d\d-\d\d", ctx["date"])
+    assert ctx["versions"] == versions()
