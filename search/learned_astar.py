@@ -125,27 +125,10 @@ def outcome_successors(transition: OutcomeTransitionFn, state: State, max_outcom
             for nxt, nll in row if nxt != state]
 
 
-def plan_symbolic(
-    transition: TransitionFn,
-    start_codes: np.ndarray,
-    goal: SymbolicGoal,
-    *,
-    max_expansions: int = 20000,
-    timeout_s: float = 30.0,
-    uniform_cost: bool = False,
-    risk_weight: float = 0.0,
-    max_outcomes: int = 1,
-    min_outcome_ratio: float = 0.05,
-    planner_name: str = "astar",
-) -> PlanResult:
-    """Plan from start_codes (K,) to a (partial) goal; one batched transition call per expansion.
-
-    risk_weight > 0 charges each action w * (-log P) on top of its unit cost; max_outcomes > 1 also
-    branches on each action's other likely outcomes (module docstring).
-    """
-    t0 = time.perf_counter()
+def _check_request(transition: TransitionFn, start_arr: np.ndarray, goal: SymbolicGoal, risk_weight: float,
+                   max_outcomes: int, min_outcome_ratio: float) -> None:
+    """Refuse a start or goal that does not fit the transition's codes, and costs or outcomes it cannot give."""
     bits = int(transition.bits)
-    start_arr = np.asarray(start_codes)
     if start_arr.ndim != 1:
         raise ValueError(f"start_codes must have shape (K,), got {start_arr.shape}")
     k = start_arr.shape[0]
@@ -169,6 +152,30 @@ def plan_symbolic(
     if max_outcomes > 1 and not callable(getattr(transition, "bit_probabilities", None)):
         raise ValueError(f"max_outcomes {max_outcomes} needs a transition with bit probabilities "
                          f"(a `bit_probabilities` method); {type(transition).__name__} has none")
+
+
+def plan_symbolic(
+    transition: TransitionFn,
+    start_codes: np.ndarray,
+    goal: SymbolicGoal,
+    *,
+    max_expansions: int = 20000,
+    timeout_s: float = 30.0,
+    uniform_cost: bool = False,
+    risk_weight: float = 0.0,
+    max_outcomes: int = 1,
+    min_outcome_ratio: float = 0.05,
+    planner_name: str = "astar",
+) -> PlanResult:
+    """Plan from start_codes (K,) to a (partial) goal; one batched transition call per expansion.
+
+    risk_weight > 0 charges each action w * (-log P) on top of its unit cost; max_outcomes > 1 also
+    branches on each action's other likely outcomes (module docstring).
+    """
+    t0 = time.perf_counter()
+    start_arr = np.asarray(start_codes)
+    _check_request(transition, start_arr, goal, risk_weight, max_outcomes, min_outcome_ratio)
+    scored = risk_weight > 0
     fixed = [(i, c) for i, c in enumerate(goal.codes) if c is not None]
     step_nll: dict[tuple[State, int, State], float] = {}
 
