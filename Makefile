@@ -34,11 +34,11 @@ demo: $(VENV)/.installed
 	$(BIN)/symlearn train-transition --run runs/demo --data data/demo --preset quick --epochs 20 --quiet
 	$(BIN)/symlearn export-pddl --run runs/demo --data data/demo --max-objects 2 --min-count 5 --pddl-fidelity-cases 0
 	$(BIN)/symlearn problems --out problems/demo --n 10 --objects 1-3 --length 1-2 --seed 0
-	$(BIN)/symlearn benchmark --run runs/demo --problems problems/demo --planners astar,astar-outcomes,fast-downward-sas-opt,symk-sas,rules-bfs --closed-loop \
+	$(BIN)/symlearn benchmark --run runs/demo --problems problems/demo --planners astar,astar-outcomes,fast-downward-sas-opt,symk-sas,rules-bfs,rules-outcomes --closed-loop \
 		--out runs/demo/benchmark.json --quiet
 	$(BIN)/symlearn plan --run runs/demo --problem problems/demo/problem_0000.json --planner astar --record runs/demo/plan.gif
 	rm -rf runs/pretrained && cp -r pretrained/quick-authors12k runs/pretrained
-	$(BIN)/symlearn benchmark --run runs/pretrained --problems problems/demo --planners astar,astar-outcomes,fast-downward-sas-opt,rules-bfs --closed-loop \
+	$(BIN)/symlearn benchmark --run runs/pretrained --problems problems/demo --planners astar,astar-outcomes,fast-downward-sas-opt,rules-bfs,rules-outcomes --closed-loop \
 		--out runs/pretrained/benchmark.json --quiet
 	$(BIN)/symlearn report --run runs/demo --data data/demo --benchmark runs/demo/benchmark.json --recording runs/demo/plan.gif
 

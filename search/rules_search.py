@@ -47,8 +47,10 @@ State = tuple[int, ...]
 UNREACHABLE = 1 << 20  # code distance of a code from which an object's goal code cannot be reached
 
 
-def code_distances(rules: RuleSet, goal: SymbolicGoal) -> np.ndarray:
+def code_distances(rules: RuleSet, goal: SymbolicGoal, *more: RuleSet) -> np.ndarray:
     """(K, 2**bits) table: fewest rule firings taking object i from a code to its goal code, ignoring contexts.
+
+    Rules of `more` rule sets (of the same bits) count as edges too.
 
     An object only changes code when a rule on its code fires, so if no chain of rules leads from
     its code to its goal code (UNREACHABLE) no plan exists from that state: a sound dead-end test.
@@ -56,7 +58,7 @@ def code_distances(rules: RuleSet, goal: SymbolicGoal) -> np.ndarray:
     several objects at once).
     """
     graph = nx.DiGraph()
-    graph.add_edges_from({(r.code_to, r.code_from) for r in rules.rules})  # reversed: search back from the goal
+    graph.add_edges_from({(r.code_to, r.code_from) for rs in (rules, *more) for r in rs.rules})  # reversed: search back from the goal
     table = np.zeros((len(goal.codes), 1 << rules.bits), np.int64)
     for i, g in enumerate(goal.codes):
         if g is None:
@@ -67,7 +69,7 @@ def code_distances(rules: RuleSet, goal: SymbolicGoal) -> np.ndarray:
     return table
 
 
-def _checked_start(start: Sequence[int], goal: SymbolicGoal, bits: int) -> np.ndarray:
+def checked_start(start: Sequence[int], goal: SymbolicGoal, bits: int) -> np.ndarray:
     """start as an int64 array (K,); ValueError if it does not match the goal or fit in `bits` bits."""
     arr = np.asarray(start, np.int64)
     if arr.ndim != 1 or len(goal.codes) != len(arr):
@@ -124,7 +126,7 @@ def plan_rules(
     if method not in METHODS:
         raise ValueError(f"unknown rule search {method!r}; known: {', '.join(METHODS)}")
     succ = rules if isinstance(rules, RuleSuccessors) else RuleSuccessors(rules)
-    start_arr = _checked_start(start, goal, succ.bits)
+    start_arr = checked_start(start, goal, succ.bits)
     name, batch_used = planner_name or f"rules-{method}", batch if method == "astar" else 0
     pairs = split_pairs(goal.codes)
     proof = _start_proof(succ.rules, start_arr, goal, pairs, pair_proof)

@@ -24,7 +24,7 @@ RECORD_FILE = "pipeline.json"
 RECORD_KIND = "symlearn-pipeline"
 PRESETS = {
     "quick": dict(n=1000, problems=5, planners="astar", max_objects=2, fidelity_cases=100, min_count=20),
-    "paper": dict(n=12000, problems=20, planners="astar,astar-ucs,astar-outcomes", max_objects=3, fidelity_cases=500,
+    "paper": dict(n=12000, problems=20, planners="astar,astar-ucs,astar-outcomes,rules-outcomes", max_objects=3, fidelity_cases=500,
                   min_count=100),
 }
 

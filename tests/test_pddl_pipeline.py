@@ -143,3 +143,43 @@ def test_examples_run_end_to_end(run, tmp_path):
 
     image = matplotlib.image.imread(tmp_path / "cmp" / "comparison.png")  # a readable PNG with pixels in it
     assert image.ndim == 3 and min(image.shape[:2]) > 50 and image.std() > 0
+
+
+def test_export_writes_second_outcomes_and_rules_outcomes_plans_on_them(run):
+    """outcomes.json reproduces the network's second outcomes; the planner reaches a state only they lead to."""
+    from pddl_export.enumeration import enumerate_scenes
+    from pddl_export.fidelity import rule_fidelity
+    from pddl_export.outcome_rules import SecondOutcome, load_outcomes
+    from pddl_export.rules import apply_rules
+    from pddl_export.symbolic import SymbolicGoal
+    from symlearn.planning.planners import OUTCOME_RULES_PLANNER, PlannerContext, make_planner
+
+    rep = export_pddl(run / "run", run / "data", ExportConfig(max_objects=2, pddl_fidelity_cases=0))
+    outcomes, outcomes_hash = load_outcomes(run / "run")
+    rules, model_hash = load_rules(run / "run")
+    assert outcomes_hash == model_hash and rep["outcomes"]["fidelity"] == 1.0
+    assert rep["outcomes"]["n_rules"] == outcomes.rules.n_rules and rep["outcomes"]["min_ratio"] == 0.05
+    tr = LearnedTransition.from_run(run / "run")
+    second = SecondOutcome(tr, 0.05)
+    from symlearn.planning.export import observed_scenes, training_codes
+
+    scenes = [s for s in observed_scenes(set(rules.vocabulary), 2, *training_codes(run / "run", run / "data"))
+              if len(s) == 1]
+    enum = enumerate_scenes(second, rules.vocabulary, scenes, 1)
+    assert rule_fidelity(outcomes.rules, enum).fraction == 1.0  # exact on the one-object scenes it was distilled on
+    main, alt, extra = second.outcomes(enum.blocks[0].states, enum.blocks[0].actions)
+    rows = np.flatnonzero((alt != main)[:, 0] & (alt[:, 0] != enum.blocks[0].states[:, 0]))
+    assert len(rows) and rep["outcomes"]["n_alternatives"] == len(outcomes.costs) >= 1
+    start, action = enum.blocks[0].states[rows[0]], int(enum.blocks[0].actions[rows[0]])
+    goal = SymbolicGoal((int(alt[rows[0], 0]),))
+    context = PlannerContext.for_run(run / "run", [OUTCOME_RULES_PLANNER])
+    res = make_planner(OUTCOME_RULES_PLANNER, context)(tr, start, goal, 10.0)
+    assert res.found and res.predicted_states[-1] == goal.codes, res.message
+    for s, a, t in zip(res.predicted_states, res.plan, res.predicted_states[1:]):  # each step: the rules' or a second outcome
+        likeliest = tuple(apply_rules(rules, np.array(s), a).tolist())
+        assert t == likeliest or tuple(apply_rules(outcomes.rules, np.array(s), a).tolist()) == t
+    assert res.extra["cost"] >= len(res.plan) and (res.plan != (action,) or res.extra["cost"] > 1)
+    (run / "run" / "pddl" / "outcomes.json").unlink()
+    with pytest.raises(ValueError, match="no exported outcome rules"):
+        PlannerContext.for_run(run / "run", ["rules-bfs", OUTCOME_RULES_PLANNER])
+    assert PlannerContext.for_run(run / "run", ["rules-bfs"]).outcomes is None

@@ -134,7 +134,8 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
     from symlearn.planning.export import ExportConfig, export_pddl
 
     cfg = ExportConfig(max_objects=args.max_objects, min_count=args.min_count, closure=args.closure,
-                       pddl_fidelity_cases=args.pddl_fidelity_cases, scenes=args.scenes, seed=args.seed)
+                       pddl_fidelity_cases=args.pddl_fidelity_cases, scenes=args.scenes, seed=args.seed,
+                       outcome_min_ratio=args.outcome_min_ratio)
     out = Path(args.out) if args.out else None
     rep = export_pddl(Path(args.run), Path(args.data), cfg, out)
     where = out or Path(args.run) / "pddl"
@@ -146,7 +147,10 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
     print(f"fidelity (rules, every case) {rep['fidelity']:.4f}; through the PDDL {through}")
     for d in rep["disagreements"][:5]:
         print(f"  disagreement: {d}")
-    print(f"wrote {where / 'domain.pddl'}, rules.json, report.json")
+    oc = rep["outcomes"]
+    print(f"second outcomes (at least {oc['min_ratio']} as likely): {oc['n_alternatives']} alternatives, "
+          f"{oc['n_rules']} rules, fidelity {oc['fidelity']:.4f}")
+    print(f"wrote {where / 'domain.pddl'}, rules.json, outcomes.json, report.json")
     return 0
 
 
@@ -241,6 +245,9 @@ def add_export_pddl_command(sub) -> None:
     x.add_argument("--closure", action="store_true", help="with --scenes all: add codes the network produces")
     x.add_argument("--pddl-fidelity-cases", type=int, default=500,
                    help="cases simulated through the PDDL (-1: every enumerated case)")
+    x.add_argument("--outcome-min-ratio", type=float, default=0.05,
+                   help="outcomes.json (rules-outcomes): keep an object's second likeliest next code where it is "
+                        "at least this fraction as likely as the likeliest")
     x.add_argument("--seed", type=int, default=0)
     x.set_defaults(func=cmd_export_pddl)
 

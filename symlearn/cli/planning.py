@@ -225,8 +225,9 @@ def _add_execution_flags(c: argparse.ArgumentParser) -> None:
     # another busy process shares the cores (docs/BENCHMARKS.md), so one thread unless asked for more
     c.add_argument("--threads", type=positive_int, default=1, help="torch CPU threads for the networks (default 1)")
     c.add_argument("--risk-weight", type=positive_finite_float, default=1.0,
-                   help="astar-likely and astar-outcomes only: each action costs 1 + W * (-log P(its predicted "
-                        "next state)) (default 1)")
+                   help="astar-likely, astar-outcomes and rules-outcomes only: each action costs 1 + W * (-log "
+                        "P(its predicted next state)) (rules-outcomes: W times a second outcome's extra -log P) "
+                        "(default 1)")
 
 
 def add_plan_command(sub) -> None:

@@ -7,7 +7,10 @@ exact rules (pddl_export.rules); the conditional-effects domain is written; fide
 on every enumerated case through the rules, and on a seeded sample through the PDDL itself
 (unified-planning's simulator, about 16 ms a case).
 
-Writes RUN/pddl/domain.pddl, rules.json, report.json.
+The second outcomes (pddl_export.outcome_rules) are distilled on the same scenes for the
+`rules-outcomes` planner.
+
+Writes RUN/pddl/domain.pddl, rules.json, outcomes.json, report.json.
 """
 from __future__ import annotations
 
@@ -22,6 +25,7 @@ from pddl_export.enumeration import enumerate_scenes, enumerate_transitions, voc
 from pddl_export.distil import distil_rules
 from pddl_export.fidelity import pddl_fidelity, rule_fidelity
 from pddl_export.files import atomic_write_text, sha256_file
+from pddl_export.outcome_rules import MIN_OUTCOME_RATIO, OUTCOMES_FILE, distil_outcomes, outcomes_to_json
 from pddl_export.pddl_writer import conditional_domain
 from pddl_export.rules_io import PDDL_DIR, rules_to_json
 from pddl_export.symbolic import code_str
@@ -41,10 +45,14 @@ class ExportConfig:
     # arbitrarily, and exact rules for those answers swell the domain (316k rules for 60 codes, K = 3).
     scenes: str = "observed"
     seed: int = 0
+    # outcomes.json: each object's second likeliest next code where it is at least this fraction as likely
+    outcome_min_ratio: float = MIN_OUTCOME_RATIO
 
     def __post_init__(self) -> None:
         if not 1 <= self.max_objects <= 5:
             raise ValueError(f"max_objects={self.max_objects} must lie in 1..5")
+        if not 0 < self.outcome_min_ratio <= 1:
+            raise ValueError(f"outcome_min_ratio={self.outcome_min_ratio} must lie in (0, 1]")
         if self.scenes not in ("observed", "all"):
             raise ValueError(f"scenes={self.scenes!r}: expected observed or all")
 
@@ -83,6 +91,16 @@ def observed_scenes(vocab: set[int], max_objects: int, *code_arrays: np.ndarray)
     return sorted(out)
 
 
+def _export_outcomes(transition, enum, min_ratio: float, out: Path, model_hash: str) -> dict:
+    """Distil and write the second-outcome rules (out/outcomes.json); their summary for the report."""
+    t0 = time.perf_counter()
+    outcomes, alt_enum = distil_outcomes(transition, enum, min_ratio)
+    fid = rule_fidelity(outcomes.rules, alt_enum)
+    atomic_write_json(out / OUTCOMES_FILE, {"model_hash": model_hash, **outcomes_to_json(outcomes)})
+    return {"min_ratio": min_ratio, "n_rules": outcomes.rules.n_rules, "n_alternatives": len(outcomes.costs),
+            "fidelity": round(fid.fraction, 6), "seconds": round(time.perf_counter() - t0, 1)}
+
+
 def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path | None = None) -> dict:
     """Enumerate, distil, write and check; returns the report (also written as report.json)."""
     from symlearn.symbolic.learned_transition import LearnedTransition
@@ -114,6 +132,7 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / "domain.pddl", domain)
     atomic_write_json(out / "rules.json", {"model_hash": model_hash, **rules_to_json(rules)})
+    outcomes_report = _export_outcomes(transition, enum, cfg.outcome_min_ratio, out, model_hash)
     t2 = time.perf_counter()
     n_pddl = None if cfg.pddl_fidelity_cases < 0 else cfg.pddl_fidelity_cases
     pf = pddl_fidelity(domain, rules, enum, max_cases=n_pddl, seed=cfg.seed) if n_pddl != 0 else None
@@ -133,6 +152,7 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
         "pddl_fidelity": None if pf is None else round(pf.fraction, 6),
         "pddl_fidelity_cases": None if pf is None else pf.n_cases,
         "pddl_disagreements": [] if pf is None else [m.as_row() for m in pf.disagreements],
+        "outcomes": outcomes_report,
         "seconds": {"vocabulary": round(t_vocab, 1), "enumeration": round(enum.seconds, 1),
                     "rules": round(t_rules, 1), "pddl_fidelity": round(t_pddl, 1)},
         "versions": versions(),

@@ -37,6 +37,7 @@ import numpy as np
 
 from pddl_export.files import atomic_write_text, sha256_file
 from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl
+from pddl_export.outcome_rules import MIN_OUTCOME_RATIO, OutcomeRules, load_outcomes
 from pddl_export.overrides import override_rules
 from pddl_export.rules import RuleSet, apply_rules_batch
 from pddl_export.rule_successors import RuleSuccessors
@@ -46,6 +47,7 @@ from pddl_export.symbolic import SymbolicGoal, TransitionFn
 from search.classical import solve_pddl
 from search.learned_astar import plan_symbolic
 from search.result import PlanResult, PlanStatus, failed
+from search.rules_outcomes import plan_rules_outcomes
 from search.rules_search import plan_rules
 from search.sas_planners import solve_sas
 from search.up_problem import strips_problem
@@ -62,6 +64,7 @@ class PlannerContext:
     model_hash: str = ""  # the transition model's hash recorded with the rules
     write_dir: Path | None = None  # save every problem/task a planner writes here (None: keep nothing)
     risk_weight: float = 1.0  # astar-likely/-outcomes: an action costs 1 + risk_weight * (-log P(its predicted next state))
+    outcomes: OutcomeRules | None = None  # RUN/pddl/outcomes.json, needed by rules-outcomes
 
     def __post_init__(self) -> None:
         if not (isinstance(self.risk_weight, (int, float)) and math.isfinite(self.risk_weight)
@@ -77,7 +80,14 @@ class PlannerContext:
             return PlannerContext(write_dir=write_dir, risk_weight=risk_weight)
         rules, model_hash = load_rules(Path(run_dir))
         check_rules_current(Path(run_dir), model_hash)
-        return PlannerContext(rules=rules, model_hash=model_hash, write_dir=write_dir, risk_weight=risk_weight)
+        outcomes = None
+        if OUTCOME_RULES_PLANNER in names:
+            outcomes, outcomes_hash = load_outcomes(Path(run_dir))
+            if outcomes_hash != model_hash:
+                raise ValueError(f"{Path(run_dir) / PDDL_DIR} holds rules.json and outcomes.json of different "
+                                 f"transition models; re-run 'symlearn export-pddl --run {run_dir}'")
+        return PlannerContext(rules=rules, model_hash=model_hash, write_dir=write_dir, risk_weight=risk_weight,
+                              outcomes=outcomes)
 
 
 def check_rules_current(run_dir: Path, model_hash: str) -> None:
@@ -117,9 +127,11 @@ def _astar_ucs(transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, 
 
 RISK_PLANNER = "astar-likely"
 OUTCOMES_PLANNER = "astar-outcomes"
-RISK_PLANNERS = (RISK_PLANNER, OUTCOMES_PLANNER)  # the planners whose plans depend on PlannerContext.risk_weight
-OUTCOMES_PER_ACTION = 4  # astar-outcomes: an action's likeliest next state and up to 3 other outcomes ...
-MIN_OUTCOME_RATIO = 0.05  # ... each at least this fraction as likely as the likeliest
+OUTCOME_RULES_PLANNER = "rules-outcomes"
+# the planners whose plans depend on PlannerContext.risk_weight
+RISK_PLANNERS = (RISK_PLANNER, OUTCOMES_PLANNER, OUTCOME_RULES_PLANNER)
+OUTCOMES_PER_ACTION = 4  # astar-outcomes: an action's likeliest next state and up to 3 other outcomes, each at
+# least MIN_OUTCOME_RATIO as likely as the likeliest (the ratio export-pddl keeps second outcomes at, too)
 
 
 def _astar_likely(risk_weight: float, transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal,
@@ -273,6 +285,31 @@ class _InProcessRulesPlanner(_RulesPlanner):
                                                     timeout_s=timeout_s, planner_name=self.name))
 
 
+class _RulesOutcomesPlanner(_InProcessRulesPlanner):
+    """rules-outcomes: A* over the rules and their second outcomes (search.rules_outcomes), compiled once.
+
+    Closed loop: a step execution has seen has its observed successor only (no override needed).
+    """
+
+    def __init__(self, rules: RuleSet, outcomes: OutcomeRules, model_hash: str, risk_weight: float) -> None:
+        super().__init__(rules, model_hash, OUTCOME_RULES_PLANNER, "outcomes", "in-process", None)
+        self.outcomes, self.risk_weight = outcomes, risk_weight
+        self._alternates, self._costs = RuleSuccessors(outcomes.rules), outcomes.cost_table()
+
+    def __call__(self, transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
+        return self._checked(transition, plan_rules_outcomes(
+            self._tools[1], self._alternates, self._costs, [int(c) for c in start], goal,
+            risk_weight=self.risk_weight, timeout_s=timeout_s, seen=getattr(transition, "seen", None),
+            planner_name=self.name))
+
+
+def _build_outcome_rules_planner(context: PlannerContext) -> PlannerFn:
+    if context.rules is None or context.outcomes is None:
+        raise ValueError(f"planner {OUTCOME_RULES_PLANNER!r} plans on the exported rules and their second outcomes "
+                         f"(RUN/pddl/rules.json and outcomes.json); run 'symlearn export-pddl' first")
+    return _RulesOutcomesPlanner(context.rules, context.outcomes, context.model_hash, context.risk_weight)
+
+
 # registry name -> (engine name in search.classical / search.sas_planners / search.rules_search, task form,
 # description)
 _RULES_PLANNERS = {
@@ -325,6 +362,9 @@ def _registry() -> Mapping[str, PlannerSpec]:
                          "determinization), each costing 1 - w log P(that outcome)", False,
                          lambda context: partial(_astar_outcomes, context.risk_weight))]
     specs += [PlannerSpec(n, desc, True, partial(_build_rules_planner, n)) for n, (_, _, desc) in _RULES_PLANNERS.items()]
+    specs.append(PlannerSpec(OUTCOME_RULES_PLANNER, "A* over the rules and each object's second likeliest outcome "
+                             "(the exported all-outcomes determinization), a deviation costing 1 - w log of its "
+                             "odds", True, _build_outcome_rules_planner))
     return types.MappingProxyType({s.name: s for s in specs})
 
 

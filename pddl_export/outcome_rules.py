@@ -1,0 +1,166 @@
+"""Each object's second most likely next code under m(z), distilled into rules: the exported all-outcomes form.
+
+The rules (pddl_export.rules) say what each object's LIKELIEST next code is. m(z) gives every
+next bit a probability, and the bits are independent, so an object's second likeliest next
+code is its likeliest with the least certain bit flipped, (1 - q) / q times less likely (q
+the chance of the flipped value). `SecondOutcome` is m(z) answering that code wherever it is
+at least `min_ratio` as likely as the likeliest (and the likeliest elsewhere); enumerated on
+the main rules' scenes and distilled by the same exact distillation (pddl_export.distil), it
+gives rules of the same kind: under `action`, an object with `code_from` MAY take `code_to`
+when the others match. Each alternative's cost is the mean over the enumerated cases of its
+extra -log P, -log((1 - q) / q) >= 0, per (action, code_from, code_to).
+
+A planner over the main rules and these (search.rules_outcomes) can then count on one object
+taking its second outcome, as the learned-net `astar-outcomes` counts on m(z)'s likely
+outcomes, without the network. Stored as RUN/pddl/outcomes.json beside rules.json.
+
+    >>> import numpy as np
+    >>> probs = np.array([[[0.9, 0.4]]])          # one object, bits MSB first: likeliest 10, next 11
+    >>> alt, extra = second_codes(probs, min_ratio=0.05)
+    >>> alt.tolist(), round(float(extra[0, 0]), 4)    # 11 is 0.4 / 0.6 as likely
+    ([[3]], 0.4055)
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pddl_export.distil import distil_rules
+from pddl_export.enumeration import Enumeration, enumerate_scenes
+from pddl_export.rules import RuleSet
+from pddl_export.rules_io import PDDL_DIR, rules_from_json, rules_to_json
+from pddl_export.symbolic import N_ACTIONS, OutcomeTransitionFn, code_str, codes_from_bits
+
+OUTCOMES_FILE = "outcomes.json"
+MIN_OUTCOME_RATIO = 0.05  # an alternative is kept where it is at least this fraction as likely as the likeliest
+
+
+def second_codes(probs: np.ndarray, min_ratio: float) -> tuple[np.ndarray, np.ndarray]:
+    """(B, K, bits) bit probabilities -> each object's second likeliest next code and its extra -log P.
+
+    Where that code is less than min_ratio as likely as the likeliest, the likeliest code is
+    returned and the extra cost is inf (no alternative).
+    """
+    if not 0 < min_ratio <= 1:
+        raise ValueError(f"min_ratio must lie in (0, 1], got {min_ratio}")
+    probs = np.asarray(probs, np.float64)
+    top = probs >= 0.5
+    q = np.where(top, 1.0 - probs, probs)
+    with np.errstate(divide="ignore"):
+        flip = np.log1p(-q) - np.log(q)  # (B, K, bits) extra -log P of flipping each bit, inf where q = 0
+    least = np.argmin(flip, axis=-1)  # (B, K) the least certain bit
+    extra = np.take_along_axis(flip, least[..., None], -1)[..., 0]
+    keep = extra <= -np.log(min_ratio)
+    bits = probs.shape[-1]
+    alt = codes_from_bits(top) ^ np.where(keep, np.left_shift(1, bits - 1 - least), 0)
+    return alt.astype(np.int64), np.where(keep, extra, np.inf)
+
+
+class SecondOutcome:
+    """m(z) as a transition function giving each object its second likeliest next code (second_codes)."""
+
+    def __init__(self, transition: OutcomeTransitionFn, min_ratio: float = MIN_OUTCOME_RATIO) -> None:
+        if not callable(getattr(transition, "bit_probabilities", None)):
+            raise ValueError("the transition model gives no bit probabilities, so it has no second outcomes")
+        self.transition, self.bits, self.min_ratio = transition, int(transition.bits), float(min_ratio)
+
+    def outcomes(self, codes: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(likeliest codes, second codes, their extra -log P) for a batch, each (B, K)."""
+        probs = np.asarray(self.transition.bit_probabilities(codes, actions), np.float64)
+        alt, extra = second_codes(probs, self.min_ratio)
+        return codes_from_bits(probs >= 0.5), alt, extra
+
+    def __call__(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        return self.outcomes(codes, actions)[1]
+
+
+@dataclass(frozen=True)
+class OutcomeRules:
+    """Rules for each object's second likeliest next code, and each alternative's extra -log P."""
+
+    rules: RuleSet  # an object with code_from MAY take code_to (its second outcome) where a rule fires
+    costs: tuple[tuple[int, int, int, float], ...]  # (action, code_from, code_to, mean extra -log P), sorted
+    min_ratio: float
+
+    def __post_init__(self) -> None:
+        if not 0 < self.min_ratio <= 1:
+            raise ValueError(f"min_ratio must lie in (0, 1], got {self.min_ratio}")
+        if any(not (np.isfinite(c) and c >= 0) for *_, c in self.costs):
+            raise ValueError("alternative costs must be finite and >= 0")
+
+    def cost_table(self) -> np.ndarray:
+        """(36, 2**bits, 2**bits) float32: the cost of (action, code_from -> code_to); inf where no alternative."""
+        n = 1 << self.rules.bits
+        table = np.full((N_ACTIONS, n, n), np.inf, np.float32)
+        for a, c, d, cost in self.costs:
+            table[a, c, d] = cost
+        return table
+
+
+def _alternative_costs(second: SecondOutcome, enumeration: Enumeration) -> tuple[tuple[int, int, int, float], ...]:
+    """Mean extra -log P per (action, code_from, code_to) over the enumerated objects that have that alternative."""
+    sums: dict[tuple[int, int, int], list[float]] = {}
+    for block in enumeration.blocks:
+        if not len(block.scenes):
+            continue
+        states = block.states
+        main, alt, extra = second.outcomes(states, block.actions)
+        rows, objs = np.nonzero(alt != main)
+        for a, c, d, x in zip(block.actions[rows].tolist(), states[rows, objs].tolist(), alt[rows, objs].tolist(),
+                              extra[rows, objs].tolist()):
+            acc = sums.setdefault((a, c, d), [0.0, 0])
+            acc[0] += x
+            acc[1] += 1
+    return tuple((a, c, d, s / n) for (a, c, d), (s, n) in sorted(sums.items()))
+
+
+def distil_outcomes(transition: OutcomeTransitionFn, enumeration: Enumeration,
+                    min_ratio: float = MIN_OUTCOME_RATIO) -> tuple[OutcomeRules, Enumeration]:
+    """The second-outcome rules on the scenes of `enumeration` (the main rules'), and their own enumeration."""
+    second = SecondOutcome(transition, min_ratio)
+    scenes = [tuple(s) for b in enumeration.blocks for s in b.scenes.tolist()]
+    enum = enumerate_scenes(second, enumeration.vocabulary, scenes, enumeration.max_objects)
+    return OutcomeRules(distil_rules(enum), _alternative_costs(second, enumeration), min_ratio), enum
+
+
+def outcomes_to_json(outcomes: OutcomeRules) -> dict:
+    """JSON-ready form (rules as in rules.json, codes as bit strings)."""
+    b = outcomes.rules.bits
+    return {"min_ratio": outcomes.min_ratio, **rules_to_json(outcomes.rules),
+            "costs": [{"action": a, "from": code_str(c, b), "to": code_str(d, b), "cost": round(x, 6)}
+                      for a, c, d, x in outcomes.costs]}
+
+
+def outcomes_from_json(d: dict) -> OutcomeRules:
+    """Inverse of outcomes_to_json; one-line ValueError on a malformed file."""
+    try:
+        costs = tuple((int(r["action"]), int(r["from"], 2), int(r["to"], 2), float(r["cost"])) for r in d["costs"])
+        return OutcomeRules(rules_from_json(d), costs, float(d["min_ratio"]))
+    except KeyError as e:
+        raise ValueError(f"malformed outcomes file: missing field {e}") from None
+    except (TypeError, AttributeError) as e:
+        raise ValueError(f"malformed outcomes file: {type(e).__name__}: {e}") from None
+
+
+def load_outcomes(run_dir: Path) -> tuple[OutcomeRules, str]:
+    """RUN/pddl/outcomes.json and the model hash recorded with it; one-line ValueError naming the file otherwise."""
+    path = Path(run_dir) / PDDL_DIR / OUTCOMES_FILE
+    fix = f"re-run 'symlearn export-pddl --run {run_dir}'"
+    if not path.exists():
+        raise ValueError(f"no exported outcome rules at {path}; {fix}")
+    try:
+        d = json.loads(path.read_text(encoding="utf-8"))
+        if not isinstance(d, dict):
+            raise ValueError(f"a JSON {type(d).__name__}, expected an object")
+        outcomes = outcomes_from_json(d)
+        model_hash = d.get("model_hash", "")
+        if not isinstance(model_hash, str):
+            raise ValueError(f"model_hash must be a string, got {model_hash!r}")
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{path}: not valid JSON (line {e.lineno}: {e.msg}); {fix}") from None
+    except (OSError, UnicodeDecodeError, ValueError) as e:
+        raise ValueError(f"{path}: {e}") from None
+    return outcomes, model_hash
