@@ -289,6 +289,10 @@ def test_plan_from_tampered_rules_fails_at_rules_vs_net(tiny_run_copy, tmp_path)
 @pytest.mark.parametrize("args, message", [
     (["plan", "--run", "{run}", "--problem", "{problem}", "--planner", "nope"], "unknown planner 'nope'; known: "),
     (["export-pddl", "--run", "{run}", "--data", "{data}", "--max-objects", "9"], "max_objects=9 must lie in 1..5"),
+    (["export-pddl", "--run", "{run}", "--data", "{data}", "--outcome-min-ratio", "0"],
+     "outcome_min_ratio=0.0 must lie in (0, 1]"),
+    (["benchmark", "--run", "{empty}", "--problems", "{problems}", "--planners", "rules-outcomes", "--out", "{empty}/b.json"],
+     "no exported rules at"),
     (["benchmark", "--run", "{empty}", "--problems", "{problems}", "--planners", "fast-downward-sas", "--out", "{empty}/b.json"],
      "no exported rules at"),
 ])

@@ -179,7 +179,12 @@ def test_export_writes_second_outcomes_and_rules_outcomes_plans_on_them(run):
         likeliest = tuple(apply_rules(rules, np.array(s), a).tolist())
         assert t == likeliest or tuple(apply_rules(outcomes.rules, np.array(s), a).tolist()) == t
     assert res.extra["cost"] >= len(res.plan) and (res.plan != (action,) or res.extra["cost"] > 1)
-    (run / "run" / "pddl" / "outcomes.json").unlink()
+    path = run / "run" / "pddl" / "outcomes.json"
+    stale = dict(json.loads(path.read_text()), model_hash="0" * 16)
+    path.write_text(json.dumps(stale))
+    with pytest.raises(ValueError, match="rules.json and outcomes.json of different transition models"):
+        PlannerContext.for_run(run / "run", [OUTCOME_RULES_PLANNER])
+    path.unlink()
     with pytest.raises(ValueError, match="no exported outcome rules"):
         PlannerContext.for_run(run / "run", ["rules-bfs", OUTCOME_RULES_PLANNER])
     assert PlannerContext.for_run(run / "run", ["rules-bfs"]).outcomes is None
