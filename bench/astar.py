@@ -11,8 +11,6 @@ baseline calls the network once per action. Writes JSON.
 from __future__ import annotations
 
 import argparse
-import json
-import platform
 import time
 from pathlib import Path
 
@@ -23,7 +21,7 @@ from search.learned_astar import plan_symbolic
 from pddl_export.symbolic import N_ACTIONS, SymbolicGoal, codes_from_bits
 from symlearn.learning.checkpoint import load_effect_model
 from symlearn.data.dataset import load_split
-from symlearn.provenance import atomic_write_json, versions
+from symlearn.provenance import atomic_write_json, bench_context
 from symlearn.symbolic.learned_transition import LearnedTransition
 from symlearn.symbolic.transition_data import encode_crops
 
@@ -86,8 +84,8 @@ def main() -> None:
     tasks = problems(args.run, args.data, args.n, args.length, args.seed, transition)
     base = tasks[: args.n_baseline]
     result = {"run": str(args.run), "data": str(args.data), "length": args.length, "seed": args.seed,
-              "threads": args.threads, "machine": platform.processor() or platform.machine(),
-              "objects": {str(k): sum(len(s) == k for s, _ in tasks) for k in (1, 2, 3)}, "versions": versions()}
+              "threads": args.threads, "objects": {str(k): sum(len(s) == k for s, _ in tasks) for k in (1, 2, 3)},
+              **bench_context()}
     for mode, uniform in (("astar", False), ("uniform_cost", True)):
         batched_all = measure(transition, tasks, uniform, args.timeout)
         batched = measure(transition, base, uniform, args.timeout)

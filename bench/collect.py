@@ -10,16 +10,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import platform
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 from symlearn.sim.collect import CollectConfig, collect, collect_shard
 from symlearn.data.dataset import effect_statistics, load_split
-from symlearn.provenance import versions
+from symlearn.provenance import bench_context
 from symlearn.sim.simulator import SimConfig
 
 ORIGINAL_TIMING = SimConfig(time_step=1 / 240, solver_iterations=50, accel_free=0.5, accel_loaded=0.5,
@@ -53,9 +50,7 @@ def main() -> None:
     two, _ = rate_with_workers(cfg, 2)
     base = rate_in_process(CollectConfig(n=args.baseline_n, seed=0, sim=ORIGINAL_TIMING), args.baseline_n)
     result = {
-        "benchmark": "collect", "date": time.strftime("%Y-%m-%d"), "machine": {
-            "cpus": os.cpu_count(), "platform": platform.platform(), "python": sys.version.split()[0]},
-        "versions": versions(), "n_samples": args.n, "crop": cfg.sim.crop,
+        "benchmark": "collect", **bench_context(), "n_samples": args.n, "crop": cfg.sim.crop,
         "samples_per_s_1_worker": round(one, 2), "samples_per_s_2_workers": round(two, 2),
         "scaling_2_workers": round(two / one, 2),
         "baseline_original_timing_samples_per_s": round(base, 2),

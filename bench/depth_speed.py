@@ -13,8 +13,6 @@ set is generated into OUT's folder first.
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import statistics
 import time
 from pathlib import Path
@@ -92,7 +90,7 @@ def summarize(records: list[dict], planners: list[str]) -> dict:
 
 
 def main() -> None:
-    from symlearn.provenance import atomic_write_json, versions
+    from symlearn.provenance import atomic_write_json, bench_context
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--run", type=Path, required=True, help="run with best.pt, transition.pt and pddl/rules.json")
@@ -127,9 +125,7 @@ def main() -> None:
     result = {"run": str(args.run), "problems": [str(d) for d in folders], "n_selected": len(problems),
               "n_timed": len(records), "objects": list(args.objects), "min_length": args.min_length,
               "timeout_s": args.timeout, "torch_threads": 1, "wall_time_s": round(time.perf_counter() - t0, 1),
-              "date": time.strftime("%Y-%m-%d"), "machine": {"processor": platform.processor() or platform.machine(),
-                                                             "cpus": os.cpu_count(), "python": platform.python_version()},
-              "versions": versions(), **summarize(records, planners), "records": records}
+              **bench_context(), **summarize(records, planners), "records": records}
     atomic_write_json(args.out, result)
     print(f"\n{'planner':<24}{'solved':>8}{'median s':>10}{'solved med s':>14}{'A*/planner':>12}")
     for name, s in result["planners"].items():

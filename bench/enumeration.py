@@ -10,7 +10,6 @@ per scene (36 rows), the way a search queries the network. Writes JSON.
 from __future__ import annotations
 
 import argparse
-import platform
 import time
 from pathlib import Path
 
@@ -20,7 +19,7 @@ import torch
 from pddl_export.enumeration import enumerate_transitions, multiset_indices
 from pddl_export.rules_io import load_rules
 from pddl_export.symbolic import N_ACTIONS
-from symlearn.provenance import atomic_write_json, versions
+from symlearn.provenance import atomic_write_json, bench_context
 from symlearn.symbolic.learned_transition import LearnedTransition
 
 
@@ -60,8 +59,7 @@ def main() -> None:
             print(f"threads {threads} batch {batch}: {enum.n_queries} queries, {enum.queries_per_s:,.0f} q/s "
                   f"({enum.queries_per_s / base:.1f}x one call per scene: {base:,.0f} q/s)")
     atomic_write_json(args.out, {"run": str(args.run), "vocabulary_size": len(vocab), "max_objects": args.max_objects,
-                                 "date": time.strftime("%Y-%m-%d"), "machine": platform.processor() or platform.machine(),
-                                 "versions": versions(), "rows": rows})
+                                 **bench_context(), "rows": rows})
     print(f"wrote {args.out}")
 
 

@@ -11,8 +11,6 @@ writes the tally per suite: tried, held, failed.
 from __future__ import annotations
 
 import argparse
-import datetime as dt
-import platform
 import subprocess
 import sys
 import tempfile
@@ -20,7 +18,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from symlearn.provenance import atomic_write_json, versions  # noqa: E402
+from symlearn.provenance import atomic_write_json, bench_context  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -55,8 +53,7 @@ def main() -> None:
     args = ap.parse_args()
     suites = run_suites(args.timeout)
     total = {k: sum(s[k] for s in suites.values()) for k in ("tried", "held", "failed", "skipped")}
-    result = {"date": dt.date.today().isoformat(), "machine": f"{platform.machine()}, {platform.processor() or '?'}",
-              "versions": versions(), "total": total, "suites": suites}
+    result = {**bench_context(), "total": total, "suites": suites}
     atomic_write_json(Path(args.out), result)
     print(f"{total['tried']} probes: {total['held']} held, {total['failed']} failed, {total['skipped']} skipped")
     for name, s in suites.items():

@@ -20,7 +20,7 @@ def main(argv: list[str] | None = None) -> int:
     from pddl_export.rules_io import load_rules
     from pddl_export.symbolic import SymbolicGoal
     from search.rule_abstraction import pair_unreachable
-    from symlearn.provenance import atomic_write_json, versions
+    from symlearn.provenance import atomic_write_json, bench_context
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--run", type=Path, required=True, help="run whose pddl/rules.json the records were planned on")
@@ -47,7 +47,7 @@ def main(argv: list[str] | None = None) -> int:
                "unsolvable": sum(x["status"] == "unsolvable" for x in rows),
                "slowest_s": max((x["time_s"] for x in rows), default=0.0)}
     atomic_write_json(args.out, {"run": str(args.run), "records": str(args.records), "planner": args.planner,
-                                 "versions": versions(), "summary": summary, "rows": rows})
+                                 **bench_context(), "summary": summary, "rows": rows})
     print(json.dumps(summary))
     return 0
 

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import platform
 import re
 import statistics
 import subprocess
@@ -22,7 +21,7 @@ import time
 from pathlib import Path
 
 from search.sas_planners import search_binary
-from symlearn.provenance import atomic_write_json, versions
+from symlearn.provenance import atomic_write_json, bench_context
 
 PARTS = ("sas_write_time_s", "pddl_write_time_s", "planner_time_s", "fd_total_time_s", "fd_search_time_s")
 TINY_SAS = "\n".join(["begin_version", "3", "end_version", "begin_metric", "0", "end_metric", "1",
@@ -93,8 +92,7 @@ def main() -> None:
     if "rows" not in bench or "planners" not in bench:
         raise SystemExit(f"{args.benchmark} is not a symlearn benchmark JSON (no rows/planners)")
     result = {"benchmark": str(args.benchmark), "problems": bench.get("problems"), "closed_loop": bench.get("closed_loop"),
-              "date": time.strftime("%Y-%m-%d"), "machine": platform.processor() or platform.machine(),
-              "versions": versions(), "planners": summarize(bench)}
+              **bench_context(), "planners": summarize(bench)}
     if args.floor:
         result["process_floor"] = process_floor(args.repeats)
     atomic_write_json(args.out, result)

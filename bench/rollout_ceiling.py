@@ -96,28 +96,23 @@ def table_scores(table: dict, before: np.ndarray, after: np.ndarray, action: np.
 
 def fit_on_rollouts(cfg, train, val, seed: int, steps: int):
     """m(z) trained on chains of `steps` actions, each fed the previous prediction; best validation weights."""
-    import math
-
     import torch
 
     from symlearn.symbolic.transition_metrics import rollout_chains
-    from symlearn.symbolic.transition_model import TransitionNet, masked_bce
+    from symlearn.symbolic.transition_model import masked_bce
+    from symlearn.symbolic.transition_training import fit_transition
 
-    torch.manual_seed(seed)
-    net = TransitionNet(cfg)
-    opt = torch.optim.Adam(net.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
-    gen = torch.Generator().manual_seed(seed)
     chains = torch.from_numpy(rollout_chains(train, steps))
     x, m, a, y = (torch.from_numpy(v) for v in (train.before, train.mask, train.action, train.after))
-    xv, mv, av, yv = (torch.from_numpy(v) for v in (val.before, val.mask, val.action, val.after))
-    best, best_state = math.inf, None
-    for _ in range(cfg.epochs):
+
+    def chain_epoch(net, opt, gen, epoch: int) -> float:
         net.train()
         perm = torch.randperm(len(chains), generator=gen)
+        losses = []
         for b in range(0, len(chains), cfg.batch_size):
             ch = chains[perm[b:b + cfg.batch_size]]
             mask, state, loss = m[ch[:, 0]], x[ch[:, 0]], 0.0
-            for j in range(steps):
+            for j in range(steps):  # each step is fed the previous step's binarised prediction (straight through)
                 out = net(state, mask, a[ch[:, j]])
                 loss = loss + masked_bce(out.logits, y[ch[:, j]], mask)
                 p = torch.sigmoid(out.logits)
@@ -125,13 +120,10 @@ def fit_on_rollouts(cfg, train, val, seed: int, steps: int):
             opt.zero_grad(set_to_none=True)
             loss.backward()
             opt.step()
-        net.eval()
-        with torch.no_grad():
-            v = float(masked_bce(net(xv, mv, av).logits, yv, mv))
-        if v < best:
-            best, best_state = v, {k: t.detach().clone() for k, t in net.state_dict().items()}
-    net.load_state_dict(best_state)
-    return net.eval()
+            losses.append(float(loss.detach()) / steps)
+        return sum(losses) / max(len(losses), 1)
+
+    return fit_transition(cfg, train, val, seed, train_epoch=chain_epoch)[0]
 
 
 def sweep_rounds(splits: dict, rounds: list[int], seeds: list[int]) -> dict:

@@ -11,8 +11,6 @@ finished (solved or unsolvable), how many were solved, and the slowest finished 
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import sys
 import time
 from pathlib import Path
@@ -42,7 +40,7 @@ def summarize(records: list[dict], planners: list[str]) -> dict:
 
 
 def main() -> None:
-    from symlearn.provenance import atomic_write_json, versions
+    from symlearn.provenance import atomic_write_json, bench_context
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--run", type=Path, required=True, help="run with best.pt, transition.pt and pddl/rules.json")
@@ -65,10 +63,8 @@ def main() -> None:
     records = time_planners(args.run, problems, planners, args.timeout, float("inf"))
     result = {"run": str(args.run), "problems": [str(d) for d in folders], "n": len(records),
               "min_objects": args.min_objects, "max_objects": args.max_objects, "max_length": args.max_length, "timeout_s": args.timeout,
-              "wall_time_s": round(time.perf_counter() - t0, 1), "date": time.strftime("%Y-%m-%d"),
-              "machine": {"processor": platform.processor() or platform.machine(), "cpus": os.cpu_count(),
-                          "python": platform.python_version()},
-              "versions": versions(), "planners": summarize(records, planners), "records": records}
+              "wall_time_s": round(time.perf_counter() - t0, 1), **bench_context(),
+              "planners": summarize(records, planners), "records": records}
     atomic_write_json(args.out, result)
     for name, s in result["planners"].items():
         print(f"{name}: finished every problem: {s['finished_all']}")

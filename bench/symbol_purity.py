@@ -1,8 +1,8 @@
 """What a run's symbols encode: how far each code pins down an object's type, location and height, and back.
 
 For every real test object the code of its pre-state crop is compared with its arrangement, read from poses the
-model never sees: type, the nearest of the 6 table locations, and its height level (5 cm steps above the lowest
-object). Purity of a property: the share of objects whose code's most common value of that property is theirs.
+model never sees (`symlearn.data.statistics.arrangement_labels`): type, the nearest of the 6 table locations, and
+its height level (5 cm steps above the type's resting height). Purity of a property: the share of objects whose code's most common value of that property is theirs.
 Determinism: the share of objects whose (type, location, level) group's most common code is theirs: 1.0 means
 the same arrangement always gets the same symbol. Also: how many codes change when every crop window is shifted
 by 1-2 pixels (placement jitter), and, where the run has m(z), how often it gets the held object's next code
@@ -23,15 +23,14 @@ import torch
 
 from pddl_export.symbolic import codes_from_bits
 from symlearn.data.dataset import load_split
-from symlearn.data.statistics import held_mask
+from symlearn.data.statistics import arrangement_labels, held_mask
 from symlearn.learning.checkpoint import effect_model_sha256, load_effect_model
-from symlearn.provenance import atomic_write_json
+from symlearn.provenance import atomic_write_json, bench_context
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, load_transition
 from symlearn.symbolic.transition_data import build_transition_data, encode_crops
 from symlearn.symbolic.transition_model import predict_bits
 from symlearn.world import LOCATIONS
 
-LEVEL_M = 0.05  # height step: a cube is 5 cm tall
 SHIFTS = ((1, 0), (0, 1), (2, 0), (0, 2), (-2, -2))
 
 
@@ -51,12 +50,9 @@ def purity(run: Path, data_dir: Path, n_shift: int = 400) -> dict:
     bits = encode_crops(model, data.pre_depth, origin, data.mask)
     m = data.mask
     codes = codes_from_bits(bits.round())[m]
-    xy, z = data.pre_pose[..., :2], data.pre_pose[..., 2]
-    dist = np.linalg.norm(xy[..., None, :] - np.asarray(LOCATIONS)[None, None], axis=-1)  # (N, K, 6)
-    loc = dist.argmin(-1)[m]
-    level = np.round((z - z[m].min()) / LEVEL_M).astype(np.int64)[m]
-    typ = data.obj_type.astype(np.int64)[m]
-    arrangement = typ * 1000 + loc * 10 + level
+    dist = np.linalg.norm(data.pre_pose[..., None, :2] - np.asarray(LOCATIONS)[None, None], axis=-1)  # (N, K, 6)
+    arrangement = arrangement_labels(data)[m]  # type * 1000 + location * 10 + level
+    typ, loc, level = arrangement // 1000, arrangement // 10 % 100, arrangement % 10
     sub = slice(0, n_shift)
     base = encode_crops(model, data.pre_depth[sub], origin[sub], data.mask[sub])
     shifted = {}
@@ -98,7 +94,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     torch.set_num_threads(args.threads)
     rows = [purity(Path(r), Path(args.data)) for r in args.runs.split(",")]
-    atomic_write_json(args.out, {"data": args.data, "runs": rows})
+    atomic_write_json(args.out, {"data": args.data, **bench_context(), "runs": rows})
     for r in rows:
         print(json.dumps(r))
     return 0

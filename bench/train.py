@@ -9,15 +9,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import platform
 import time
 from pathlib import Path
 
 import torch
 
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig, masked_mse
-from symlearn.provenance import atomic_write_json, versions
+from symlearn.provenance import atomic_write_json, bench_context
 
 
 def _onednn_bf16(on: bool) -> None:
@@ -79,10 +77,8 @@ def main() -> None:
     if args.compile:
         rows["channels_last_bf16_compiled"] = measure(cfg, args.batch, args.steps, True, True, True)
     base = rows["fp32_eager_nchw (baseline)"]
-    result = {"benchmark": "train_throughput", "date": time.strftime("%Y-%m-%d"), "preset": args.preset,
+    result = {"benchmark": "train_throughput", **bench_context(), "preset": args.preset,
               "batch_scenes": args.batch, "threads": torch.get_num_threads(),
-              "machine": {"cpus": os.cpu_count(), "platform": platform.platform(), "processor": platform.processor()},
-              "versions": versions(),
               "crops_per_s": {k: round(v, 1) for k, v in rows.items()},
               "speedup_vs_baseline": {k: round(v / base, 2) for k, v in rows.items()}}
     atomic_write_json(Path(args.out), result)

@@ -1,6 +1,7 @@
 """What every output records beside itself: versions, hashes, and atomic writes of JSON."""
 from __future__ import annotations
 
+import os
 import platform
 import time
 from importlib import metadata
@@ -23,6 +24,6 @@ def versions() -> dict[str, str]:
 
 
 def bench_context() -> dict:
-    """Where and when a bench script ran, and with what: the machine, today's date and versions()."""
-    return {"machine": f"{platform.machine()}, {platform.processor() or 'cpu'}", "date": time.strftime("%Y-%m-%d"),
-            "versions": versions()}
+    """Where and when a bench script ran, and with what: the machine, its CPU count, today's date and versions()."""
+    return {"machine": f"{platform.machine()}, {platform.processor() or 'cpu'}", "cpus": os.cpu_count(),
+            "date": time.strftime("%Y-%m-%d"), "versions": versions()}

@@ -88,6 +88,6 @@ def test_bench_context_names_the_machine_the_date_and_the_versions():
     from symlearn.provenance import bench_context
 
     ctx = bench_context()
-    assert list(ctx) == ["machine", "date", "versions"]
+    assert list(ctx) == ["machine", "cpus", "date", "versions"] and ctx["cpus"] >= 1
     assert ctx["machine"].startswith(platform.machine() + ", ") and re.fullmatch(r"\d{4}-\d\d-\d\d", ctx["date"])
     assert ctx["versions"] == versions()

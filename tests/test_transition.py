@@ -333,3 +333,30 @@ def test_encode_observation_of_live_scene(run, sim):
     assert codes.shape == (2,) and codes.dtype == np.int64
     assert codes.min() >= 0 and codes.max() < 1 << encoder.cfg.bits
     np.testing.assert_array_equal(codes, encode_observation(encoder, sim.observe()))
+
+
+def test_fit_transition_keeps_the_best_epoch_of_a_custom_training_epoch():
+    """train_epoch replaces the pass over pairs; validation still keeps the weights of the best epoch."""
+    from symlearn.symbolic.transition_training import fit_transition
+
+    rng = np.random.default_rng(0)
+    z = rng.integers(0, 2, (24, 2, BITS)).astype(np.float32)
+    data = TransitionData(z, rng.integers(0, 36, 24), z.copy(), np.ones((24, 2), bool), np.arange(24), np.zeros(24, np.int64))
+    cfg = TransitionConfig.from_preset("quick", bits=BITS, epochs=4)
+    calls = []
+
+    def jolt(net, opt, gen, epoch):  # random steps: the validation loss goes up and down
+        calls.append(epoch)
+        with torch.no_grad():
+            for p in net.parameters():
+                p.add_(torch.randn(p.shape, generator=gen) * 0.3)
+        return 1.0
+
+    net, best, history = fit_transition(cfg, data, data, seed=0, train_epoch=jolt)
+    assert calls == [0, 1, 2, 3] and [h["train_loss"] for h in history] == [1.0] * 4
+    assert best == pytest.approx(min(h["val_loss"] for h in history), abs=1e-4)
+    tensors = [torch.from_numpy(v) for v in (data.before, data.mask, data.action, data.after)]
+    with torch.no_grad():
+        kept = float(masked_bce(net(*tensors[:3]).logits, tensors[3], tensors[1]))
+    assert kept == pytest.approx(best, rel=1e-5)
+    assert history[-1]["val_loss"] > best + 1e-3  # the last epoch was not the best: its weights were not kept

@@ -11,6 +11,7 @@ import dataclasses
 import math
 import time
 from pathlib import Path
+from typing import Callable
 
 import torch
 
@@ -56,9 +57,18 @@ def encode_splits(encoder: AttentiveDeepSym, data_dir: Path, batch_size: int) ->
     return {s: build_transition_data(encoder, load_split(data_dir, s), batch_size) for s in ("train", "val", "test")}
 
 
+# one training epoch: (net, optimizer, shuffling generator, epoch index) -> mean training loss
+EpochFn = Callable[[TransitionNet, torch.optim.Optimizer, torch.Generator, int], float]
+
+
 def fit_transition(cfg: TransitionConfig, tr: TransitionData, va: TransitionData, seed: int,
-                   show_progress: bool = False) -> tuple[TransitionNet, float, list[dict]]:
-    """Adam on masked BCE for cfg.epochs; returns the net with its best-validation weights, that loss and the history."""
+                   show_progress: bool = False,
+                   train_epoch: EpochFn | None = None) -> tuple[TransitionNet, float, list[dict]]:
+    """Adam on masked BCE for cfg.epochs; returns the net with its best-validation weights, that loss and the history.
+
+    train_epoch replaces the epoch over (before, action, after) pairs (for instance one over multi-step chains);
+    validation and keeping the best weights stay the same.
+    """
     with torch.random.fork_rng(devices=[]):  # seeded init without touching the caller's global RNG
         torch.manual_seed(seed)
         net = TransitionNet(cfg)
@@ -68,7 +78,8 @@ def fit_transition(cfg: TransitionConfig, tr: TransitionData, va: TransitionData
     x_va, m_va, a_va, y_va = _tensors(va)
     best, best_state, history = math.inf, None, []
     for epoch in range(cfg.epochs):
-        train_loss = _train_epoch(net, opt, gen, train_t, cfg, epoch)
+        train_loss = (train_epoch(net, opt, gen, epoch) if train_epoch is not None
+                      else _train_epoch(net, opt, gen, train_t, cfg, epoch))
         net.eval()
         with torch.no_grad():
             val_loss = float(masked_bce(net(x_va, m_va, a_va).logits, y_va, m_va))
