@@ -29,9 +29,9 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from pddl_export.rule_successors import RuleSuccessors
-from pddl_export.symbolic import N_ACTIONS, SymbolicGoal
+from pddl_export.symbolic import N_ACTIONS, SymbolicGoal, code_str
 from search.astar import astar, outcome_result
-from search.result import PlanResult
+from search.result import PlanResult, PlanStatus
 from search.rules_search import UNREACHABLE, checked_start, code_distances
 
 State = tuple[int, ...]
@@ -104,6 +104,14 @@ def plan_rules_outcomes(
     seen = seen or {}
     dist = code_distances(main.rules, goal, alternates.rules).tolist()
     fixed = [(i, c) for i, c in enumerate(goal.codes) if c is not None]
+    stuck = [i for i, c in fixed if dist[i][start_arr[i]] >= UNREACHABLE]
+    if stuck:  # a proof before any search: no chain of rules or second outcomes leads this object to its goal code
+        i = stuck[0]
+        return PlanResult(planner=planner_name, status=PlanStatus.UNSOLVABLE, plan=(), predicted_states=(),
+                          expansions=0, planning_time_s=time.perf_counter() - t0,
+                          message=f"object {i} cannot reach its goal code {code_str(goal.codes[i], main.bits)} from "
+                                  f"{code_str(int(start_arr[i]), main.bits)} through any chain of rules or second outcomes",
+                          extra={"generated": 0, "batch": batch, "proof": "code_graph"})
 
     def heuristic(s: State) -> float:
         h = sum(row[c] for row, c in zip(dist, s))

@@ -129,6 +129,15 @@ def test_a_goal_only_a_second_outcome_reaches():
     assert res.status is PlanStatus.UNSOLVABLE
 
 
+def test_a_goal_code_no_chain_reaches_is_refused_before_search():
+    main = _toy_rules(Rule(action=5, code_from=1, code_to=2))
+    alt = _toy_rules(Rule(action=5, code_from=1, code_to=3))
+    res = plan_rules_outcomes(RuleSuccessors(main), RuleSuccessors(alt), _costs(a5_1_3=0.5), [2, 1], SymbolicGoal((None, 0)),
+                              risk_weight=1.0, timeout_s=5)
+    assert res.status is PlanStatus.UNSOLVABLE and res.expansions == 0 and res.extra["proof"] == "code_graph"
+    assert res.message == "object 1 cannot reach its goal code 00 from 01 through any chain of rules or second outcomes"
+
+
 def test_risk_weight_trades_a_longer_sure_plan_for_a_short_unlikely_one():
     main = _toy_rules(Rule(action=1, code_from=1, code_to=2), Rule(action=2, code_from=2, code_to=3))
     alt = _toy_rules(Rule(action=1, code_from=1, code_to=3))
