@@ -15,7 +15,8 @@ grounded STRIPS form of the domain for this problem) and call the planner throug
 unified-planning (search.classical), or, for the `-sas` planners, write the rules for this
 problem as a SAS+ task and run Fast Downward's or SymK's search on it without a translator
 (search.sas_planners). The `rules-` planners search the rules in this process (search.rules_search),
-without writing a task or starting a process. Their plans are checked against the network: if rolling the
+without writing a task or starting a process; `rules-outcomes` also follows each object's second likeliest
+outcome (RUN/pddl/outcomes.json, search.rules_outcomes), the exported form of "astar-outcomes". Their plans are checked against the network: if rolling the
 transition network along the plan gives other states than the PDDL predicted, the result is
 marked `rules_vs_net`. PDDL writing time and the planner's own time are reported separately.
 
@@ -74,7 +75,7 @@ class PlannerContext:
     @staticmethod
     def for_run(run_dir: Path, names: list[str], write_dir: Path | None = None,
                 risk_weight: float = 1.0) -> "PlannerContext":
-        """A context for the named planners of a run: loads RUN/pddl/rules.json only when one of them needs it."""
+        """A context for the named planners of a run: loads RUN/pddl/rules.json (and outcomes.json) only when needed."""
         specs = [planner_spec(n) for n in names]  # refuse unknown names before reading anything
         if not any(s.needs_rules for s in specs):
             return PlannerContext(write_dir=write_dir, risk_weight=risk_weight)
