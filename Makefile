@@ -20,9 +20,10 @@ $(VENV)/.installed: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q -e '.[dev]'
 	touch $@
 
-# The whole pipeline at the quick preset on a small data set (about 10 minutes on 2 cores), ending with the
+# The whole pipeline at the quick preset on a small data set (about 15 minutes on 2 cores), ending with the
 # learned-net A* next to Fast Downward and SymK on the exported rules (their SAS+ route; the PDDL route through
-# unified-planning takes seconds per task and runs in `make test` and examples/), the same problems on the
+# unified-planning takes seconds per task and runs in `make test` and examples/) and the in-process rule searches
+# (rules-bfs, rules-outcomes), the same problems on the
 # shipped pretrained run (copied to runs/pretrained), and RUN/report.html.
 demo: $(VENV)/.installed
 	$(BIN)/symlearn scenarios
