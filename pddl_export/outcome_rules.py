@@ -23,16 +23,17 @@ outcomes, without the network. Stored as RUN/pddl/outcomes.json beside rules.jso
 from __future__ import annotations
 
 import json
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from pddl_export.distil import distil_rules
-from pddl_export.enumeration import Enumeration, enumerate_scenes
+from pddl_export.enumeration import Enumeration, SceneBlock
 from pddl_export.rules import RuleSet
 from pddl_export.rules_io import PDDL_DIR, rules_from_json, rules_to_json
-from pddl_export.symbolic import N_ACTIONS, OutcomeTransitionFn, code_str, codes_from_bits
+from pddl_export.symbolic import N_ACTIONS, OutcomeTransitionFn, bit_flip_costs, code_str, codes_from_bits
 
 OUTCOMES_FILE = "outcomes.json"
 MIN_OUTCOME_RATIO = 0.05  # an alternative is kept where it is at least this fraction as likely as the likeliest
@@ -47,10 +48,7 @@ def second_codes(probs: np.ndarray, min_ratio: float) -> tuple[np.ndarray, np.nd
     if not 0 < min_ratio <= 1:
         raise ValueError(f"min_ratio must lie in (0, 1], got {min_ratio}")
     probs = np.asarray(probs, np.float64)
-    top = probs >= 0.5
-    q = np.where(top, 1.0 - probs, probs)
-    with np.errstate(divide="ignore"):
-        flip = np.log1p(-q) - np.log(q)  # (B, K, bits) extra -log P of flipping each bit, inf where q = 0
+    top, flip = bit_flip_costs(probs)  # (B, K, bits) extra -log P of flipping each bit
     least = np.argmin(flip, axis=-1)  # (B, K) the least certain bit
     extra = np.take_along_axis(flip, least[..., None], -1)[..., 0]
     keep = extra <= -np.log(min_ratio)
@@ -100,30 +98,34 @@ class OutcomeRules:
         return table
 
 
-def _alternative_costs(second: SecondOutcome, enumeration: Enumeration) -> tuple[tuple[int, int, int, float], ...]:
-    """Mean extra -log P per (action, code_from, code_to) over the enumerated objects that have that alternative."""
+def _second_enumeration(second: SecondOutcome, enumeration: Enumeration
+                        ) -> tuple[Enumeration, tuple[tuple[int, int, int, float], ...]]:
+    """SecondOutcome's answers on the enumeration's scenes, and the mean extra -log P per (action, code_from,
+    code_to) over the objects that have that alternative: both from one pass of the network."""
     sums: dict[tuple[int, int, int], list[float]] = {}
+    blocks, seconds = [], 0.0
     for block in enumeration.blocks:
-        if not len(block.scenes):
-            continue
         states = block.states
+        t0 = time.perf_counter()
         main, alt, extra = second.outcomes(states, block.actions)
+        seconds += time.perf_counter() - t0
+        blocks.append(SceneBlock(block.n_objects, block.scenes, block.actions, alt))
         rows, objs = np.nonzero(alt != main)
         for a, c, d, x in zip(block.actions[rows].tolist(), states[rows, objs].tolist(), alt[rows, objs].tolist(),
                               extra[rows, objs].tolist()):
             acc = sums.setdefault((a, c, d), [0.0, 0])
             acc[0] += x
             acc[1] += 1
-    return tuple((a, c, d, s / n) for (a, c, d), (s, n) in sorted(sums.items()))
+    enum = Enumeration(enumeration.bits, enumeration.vocabulary, enumeration.max_objects, tuple(blocks),
+                       n_calls=len(blocks), seconds=seconds, complete=enumeration.complete)
+    return enum, tuple((a, c, d, s / n) for (a, c, d), (s, n) in sorted(sums.items()))
 
 
 def distil_outcomes(transition: OutcomeTransitionFn, enumeration: Enumeration,
                     min_ratio: float = MIN_OUTCOME_RATIO) -> tuple[OutcomeRules, Enumeration]:
     """The second-outcome rules on the scenes of `enumeration` (the main rules'), and their own enumeration."""
-    second = SecondOutcome(transition, min_ratio)
-    scenes = [tuple(s) for b in enumeration.blocks for s in b.scenes.tolist()]
-    enum = enumerate_scenes(second, enumeration.vocabulary, scenes, enumeration.max_objects)
-    return OutcomeRules(distil_rules(enum), _alternative_costs(second, enumeration), min_ratio), enum
+    enum, costs = _second_enumeration(SecondOutcome(transition, min_ratio), enumeration)
+    return OutcomeRules(distil_rules(enum), costs, min_ratio), enum
 
 
 def outcomes_to_json(outcomes: OutcomeRules) -> dict:

@@ -63,6 +63,19 @@ def codes_from_bits(b: np.ndarray) -> np.ndarray:
     return (b * weights).sum(-1)
 
 
+def bit_flip_costs(probs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(..., bits) P(each bit is 1) -> (the likeliest bits, the extra -log P of flipping each), both (..., bits).
+
+    Bits are independent, so flipping bit b multiplies P by q_b / (1 - q_b), q_b the probability of the
+    value it does not take in the likeliest state: the extra cost is log((1 - q_b) / q_b) >= 0 (inf if q_b = 0).
+    """
+    probs = np.asarray(probs, np.float64)
+    top = probs >= 0.5
+    q = np.where(top, 1.0 - probs, probs)
+    with np.errstate(divide="ignore"):
+        return top, np.log1p(-q) - np.log(q)
+
+
 def bits_from_codes(codes: np.ndarray, bits: int) -> np.ndarray:
     """(...) int codes -> (..., bits) float32 0/1 vectors, element 0 the most significant bit."""
     codes = np.asarray(codes, np.int64)

@@ -45,7 +45,7 @@ import numpy as np
 from search.astar import astar, outcome_result
 from search.result import PlanResult
 from pddl_export.symbolic import (N_ACTIONS, OutcomeTransitionFn, ScoredTransitionFn, SymbolicGoal, TransitionFn,
-                                  codes_from_bits)
+                                  bit_flip_costs, codes_from_bits)
 
 State = tuple[int, ...]
 MAX_OUTCOMES = 9  # likely_outcomes enumerates 2**(max_outcomes - 1) flip subsets per action
@@ -93,11 +93,9 @@ def likely_outcomes(probs: np.ndarray, max_outcomes: int, min_ratio: float) -> l
     """
     probs = np.asarray(probs, np.float64)
     n_rows, k, bits = probs.shape
-    top = probs >= 0.5
-    q = np.where(top, 1.0 - probs, probs)  # each bit's chance of the other value
-    with np.errstate(divide="ignore"):
-        base = -np.log1p(-q).sum((1, 2))  # (A,) -log P(likeliest state)
-        flip = (np.log1p(-q) - np.log(q)).reshape(n_rows, k * bits)  # extra -log P of one flip, >= 0, inf if q=0
+    top, flip_bits = bit_flip_costs(probs)
+    base = -np.log(np.where(top, probs, 1.0 - probs)).sum((1, 2))  # (A,) -log P(likeliest state)
+    flip = flip_bits.reshape(n_rows, k * bits)  # extra -log P of one flip, >= 0, inf where certain
     n_cand = min(max_outcomes - 1, k * bits)
     cand = np.argsort(flip, axis=1, kind="stable")[:, :n_cand]  # (A, n_cand) the least certain bits
     subsets = ((np.arange(1 << n_cand)[:, None] >> np.arange(n_cand)) & 1).astype(bool)  # (S, n_cand), [0] = none

@@ -359,7 +359,7 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
     once; a run interrupted (killed) and started again with the same settings resumes there, and its
     final JSON equals an uninterrupted run's (its timings aside). The log is removed once out_file is
     written. With record_dir, each failed open-loop run is saved as record_dir/<problem>_<planner>.gif.
-    risk_weight is astar-likely's and astar-outcomes' (symlearn.planning.planners.PlannerContext), recorded when one plans.
+    risk_weight is that of the RISK_PLANNERS (symlearn.planning.planners.PlannerContext), recorded when one plans.
     """
     if not planners:
         raise ValueError("no planners given")
