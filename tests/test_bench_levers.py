@@ -129,3 +129,36 @@ def test_outcome_reach_tells_the_likeliest_chain_from_the_likely_outcomes():
     # outcomes below the ratio, or a beam of one chain, leave only the likeliest
     assert orr.reach(_Coin(), (0,), (0, 1), {0: 3}, beam=4, max_outcomes=4, min_ratio=0.5) == (False, None)
     assert orr.reach(_Coin(), (0,), (0, 1), {0: 3}, beam=1, max_outcomes=4, min_ratio=0.05) == (False, None)
+
+
+def test_transition_volume_counts_rollouts_per_object_count():
+    """A copying m(z) on two episodes: 2 objects that never change, 4 objects of which one changes at step 1."""
+    import torch
+
+    from symlearn.symbolic.transition_data import TransitionData
+    from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet
+
+    tv = _load("transition_volume")
+    cfg = TransitionConfig.from_preset("quick", bits=8, copy_prior=3.0)
+    net = TransitionNet(cfg).eval()
+    torch.nn.init.zeros_(net.post[-1].weight)
+    torch.nn.init.zeros_(net.post[-1].bias)
+    rng = np.random.default_rng(0)
+    a = (rng.random((4, 8)) < 0.5).astype(np.float32)
+    b = a.copy()
+    b[2] = 1 - b[2]  # the third object's code changes at step 1 of the second episode
+    c2 = (rng.random((4, 8)) < 0.5).astype(np.float32)
+    c2[2:] = 0
+    states = [c2, c2, c2, c2, a, a, b, b]  # episode 0: s0..s3; episode 1: s0..s3
+    before = np.stack([states[0], states[1], states[2], states[4], states[5], states[6]])
+    after = np.stack([states[1], states[2], states[3], states[5], states[6], states[7]])
+    mask = np.zeros((6, 4), bool)
+    mask[:3, :2] = True
+    mask[3:] = True
+    data = TransitionData(before=before, action=np.zeros(6, np.int64), after=after, mask=mask,
+                          episode=np.array([0, 0, 0, 1, 1, 1], np.int32), step=np.array([0, 1, 2, 0, 1, 2]))
+    one, two, three = (tv.rollout_by_objects(net, data, n) for n in (1, 2, 3))
+    assert one["2"] == {"n": 3, "scene_accuracy": 1.0} and one["4"] == {"n": 3, "scene_accuracy": round(2 / 3, 4)}
+    assert one["all"] == {"n": 6, "scene_accuracy": round(5 / 6, 4)}
+    assert two["2"]["scene_accuracy"] == 1.0 and two["4"] == {"n": 2, "scene_accuracy": 0.0}
+    assert three["all"] == {"n": 2, "scene_accuracy": 0.5}

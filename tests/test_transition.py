@@ -7,14 +7,16 @@ import numpy as np
 import pytest
 import torch
 
+from conftest import TINY_TRANSITION_ARGS, cli, cli_json
 from search.learned_astar import plan_symbolic
 from pddl_export.symbolic import SymbolicGoal
 from symlearn.learning.checkpoint import load_effect_model
-from symlearn.data.dataset import load_split
+from symlearn.data.dataset import data_fingerprint, load_split
 from symlearn.learning.training import TrainConfig
 from symlearn.symbolic.learned_transition import LearnedTransition
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, TransitionError, load_transition, save_transition
-from symlearn.symbolic.transition_data import TransitionData, build_transition_data, encode_observation
+from symlearn.symbolic.transition_data import (TransitionData, build_transition_data, concat_transition_data,
+                                               encode_observation)
 from symlearn.symbolic.transition_metrics import ROLLOUT_STEPS, rollout_chains
 from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet, masked_bce
 from symlearn.symbolic.transition_training import METRICS_FILE
@@ -360,3 +362,58 @@ def test_fit_transition_keeps_the_best_epoch_of_a_custom_training_epoch():
         kept = float(masked_bce(net(*tensors[:3]).logits, tensors[3], tensors[1]))
     assert kept == pytest.approx(best, rel=1e-5)
     assert history[-1]["val_loss"] > best + 1e-3  # the last epoch was not the best: its weights were not kept
+
+
+# ------------------------------------------------------------------------------- extra transition data
+
+
+def _td(n: int, k: int, episodes: list[int], seed: int) -> TransitionData:
+    rng = np.random.default_rng(seed)
+    mask = np.zeros((n, k), bool)
+    mask[:, :2] = True
+    bits = lambda: (rng.random((n, k, BITS)) < 0.5).astype(np.float32) * mask[..., None]  # noqa: E731
+    return TransitionData(before=bits(), action=rng.integers(0, 36, n), after=bits(), mask=mask,
+                          episode=np.asarray(episodes, np.int32), step=np.arange(n) % 3)
+
+
+def test_concat_pads_objects_and_keeps_episodes_apart():
+    a, b = _td(6, 3, [0, 0, 0, 1, 1, 1], 0), _td(3, 5, [0, 0, 0], 1)
+    both = concat_transition_data([a, b])
+    assert both.before.shape == (9, 5, BITS) and both.mask.shape == (9, 5)
+    np.testing.assert_array_equal(both.before[:6, :3], a.before)
+    assert not both.mask[:6, 3:].any() and not both.before[:6, 3:].any()
+    np.testing.assert_array_equal(both.after[6:], b.after)
+    assert both.episode.tolist() == [0, 0, 0, 1, 1, 1, 2, 2, 2]
+    # a 3-step chain never joins the last episode of one part to the first of the next
+    assert sorted(map(tuple, rollout_chains(both, 3).tolist())) == [(0, 1, 2), (3, 4, 5), (6, 7, 8)]
+    with pytest.raises(ValueError, match="no transition data"):
+        concat_transition_data([])
+
+
+def test_extra_data_joins_training_and_is_tested_apart(tiny_run, tiny_run_copy, tmp_path, capsys):
+    extra = tmp_path / "k45"
+    cli_json("collect", "--out", extra, "--n", "16", "--objects", "4-5", "--seed", "5", "--shard-size", "4", "--quiet")
+    sizes = {s: len(load_split(extra, s).action) for s in ("train", "val", "test")}
+    assert load_split(extra, "train").mask.shape[1] == 5
+    out = cli_json("train-transition", "--run", tiny_run_copy, "--data", tiny_run.data, "--extra-data", extra,
+                   *TINY_TRANSITION_ARGS, "--quiet")
+    m = json.loads((tiny_run_copy / METRICS_FILE).read_text())
+    assert m["n_samples"] == {"train": 40 + sizes["train"], "val": 4 + sizes["val"], "test": 4}
+    assert m["extra_data"] == [{"data": str(extra), "data_fingerprint": data_fingerprint(extra)}]
+    # the saved network's accuracy on the extra set's 5-object test split, recomputed here
+    net, meta = load_transition(tiny_run_copy / TRANSITION_FILE)
+    assert meta["extra_data"] == m["extra_data"]
+    encoder, _ = load_effect_model(tiny_run_copy)
+    td = build_transition_data(encoder, load_split(extra, "test"))
+    with torch.no_grad():
+        pred = net(torch.from_numpy(td.before), torch.from_numpy(td.mask), torch.from_numpy(td.action)).codes.numpy()
+    got = m["extra_test"][str(extra)]
+    assert got["n"] == sizes["test"] == len(td)
+    assert got["object_accuracy"] == pytest.approx((pred == td.after).all(-1)[td.mask].mean(), abs=1e-5)
+    assert out["extra_test_rollout_scene_accuracy"][str(extra)]["1"] == got["scene_accuracy"]
+    # the main test split is the same 4 samples as without extra data
+    assert m["test"]["n"] == 4
+    capsys.readouterr()
+    rc, _ = cli("train-transition", "--run", tiny_run_copy, "--data", tiny_run.data, "--extra-data",
+                tiny_run.data, *TINY_TRANSITION_ARGS, "--quiet")
+    assert rc != 0 and "must differ" in capsys.readouterr().err

@@ -50,13 +50,17 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
     cfg = TransitionConfig.from_preset(args.preset, **over)
     print(f"train-transition: preset {cfg.preset}, {cfg.attention_rounds} attention round(s), {cfg.epochs} epochs, "
           f"seed {args.seed}, run {args.run}, "
-          f"data {args.data}", file=sys.stderr)
-    m = train_transition(Path(args.run), Path(args.data), cfg, seed=args.seed, show_progress=not args.quiet)
+          f"data {args.data}" + "".join(f" + {d}" for d in args.extra_data), file=sys.stderr)
+    m = train_transition(Path(args.run), Path(args.data), cfg, seed=args.seed, show_progress=not args.quiet,
+                         extra_data=tuple(Path(d) for d in args.extra_data))
     test = m["test"]
-    print(json.dumps({"run": args.run, "best_val_loss": m["best_val_loss"],
-                      "test": {k: test[k] for k in ("bit_accuracy", "object_accuracy", "scene_accuracy")},
-                      "rollout_scene_accuracy": {n: r["scene_accuracy"] for n, r in test["rollout"].items()}},
-                     indent=2))
+    out = {"run": args.run, "best_val_loss": m["best_val_loss"],
+           "test": {k: test[k] for k in ("bit_accuracy", "object_accuracy", "scene_accuracy")},
+           "rollout_scene_accuracy": {n: r["scene_accuracy"] for n, r in test["rollout"].items()}}
+    if m["extra_test"]:
+        out["extra_test_rollout_scene_accuracy"] = {d: {n: r["scene_accuracy"] for n, r in t["rollout"].items()}
+                                                    for d, t in m["extra_test"].items()}
+    print(json.dumps(out, indent=2))
     return 0
 
 
@@ -179,6 +183,8 @@ def add_train_transition_command(sub) -> None:
     t = sub.add_parser("train-transition", help="train the symbolic transition model m(z) on a run's codes")
     t.add_argument("--run", required=True, help="run directory with the trained effect model (best.pt)")
     t.add_argument("--data", required=True, help="the data set to encode")
+    t.add_argument("--extra-data", nargs="+", default=[], metavar="DIR",
+                   help="more data sets whose train and val splits join m(z)'s (their test splits are reported apart)")
     t.add_argument("--preset", default="paper", choices=["paper", "quick"])
     t.add_argument("--epochs", type=int)
     t.add_argument("--copy-prior", type=float, help="logit bias toward keeping each input bit (preset's if unset)")

@@ -39,6 +39,24 @@ class TransitionData:
         return int(self.action.shape[0])
 
 
+def concat_transition_data(parts: list[TransitionData]) -> TransitionData:
+    """Several splits as one: object slots padded to the widest, episode ids kept apart per part."""
+    if not parts:
+        raise ValueError("no transition data to join")
+    k = max(p.mask.shape[1] for p in parts)
+
+    def pad(a: np.ndarray) -> np.ndarray:
+        return np.pad(a, [(0, 0), (0, k - a.shape[1])] + [(0, 0)] * (a.ndim - 2))
+
+    offsets = np.cumsum([0] + [int(p.episode.max()) + 1 if len(p) else 0 for p in parts[:-1]])
+    return TransitionData(before=np.concatenate([pad(p.before) for p in parts]),
+                          action=np.concatenate([p.action for p in parts]),
+                          after=np.concatenate([pad(p.after) for p in parts]),
+                          mask=np.concatenate([pad(p.mask) for p in parts]),
+                          episode=np.concatenate([p.episode + o for p, o in zip(parts, offsets)]).astype(np.int32),
+                          step=np.concatenate([p.step for p in parts]))
+
+
 @torch.no_grad()
 def encode_crops(model: AttentiveDeepSym, depth: np.ndarray, origin: np.ndarray, mask: np.ndarray,
                  batch_size: int = 256, image_size: int = 256) -> np.ndarray:

@@ -3,7 +3,9 @@
     >>> train_transition(Path("runs/paper"), Path("data/paper"), TransitionConfig.from_preset("paper"))  # doctest: +SKIP
 
 The metrics file records the transition config, the seed, package versions, the data set's
-fingerprint and the hash of the effect model (best.pt) the codes came from.
+fingerprint and the hash of the effect model (best.pt) the codes came from. Extra data sets (collected
+apart, for instance with more objects) add their train and val splits to m(z)'s; their test splits are
+reported apart, so the main test figures stay comparable with a model trained on the main set alone.
 """
 from __future__ import annotations
 
@@ -21,7 +23,7 @@ from symlearn.learning.models import AttentiveDeepSym
 from pddl_export.files import finite_or_null
 from symlearn.provenance import atomic_write_json, versions
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, save_transition
-from symlearn.symbolic.transition_data import TransitionData, build_transition_data
+from symlearn.symbolic.transition_data import TransitionData, build_transition_data, concat_transition_data
 from symlearn.symbolic.transition_metrics import evaluate_transition
 from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet, masked_bce
 
@@ -29,23 +31,37 @@ METRICS_FILE = "transition_metrics.json"
 
 
 def train_transition(run_dir: Path, data_dir: Path, cfg: TransitionConfig, seed: int = 0,
-                     show_progress: bool = False) -> dict:
-    """Train m(z) on the codes of RUN's effect model; writes RUN/transition.pt and RUN/transition_metrics.json."""
+                     show_progress: bool = False, extra_data: tuple[Path, ...] = ()) -> dict:
+    """Train m(z) on the codes of RUN's effect model; writes RUN/transition.pt and RUN/transition_metrics.json.
+
+    extra_data: more data sets whose train and val splits join the main set's (their test splits are
+    evaluated apart, under "extra_test").
+    """
     run_dir, data_dir = Path(run_dir), Path(data_dir)
+    extra_data = tuple(Path(d) for d in extra_data)
+    resolved = [d.resolve() for d in (data_dir, *extra_data)]
+    if len(set(resolved)) != len(resolved):
+        raise ValueError(f"extra data sets must differ from each other and from {data_dir}: {list(map(str, extra_data))}")
     t_start = time.perf_counter()
     encoder, ck = load_effect_model(run_dir, device=analysis_device())
     cfg = dataclasses.replace(cfg, bits=ck.config.bits)
     fingerprint = data_fingerprint(data_dir)
+    extra_fp = [{"data": str(d), "data_fingerprint": data_fingerprint(d)} for d in extra_data]
     splits = encode_splits(encoder, data_dir, cfg.encode_batch_size)
+    extras = [encode_splits(encoder, d, cfg.encode_batch_size) for d in extra_data]
+    train = concat_transition_data([splits["train"], *(e["train"] for e in extras)])
+    val = concat_transition_data([splits["val"], *(e["val"] for e in extras)])
     encode_s = time.perf_counter() - t_start
-    net, best, history = fit_transition(cfg, splits["train"], splits["val"], seed, show_progress)
+    net, best, history = fit_transition(cfg, train, val, seed, show_progress)
     meta = {"transition_config": cfg.to_json(), "seed": seed, "data": str(data_dir),
-            "data_fingerprint": fingerprint, "effect_model": "best.pt",
+            "data_fingerprint": fingerprint, "extra_data": extra_fp, "effect_model": "best.pt",
             "effect_model_sha256": effect_model_sha256(run_dir), "effect_model_bits": ck.config.bits,
             "best_val_loss": best, "versions": versions()}
     save_transition(run_dir / TRANSITION_FILE, net, meta)
-    metrics = {**meta, "history": history, "n_samples": {s: len(d) for s, d in splits.items()},
+    metrics = {**meta, "history": history,
+               "n_samples": {"train": len(train), "val": len(val), "test": len(splits["test"])},
                "test": evaluate_transition(net, splits["test"]), "val": evaluate_transition(net, splits["val"]),
+               "extra_test": {str(d): evaluate_transition(net, e["test"]) for d, e in zip(extra_data, extras)},
                "encode_time_s": round(encode_s, 2), "wall_time_s": round(time.perf_counter() - t_start, 2)}
     metrics = finite_or_null(metrics)  # NaN metrics of empty selections become null
     atomic_write_json(run_dir / METRICS_FILE, metrics)
