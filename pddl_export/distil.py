@@ -51,7 +51,6 @@ objects, a consistent generalization above.
     (6, [2, 2, 2])
 """
 from __future__ import annotations
-from __future__ import annotations
 
 import numpy as np
 from sklearn.tree import DecisionTreeClassifier

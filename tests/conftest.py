@@ -80,6 +80,14 @@ def tiny_data(tmp_path_factory) -> TinyData:
 
 
 @pytest.fixture(scope="session")
+def tiny_k45(tmp_path_factory) -> Path:
+    """A 16-sample data set of 4-5-object scenes (4 shards), collected once per session (read only)."""
+    path = tmp_path_factory.mktemp("tiny_k45") / "k45"
+    cli_json("collect", "--out", path, "--n", "16", "--objects", "4-5", "--seed", "5", "--shard-size", "4", "--quiet")
+    return path
+
+
+@pytest.fixture(scope="session")
 def tiny_run(tmp_path_factory, tiny_data) -> TinyRun:
     """Effect model, transition network and exported rules trained once per session on tiny_data (read only)."""
     path = tmp_path_factory.mktemp("tiny_run") / "run"

@@ -65,6 +65,35 @@ def test_export_writes_domain_rules_and_exact_report(run):
     _check_domain(domain, rules)
 
 
+def test_observed_scenes_take_sub_scenes_of_larger_scenes_on_request():
+    from symlearn.planning.export import observed_scenes
+
+    codes = np.array([[1, 2, 3, 4], [1, 1, -1, -1], [1, 4, -1, -1]])  # 4 lies outside the vocabulary
+    assert observed_scenes({1, 2, 3}, 2, codes) == [(1,), (1, 1)]
+    assert observed_scenes({1, 2, 3}, 2, codes, larger=True) == [(1,), (1, 1), (1, 2), (1, 3), (2,), (2, 3), (3,)]
+
+
+def test_export_with_extra_data_and_larger_scenes(run, tiny_k45, tmp_path):
+    from symlearn.data.dataset import data_fingerprint
+    from symlearn.planning.export import code_counts, observed_scenes, training_codes
+
+    cfg = ExportConfig(max_objects=2, pddl_fidelity_cases=0, larger_scenes=True)
+    rep = export_pddl(run / "run", run / "data", cfg, tmp_path / "pddl", extra_data=(tiny_k45,))
+    assert rep["extra_data"] == [{"data": str(tiny_k45), "data_fingerprint": data_fingerprint(tiny_k45)}]
+    assert rep["config"]["larger_scenes"] is True and rep["fidelity"] == 1.0
+    arrays = [*training_codes(run / "run", run / "data"), *training_codes(run / "run", tiny_k45)]
+    assert max((a >= 0).sum(1).max() for a in arrays) == 5
+    assert rep["vocabulary_size"] == len(code_counts(*arrays))
+    vocab = set(code_counts(*arrays))
+    with_larger = observed_scenes(vocab, 2, *arrays, larger=True)
+    assert rep["n_enumerated_scenes"] == len(with_larger) > len(observed_scenes(vocab, 2, *arrays))
+    rules = rules_from_json(json.loads((tmp_path / "pddl" / "rules.json").read_text()))
+    assert rules.max_objects == 2 and set(rules.vocabulary) == vocab
+    with pytest.raises(ValueError, match="must differ"):
+        export_pddl(run / "run", run / "data", cfg, tmp_path / "again", extra_data=(run / "data",))
+    assert not (tmp_path / "again").exists()
+
+
 def test_malformed_rules_refused(tmp_path):
     with pytest.raises(ValueError, match="malformed rules file"):
         rules_from_json({"bits": 8, "rules": [{"action": 1}]})

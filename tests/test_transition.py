@@ -390,9 +390,8 @@ def test_concat_pads_objects_and_keeps_episodes_apart():
         concat_transition_data([])
 
 
-def test_extra_data_joins_training_and_is_tested_apart(tiny_run, tiny_run_copy, tmp_path, capsys):
-    extra = tmp_path / "k45"
-    cli_json("collect", "--out", extra, "--n", "16", "--objects", "4-5", "--seed", "5", "--shard-size", "4", "--quiet")
+def test_extra_data_joins_training_and_is_tested_apart(tiny_run, tiny_run_copy, tiny_k45, capsys):
+    extra = tiny_k45
     sizes = {s: len(load_split(extra, s).action) for s in ("train", "val", "test")}
     assert load_split(extra, "train").mask.shape[1] == 5
     out = cli_json("train-transition", "--run", tiny_run_copy, "--data", tiny_run.data, "--extra-data", extra,

@@ -135,9 +135,9 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
 
     cfg = ExportConfig(max_objects=args.max_objects, min_count=args.min_count, closure=args.closure,
                        pddl_fidelity_cases=args.pddl_fidelity_cases, scenes=args.scenes, seed=args.seed,
-                       outcome_min_ratio=args.outcome_min_ratio)
+                       outcome_min_ratio=args.outcome_min_ratio, larger_scenes=args.larger_scenes)
     out = Path(args.out) if args.out else None
-    rep = export_pddl(Path(args.run), Path(args.data), cfg, out)
+    rep = export_pddl(Path(args.run), Path(args.data), cfg, out, extra_data=tuple(Path(d) for d in args.extra_data))
     where = out or Path(args.run) / "pddl"
     print(f"vocabulary {rep['vocabulary_size']} codes; {rep['n_enumerated_cases']} enumerated cases at "
           f"{rep['enumeration_queries_per_s']:.0f} queries/s; rules {rep['n_rules_before_generalization']} -> "
@@ -237,12 +237,17 @@ def add_export_pddl_command(sub) -> None:
     x = sub.add_parser("export-pddl", help="distil the transition network into rules and a PDDL domain")
     x.add_argument("--run", required=True)
     x.add_argument("--data", required=True, help="the data set whose training codes form the vocabulary")
+    x.add_argument("--extra-data", nargs="+", default=[], metavar="DIR",
+                   help="more data sets whose training codes join the vocabulary and the observed scenes")
     x.add_argument("--out", help="output directory (default RUN/pddl)")
     x.add_argument("--max-objects", type=int, default=3, help="largest enumerated scene")
     x.add_argument("--min-count", type=int, default=1, help="training objects a code needs to enter the vocabulary")
     x.add_argument("--scenes", default="observed", choices=["observed", "all"],
                    help="enumerate the code multisets of training scenes (default) or every multiset")
     x.add_argument("--closure", action="store_true", help="with --scenes all: add codes the network produces")
+    x.add_argument("--larger-scenes", action="store_true",
+                   help="with --scenes observed: also enumerate the sub-scenes of up to --max-objects codes of "
+                        "observed scenes with more objects")
     x.add_argument("--pddl-fidelity-cases", type=int, default=500,
                    help="cases simulated through the PDDL (-1: every enumerated case)")
     x.add_argument("--outcome-min-ratio", type=float, default=0.05,

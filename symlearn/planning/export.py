@@ -44,6 +44,9 @@ class ExportConfig:
     # of vocabulary codes. A learned network answers impossible scenes (three objects on one spot)
     # arbitrarily, and exact rules for those answers swell the domain (316k rules for 60 codes, K = 3).
     scenes: str = "observed"
+    # observed: also enumerate the sub-multisets of up to max_objects codes of observed scenes with more
+    # objects (a 5-object data set's stacks and rows then shape rules exact for smaller scenes)
+    larger_scenes: bool = False
     seed: int = 0
     # outcomes.json: each object's second likeliest next code where it is at least this fraction as likely
     outcome_min_ratio: float = MIN_OUTCOME_RATIO
@@ -77,17 +80,28 @@ def code_counts(*code_arrays: np.ndarray) -> dict[int, int]:
     return {int(c): int(k) for c, k in sorted(zip(uniq, n), key=lambda t: -t[1])}
 
 
-def observed_scenes(vocab: set[int], max_objects: int, *code_arrays: np.ndarray) -> list[tuple[int, ...]]:
-    """Distinct code multisets of observed scenes whose codes all lie in the vocabulary, and their sub-multisets."""
+def observed_scenes(vocab: set[int], max_objects: int, *code_arrays: np.ndarray,
+                    larger: bool = False) -> list[tuple[int, ...]]:
+    """Distinct code multisets of observed scenes whose codes all lie in the vocabulary, and their sub-multisets.
+
+    With `larger`, scenes of more than max_objects objects add their sub-multisets of up to max_objects
+    codes that lie in the vocabulary.
+    """
     from itertools import combinations
 
     out: set[tuple[int, ...]] = set()
     for arr in code_arrays:
         for row in np.unique(np.sort(arr, axis=1), axis=0):
             sc = tuple(int(c) for c in row if c >= 0)
-            if sc and len(sc) <= max_objects and set(sc) <= vocab:
+            if not sc:
+                continue
+            if len(sc) <= max_objects and set(sc) <= vocab:
                 for k in range(1, len(sc) + 1):
                     out.update(combinations(sc, k))
+            elif larger and len(sc) > max_objects:
+                known = tuple(c for c in sc if c in vocab)
+                for k in range(1, min(len(known), max_objects) + 1):
+                    out.update(combinations(known, k))
     return sorted(out)
 
 
@@ -101,8 +115,14 @@ def _export_outcomes(transition, enum, min_ratio: float, out: Path, model_hash: 
             "fidelity": round(fid.fraction, 6), "seconds": round(time.perf_counter() - t0, 1)}
 
 
-def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path | None = None) -> dict:
-    """Enumerate, distil, write and check; returns the report (also written as report.json)."""
+def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path | None = None,
+                extra_data: tuple[Path, ...] = ()) -> dict:
+    """Enumerate, distil, write and check; returns the report (also written as report.json).
+
+    extra_data: more data sets whose training codes join the vocabulary counts and the observed scenes
+    (for instance 1-5-object sets the effect model never saw, as `train-transition --extra-data`).
+    """
+    from symlearn.data.dataset import data_fingerprint
     from symlearn.symbolic.learned_transition import LearnedTransition
     from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
 
@@ -110,15 +130,20 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     out = Path(out_dir) if out_dir else run_dir / PDDL_DIR
     transition = LearnedTransition.from_run(run_dir)
     model_hash = sha256_file(run_dir / TRANSITION_FILE)[:16]
+    extra_data = tuple(Path(d) for d in extra_data)
+    resolved = [Path(d).resolve() for d in (data_dir, *extra_data)]
+    if len(set(resolved)) != len(resolved):
+        raise ValueError(f"extra data sets must differ from each other and from {data_dir}: {list(map(str, extra_data))}")
     t0 = time.perf_counter()
-    pre, post = training_codes(run_dir, data_dir)
-    counts = code_counts(pre, post)
+    code_sets = [training_codes(run_dir, d) for d in (data_dir, *extra_data)]
+    arrays = [a for pair in code_sets for a in pair]
+    counts = code_counts(*arrays)
     vocab = sorted(c for c, n in counts.items() if n >= cfg.min_count)
     t_vocab = time.perf_counter() - t0
     added: list[int] = []
     if cfg.scenes == "observed":
-        enum = enumerate_scenes(transition, vocab, observed_scenes(set(vocab), cfg.max_objects, pre, post),
-                                cfg.max_objects)
+        scenes = observed_scenes(set(vocab), cfg.max_objects, *arrays, larger=cfg.larger_scenes)
+        enum = enumerate_scenes(transition, vocab, scenes, cfg.max_objects)
     elif cfg.closure:
         clo = vocabulary_closure(transition, vocab, cfg.max_objects)
         enum, added = clo.enumeration, list(clo.added)
@@ -140,6 +165,8 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     produced = set(int(c) for c in enum.produced_codes())
     report = {
         "run": str(run_dir), "model_hash": model_hash, "config": dataclasses.asdict(cfg),
+        "data": str(data_dir), "data_fingerprint": data_fingerprint(data_dir),
+        "extra_data": [{"data": str(d), "data_fingerprint": data_fingerprint(d)} for d in extra_data],
         "scenes": cfg.scenes, "n_enumerated_scenes": enum.n_scenes,
         "vocabulary_size": len(vocab), "vocabulary_counts": {code_str(c, rules.bits): counts.get(c, 0) for c in vocab},
         "closure_added": [code_str(c, rules.bits) for c in added],
