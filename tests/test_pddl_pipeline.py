@@ -92,6 +92,8 @@ def test_export_with_extra_data_and_larger_scenes(run, tiny_k45, tmp_path):
     with pytest.raises(ValueError, match="must differ"):
         export_pddl(run / "run", run / "data", cfg, tmp_path / "again", extra_data=(run / "data",))
     assert not (tmp_path / "again").exists()
+    with pytest.raises(ValueError, match="needs scenes='observed'"):
+        ExportConfig(scenes="all", larger_scenes=True)
 
 
 def test_malformed_rules_refused(tmp_path):

@@ -45,7 +45,7 @@ class ExportConfig:
     # arbitrarily, and exact rules for those answers swell the domain (316k rules for 60 codes, K = 3).
     scenes: str = "observed"
     # observed: also enumerate the sub-multisets of up to max_objects codes of observed scenes with more
-    # objects (a 5-object data set's stacks and rows then shape rules exact for smaller scenes)
+    # objects; with max_objects 4-5 the rules are exact on the bigger scenes of a 1-5-object set
     larger_scenes: bool = False
     seed: int = 0
     # outcomes.json: each object's second likeliest next code where it is at least this fraction as likely
@@ -58,6 +58,8 @@ class ExportConfig:
             raise ValueError(f"outcome_min_ratio={self.outcome_min_ratio} must lie in (0, 1]")
         if self.scenes not in ("observed", "all"):
             raise ValueError(f"scenes={self.scenes!r}: expected observed or all")
+        if self.larger_scenes and self.scenes != "observed":
+            raise ValueError("larger_scenes takes sub-scenes of observed scenes: it needs scenes='observed'")
 
 
 
