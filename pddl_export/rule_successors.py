@@ -15,6 +15,8 @@ both against each other. States pack into one int64 key (pack_states) for duplic
 """
 from __future__ import annotations
 
+from functools import cached_property
+
 import numpy as np
 
 from pddl_export.rules import INF, RuleSet
@@ -63,6 +65,11 @@ class RuleSuccessors:
             self._groups[c] = (np.array(cols, np.int64), lo, hi,
                                np.array([column[r.action] for r in group], np.int64),
                                np.array([r.code_to for r in group], np.int64))
+
+    @cached_property
+    def code_changes(self) -> frozenset[tuple[int, int]]:
+        """The (code_from, code_to) pairs of the rules: the code graph of the searches' heuristic, read once."""
+        return frozenset((r.code_from, r.code_to) for r in self.rules.rules)
 
     def __call__(self, states: np.ndarray) -> np.ndarray:
         states = np.asarray(states, np.int64)

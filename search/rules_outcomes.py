@@ -102,7 +102,8 @@ def plan_rules_outcomes(
                          "do not match")
     start_arr = checked_start(start, goal, main.bits)
     seen = seen or {}
-    dist = code_distances(main.rules, goal, alternates.rules).tolist()
+    dist = code_distances(main.rules, goal, alternates.rules,
+                          changes=main.code_changes | alternates.code_changes).tolist()
     fixed = [(i, c) for i, c in enumerate(goal.codes) if c is not None]
     stuck = [i for i, c in fixed if dist[i][start_arr[i]] >= UNREACHABLE]
     if stuck:  # a proof before any search: no chain of rules or second outcomes leads this object to its goal code

@@ -28,7 +28,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from typing import Sequence
+from typing import Iterable, Sequence
 
 import networkx as nx
 import numpy as np
@@ -47,10 +47,13 @@ State = tuple[int, ...]
 UNREACHABLE = 1 << 20  # code distance of a code from which an object's goal code cannot be reached
 
 
-def code_distances(rules: RuleSet, goal: SymbolicGoal, *more: RuleSet) -> np.ndarray:
+def code_distances(rules: RuleSet, goal: SymbolicGoal, *more: RuleSet,
+                   changes: Iterable[tuple[int, int]] | None = None) -> np.ndarray:
     """(K, 2**bits) table: fewest rule firings taking object i from a code to its goal code, ignoring contexts.
 
-    Rules of `more` rule sets (of the same bits) count as edges too.
+    Rules of `more` rule sets (of the same bits) count as edges too. `changes`: the (code_from, code_to)
+    pairs of all those rules, when the caller has them already (RuleSuccessors.code_changes): reading
+    them off 200k rules costs more than the rest of a short search.
 
     An object only changes code when a rule on its code fires, so if no chain of rules leads from
     its code to its goal code (UNREACHABLE) no plan exists from that state: a sound dead-end test.
@@ -58,7 +61,9 @@ def code_distances(rules: RuleSet, goal: SymbolicGoal, *more: RuleSet) -> np.nda
     several objects at once).
     """
     graph = nx.DiGraph()
-    graph.add_edges_from({(r.code_to, r.code_from) for rs in (rules, *more) for r in rs.rules})  # reversed: search back from the goal
+    if changes is None:
+        changes = {(r.code_from, r.code_to) for rs in (rules, *more) for r in rs.rules}
+    graph.add_edges_from((to, frm) for frm, to in changes)  # reversed: search back from the goal
     table = np.zeros((len(goal.codes), 1 << rules.bits), np.int64)
     for i, g in enumerate(goal.codes):
         if g is None:
@@ -143,7 +148,7 @@ def plan_rules(
     idx = np.array([i for i, _ in fixed], np.int64)
     val = np.array([c for _, c in fixed], np.int64)
     actions = succ.actions.tolist()
-    dist = code_distances(succ.rules, goal)
+    dist = code_distances(succ.rules, goal, changes=succ.code_changes)
     objects = np.arange(len(start_arr))
     dist_rows = dist.tolist()
     pair_rows = pairs.tolist()

@@ -122,6 +122,9 @@ def test_code_distance_dead_ends_are_sound(seed):
         goal = SymbolicGoal(tuple(int(c) for c in rng.choice(VOCAB, 3)))
         table = code_distances(rules, goal)
         assert table.shape == (3, 4)
+        more = random_rules(rng, n=6)  # the code graph read off the rules or given, with a second rule set
+        assert np.array_equal(code_distances(rules, goal, more), code_distances(
+            rules, goal, more, changes=RuleSuccessors(rules).code_changes | RuleSuccessors(more).code_changes))
         assert all(table[i, c] == 0 for i, c in enumerate(goal.codes))
         states, _ = reachable_transitions(rules, init)
         for s in states:  # a state called dead must have no goal state reachable from it
