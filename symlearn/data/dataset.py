@@ -11,6 +11,7 @@ import json
 import zipfile
 from dataclasses import dataclass, fields
 from pathlib import Path
+from typing import Sequence
 
 import numpy as np
 
@@ -144,6 +145,20 @@ def data_fingerprint(root: Path) -> str:
     """Hash of the data set's shard checksums: identifies exactly what a run was trained on."""
     m = load_manifest(root)
     return sha256_bytes("".join(sorted(s["sha256"] for s in m["shards"])).encode())[:16]
+
+
+def distinct_extra_data(data_dir: Path, extra_data: Sequence[Path | str]) -> tuple[Path, ...]:
+    """extra_data as paths; ValueError when a set is given twice or is data_dir itself (a stage would count it twice)."""
+    extra = tuple(Path(d) for d in extra_data)
+    resolved = [Path(d).resolve() for d in (data_dir, *extra)]
+    if len(set(resolved)) != len(resolved):
+        raise ValueError(f"extra data sets must differ from each other and from {data_dir}: {list(map(str, extra))}")
+    return extra
+
+
+def data_records(roots: Sequence[Path]) -> list[dict]:
+    """Each data set's path and fingerprint, as stages record the extra sets they read."""
+    return [{"data": str(d), "data_fingerprint": data_fingerprint(d)} for d in roots]
 
 
 def effect_statistics(data: InteractionData) -> dict:

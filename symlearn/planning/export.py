@@ -124,7 +124,7 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     extra_data: more data sets whose training codes join the vocabulary counts and the observed scenes
     (for instance 1-5-object sets the effect model never saw, as `train-transition --extra-data`).
     """
-    from symlearn.data.dataset import data_fingerprint
+    from symlearn.data.dataset import data_fingerprint, data_records, distinct_extra_data
     from symlearn.symbolic.learned_transition import LearnedTransition
     from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
 
@@ -132,10 +132,7 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     out = Path(out_dir) if out_dir else run_dir / PDDL_DIR
     transition = LearnedTransition.from_run(run_dir)
     model_hash = sha256_file(run_dir / TRANSITION_FILE)[:16]
-    extra_data = tuple(Path(d) for d in extra_data)
-    resolved = [Path(d).resolve() for d in (data_dir, *extra_data)]
-    if len(set(resolved)) != len(resolved):
-        raise ValueError(f"extra data sets must differ from each other and from {data_dir}: {list(map(str, extra_data))}")
+    extra_data = distinct_extra_data(data_dir, extra_data)
     t0 = time.perf_counter()
     code_sets = [training_codes(run_dir, d) for d in (data_dir, *extra_data)]
     arrays = [a for pair in code_sets for a in pair]
@@ -168,7 +165,7 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     report = {
         "run": str(run_dir), "model_hash": model_hash, "config": dataclasses.asdict(cfg),
         "data": str(data_dir), "data_fingerprint": data_fingerprint(data_dir),
-        "extra_data": [{"data": str(d), "data_fingerprint": data_fingerprint(d)} for d in extra_data],
+        "extra_data": data_records(extra_data),
         "scenes": cfg.scenes, "n_enumerated_scenes": enum.n_scenes,
         "vocabulary_size": len(vocab), "vocabulary_counts": {code_str(c, rules.bits): counts.get(c, 0) for c in vocab},
         "closure_added": [code_str(c, rules.bits) for c in added],

@@ -17,7 +17,7 @@ from typing import Callable
 
 import torch
 
-from symlearn.data.dataset import data_fingerprint, load_split
+from symlearn.data.dataset import data_fingerprint, data_records, distinct_extra_data, load_split
 from symlearn.learning.checkpoint import analysis_device, effect_model_sha256, load_effect_model
 from symlearn.learning.models import AttentiveDeepSym
 from pddl_export.files import finite_or_null
@@ -38,15 +38,12 @@ def train_transition(run_dir: Path, data_dir: Path, cfg: TransitionConfig, seed:
     evaluated apart, under "extra_test").
     """
     run_dir, data_dir = Path(run_dir), Path(data_dir)
-    extra_data = tuple(Path(d) for d in extra_data)
-    resolved = [d.resolve() for d in (data_dir, *extra_data)]
-    if len(set(resolved)) != len(resolved):
-        raise ValueError(f"extra data sets must differ from each other and from {data_dir}: {list(map(str, extra_data))}")
+    extra_data = distinct_extra_data(data_dir, extra_data)
     t_start = time.perf_counter()
     encoder, ck = load_effect_model(run_dir, device=analysis_device())
     cfg = dataclasses.replace(cfg, bits=ck.config.bits)
     fingerprint = data_fingerprint(data_dir)
-    extra_fp = [{"data": str(d), "data_fingerprint": data_fingerprint(d)} for d in extra_data]
+    extra_fp = data_records(extra_data)
     splits = encode_splits(encoder, data_dir, cfg.encode_batch_size)
     extras = [encode_splits(encoder, d, cfg.encode_batch_size) for d in extra_data]
     train = concat_transition_data([splits["train"], *(e["train"] for e in extras)])
