@@ -85,7 +85,7 @@ def time_tasks(run: Path, task_list, timeout_s: float, seed: int) -> dict:
                                       timeout_s=timeout_s)
             times[mode][i] = time.perf_counter() - t0
             plans[mode][i] = (res.status.value, tuple(res.plan))
-    return {"times": times, "plans": plans}
+    return {"times": times, "plans": plans, "n_rules": rules.n_rules, "n_outcome_rules": outcomes.rules.n_rules}
 
 
 def main() -> None:
@@ -113,7 +113,7 @@ def main() -> None:
                            "speedup": round(u / c, 2)}
     report = {
         **bench_context(), "run": str(run), "data": str(data), "n_tasks": len(task_list), "timeout_s": args.timeout,
-        "n_rules": load_rules(run)[0].n_rules, "n_outcome_rules": load_outcomes(run)[0].rules.n_rules,
+        "n_rules": got["n_rules"], "n_outcome_rules": got["n_outcome_rules"],
         "median_per_call_s": round(med["per_call"], 5), "median_once_s": round(med["once"], 5),
         "speedup": round(med["per_call"] / med["once"], 2),
         "total_per_call_s": round(sum(times["per_call"].values()), 2),
