@@ -6,6 +6,7 @@ data set and the run with collect, train, train-transition and export-pddl); one
 """
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import math
@@ -189,6 +190,10 @@ def test_export_pddl_all_scenes(tiny_data, tiny_run, tmp_path):
     assert rep["n_enumerated_cases"] == N_ACTIONS * rep["n_enumerated_scenes"]
     assert rep["n_enumerated_scenes"] >= tiny_run.export_report["n_enumerated_scenes"]
     assert rep["fidelity"] == 1.0 and rep["pddl_fidelity"] == 1.0 and rep["pddl_fidelity_cases"] == 20
+    # flags left unset keep ExportConfig's defaults; the given ones are recorded
+    from symlearn.planning.export import ExportConfig
+    want = dataclasses.asdict(ExportConfig(scenes="all", max_objects=2, pddl_fidelity_cases=20))
+    assert rep["config"] == want
 
 
 # ------------------------------------------------------------------------------- problems, plan, benchmark

@@ -133,9 +133,10 @@ def cmd_symbols(args: argparse.Namespace) -> int:
 def cmd_export_pddl(args: argparse.Namespace) -> int:
     from symlearn.planning.export import ExportConfig, export_pddl
 
-    cfg = ExportConfig(max_objects=args.max_objects, min_count=args.min_count, closure=args.closure,
-                       pddl_fidelity_cases=args.pddl_fidelity_cases, scenes=args.scenes, seed=args.seed,
-                       outcome_min_ratio=args.outcome_min_ratio, larger_scenes=args.larger_scenes)
+    given = {"max_objects": args.max_objects, "min_count": args.min_count, "closure": args.closure,
+             "pddl_fidelity_cases": args.pddl_fidelity_cases, "scenes": args.scenes, "seed": args.seed,
+             "outcome_min_ratio": args.outcome_min_ratio, "larger_scenes": args.larger_scenes}
+    cfg = ExportConfig(**{k: v for k, v in given.items() if v is not None})  # unset flags keep ExportConfig's defaults
     out = Path(args.out) if args.out else None
     rep = export_pddl(Path(args.run), Path(args.data), cfg, out, extra_data=tuple(Path(d) for d in args.extra_data))
     where = out or Path(args.run) / "pddl"
@@ -240,20 +241,21 @@ def add_export_pddl_command(sub) -> None:
     x.add_argument("--extra-data", nargs="+", default=[], metavar="DIR",
                    help="more data sets whose training codes join the vocabulary and the observed scenes")
     x.add_argument("--out", help="output directory (default RUN/pddl)")
-    x.add_argument("--max-objects", type=int, default=3, help="largest enumerated scene")
-    x.add_argument("--min-count", type=int, default=1, help="training objects a code needs to enter the vocabulary")
-    x.add_argument("--scenes", default="observed", choices=["observed", "all"],
+    x.add_argument("--max-objects", type=int, help="largest enumerated scene (default 3)")
+    x.add_argument("--min-count", type=int,
+                   help="training objects a code needs to enter the vocabulary (default 1)")
+    x.add_argument("--scenes", choices=["observed", "all"],
                    help="enumerate the code multisets of training scenes (default) or every multiset")
-    x.add_argument("--closure", action="store_true", help="with --scenes all: add codes the network produces")
-    x.add_argument("--larger-scenes", action="store_true",
+    x.add_argument("--closure", action="store_true", default=None, help="with --scenes all: add codes the network produces")
+    x.add_argument("--larger-scenes", action="store_true", default=None,
                    help="with --scenes observed: also enumerate the sub-scenes of up to --max-objects codes of "
                         "observed scenes with more objects")
-    x.add_argument("--pddl-fidelity-cases", type=int, default=500,
-                   help="cases simulated through the PDDL (-1: every enumerated case)")
-    x.add_argument("--outcome-min-ratio", type=float, default=0.05,
+    x.add_argument("--pddl-fidelity-cases", type=int,
+                   help="cases simulated through the PDDL (-1: every enumerated case; default 500)")
+    x.add_argument("--outcome-min-ratio", type=float,
                    help="outcomes.json (rules-outcomes): keep an object's second likeliest next code where it is "
-                        "at least this fraction as likely as the likeliest")
-    x.add_argument("--seed", type=int, default=0)
+                        "at least this fraction as likely as the likeliest (default 0.05)")
+    x.add_argument("--seed", type=int, help="seed of the sampled PDDL fidelity cases (default 0)")
     x.set_defaults(func=cmd_export_pddl)
 
 

@@ -63,13 +63,17 @@ class ExportConfig:
 
 
 
-def training_codes(run_dir: Path, data_dir: Path) -> tuple[np.ndarray, np.ndarray]:
-    """The encoder's integer codes of every training sample's objects before and after: two (N, K), -1 padding."""
+def training_codes(run_dir: Path, data_dir: Path, model=None) -> tuple[np.ndarray, np.ndarray]:
+    """The encoder's integer codes of every training sample's objects before and after: two (N, K), -1 padding.
+
+    model: the run's effect model when already loaded (it is loaded from run_dir otherwise).
+    """
     from symlearn.learning.checkpoint import load_effect_model
     from symlearn.data.dataset import load_split
     from symlearn.symbolic.symbols import encode_codes
 
-    model, _ = load_effect_model(run_dir)
+    if model is None:
+        model, _ = load_effect_model(run_dir)
     data = load_split(data_dir, "train")
     return (encode_codes(model, data.pre_depth, data.pre_origin, data.mask),
             encode_codes(model, data.post_depth, data.post_origin, data.mask))
@@ -134,7 +138,10 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     model_hash = sha256_file(run_dir / TRANSITION_FILE)[:16]
     extra_data = distinct_extra_data(data_dir, extra_data)
     t0 = time.perf_counter()
-    code_sets = [training_codes(run_dir, d) for d in (data_dir, *extra_data)]
+    from symlearn.learning.checkpoint import load_effect_model
+
+    model, _ = load_effect_model(run_dir)
+    code_sets = [training_codes(run_dir, d, model) for d in (data_dir, *extra_data)]
     arrays = [a for pair in code_sets for a in pair]
     counts = code_counts(*arrays)
     vocab = sorted(c for c, n in counts.items() if n >= cfg.min_count)
