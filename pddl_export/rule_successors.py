@@ -1,10 +1,10 @@
 """Every successor of a batch of joint states under the rules, for searches that expand in batches.
 
-apply_rules_batch (pddl_export.rules) is the reference semantics; it loops over rules and
-compares every row with each. A search over joint states of 4-5 objects meets millions of
-states, and there RuleSuccessors is ~20x faster: it groups rules by own code, touches only
-the objects that hold that code, and tests all of a code's rules in one comparison. Tests check
-both against each other. States pack into one int64 key (pack_states) for duplicate detection.
+apply_rules_batch (pddl_export.rules) answers one (state, action) per row; a search wants every
+action's successor of every frontier state, and over joint states of 4-5 objects it meets
+millions of them. RuleSuccessors answers all actions at once: it groups rules by own code,
+touches only the objects that hold that code, and tests all of a code's rules, whatever their
+action, in one comparison. Tests check it against apply_rules_batch and the row-by-row apply_rules. States pack into one int64 key (pack_states) for duplicate detection.
 
     >>> from pddl_export.rules import Rule, RuleSet
     >>> rs = RuleSet(bits=2, vocabulary=(1, 2, 3), max_objects=2, n_rules_before_generalization=1,

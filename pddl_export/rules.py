@@ -29,6 +29,7 @@ from pddl_export.symbolic import N_ACTIONS
 
 INF = 1 << 62  # open upper end of a count interval
 Bounds = dict[int, tuple[int, int]]  # code -> [lo, hi) on the number of OTHER objects with it
+COUNT_CAP = (1 << 15) - 2  # apply_rules_batch compares counts as int16 up to this
 
 
 
@@ -114,16 +115,41 @@ class Rule:
         return len(self.requires) + len(self.forbids) + len(self.at_least) + len(self.fewer_than)
 
 
-def _first_overlap(boxes: Sequence[Mapping[int, tuple[int, int]]]) -> tuple[int, int] | None:
-    """First pair (i, j) of boxes that some multiset satisfies both of, or None if pairwise disjoint."""
-    if len(boxes) < 2:
-        return None
-    codes = sorted({x for b in boxes for x in b})
-    lo = np.array([[b.get(x, (0, INF))[0] for x in codes] for b in boxes], np.int64).reshape(len(boxes), len(codes))
-    hi = np.array([[b.get(x, (0, INF))[1] for x in codes] for b in boxes], np.int64).reshape(len(boxes), len(codes))
-    disjoint = np.any(np.maximum(lo[:, None], lo[None]) >= np.minimum(hi[:, None], hi[None]), axis=2)  # (R, R)
-    i, j = np.nonzero(~disjoint & ~np.eye(len(boxes), dtype=bool))
-    return (int(i[0]), int(j[0])) if len(i) else None
+DenseGroup = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # (C,) codes, (R, C) lo, (R, C) hi, (R,) code_to
+
+
+def _dense_group(group: Sequence[Rule]) -> DenseGroup:
+    """The rules of one (action, own code) as arrays: context codes, int16 bounds lo <= count < hi, outcomes.
+
+    INF is stored as COUNT_CAP + 1 and counts are compared clipped to COUNT_CAP, which is exact because
+    finite bounds above COUNT_CAP are refused (a bound counts objects of one scene).
+    """
+    bounds = [r.bounds() for r in group]
+    cols = sorted({x for b in bounds for x in b})
+    where = {x: j for j, x in enumerate(cols)}
+    lo = np.zeros((len(group), len(cols)), np.int16)
+    hi = np.full((len(group), len(cols)), COUNT_CAP + 1, np.int16)
+    for i, b in enumerate(bounds):
+        for x, (l, h) in b.items():
+            if l > COUNT_CAP or COUNT_CAP < h < INF:
+                raise ValueError(f"{group[i]}: a count bound above {COUNT_CAP} objects")
+            lo[i, where[x]], hi[i, where[x]] = l, min(h, COUNT_CAP + 1)
+    return np.array(cols, np.int64), lo, hi, np.array([r.code_to for r in group], np.int64)
+
+
+def _first_overlap(lo: np.ndarray, hi: np.ndarray, max_cells: int = 1 << 22) -> tuple[int, int] | None:
+    """First pair (i, j) of boxes lo <= count < hi, (R, C) each, that some multiset satisfies both of; None if
+    pairwise disjoint. Compared in row chunks of at most max_cells cells."""
+    n = len(lo)
+    step = max(1, max_cells // max(1, n * lo.shape[1]))
+    for s in range(0, n, step):
+        a_lo, a_hi = lo[s:s + step, None], hi[s:s + step, None]
+        disjoint = np.any(np.maximum(a_lo, lo[None]) >= np.minimum(a_hi, hi[None]), axis=2)  # (m, R)
+        disjoint[np.arange(len(disjoint)), np.arange(s, s + len(disjoint))] = True
+        i, j = np.nonzero(~disjoint)
+        if len(i):
+            return s + int(i[0]), int(j[0])
+    return None
 
 
 @dataclass(frozen=True, eq=False)
@@ -136,6 +162,7 @@ class RuleSet:
     rules: tuple[Rule, ...]
     n_rules_before_generalization: int  # changing (action, own code, exact others) cases
     _index: dict = field(init=False, repr=False, compare=False)
+    _dense: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "vocabulary", tuple(int(c) for c in self.vocabulary))
@@ -147,13 +174,16 @@ class RuleSet:
         index: dict[tuple[int, int], list[Rule]] = {}
         for r in self.rules:
             index.setdefault((r.action, r.code_from), []).append(r)
+        dense = {}
         for (a, c), group in index.items():
-            clash = _first_overlap([r.bounds() for r in group])
+            dense[(a, c)] = _dense_group(group)
+            clash = _first_overlap(*dense[(a, c)][1:3]) if len(group) > 1 else None
             if clash is not None:
                 i, j = clash
                 raise ValueError(f"rules for action {a}, code {c} are not mutually exclusive: "
                                  f"{group[i]} and {group[j]}")
         object.__setattr__(self, "_index", {k: tuple(v) for k, v in index.items()})
+        object.__setattr__(self, "_dense", dense)
 
     @property
     def n_rules(self) -> int:
@@ -190,6 +220,12 @@ class RuleSet:
         """The rules of one (action, own code), mutually exclusive; () if none."""
         return self._index.get((int(action), int(code_from)), ())
 
+    @property
+    def dense_groups(self) -> dict[tuple[int, int], DenseGroup]:
+        """(action, own code) -> (C,) context codes, (R, C) lo, (R, C) hi, (R,) code_to: its rules as arrays
+        (int16 bounds, see _dense_group), built once for the overlap check and apply_rules_batch."""
+        return self._dense
+
 
 
 # ----------------------------------------------------------------------------- application
@@ -221,36 +257,45 @@ def apply_rules(rules: RuleSet | Sequence[Rule], codes: np.ndarray | Sequence[in
     return np.array(out, np.int64)
 
 
-def apply_rules_batch(rules: RuleSet, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
-    """Vectorized apply_rules: (B, K) codes and (B,) actions -> (B, K) next codes."""
+def apply_rules_batch(rules: RuleSet, codes: np.ndarray, actions: np.ndarray, max_cells: int = 1 << 22) -> np.ndarray:
+    """Vectorized apply_rules: (B, K) codes and (B,) actions -> (B, K) next codes.
+
+    The (row, object) pairs are grouped by (action, own code); each group's pairs are compared with all
+    of that group's rules at once (RuleSet.dense_groups), in chunks of at most `max_cells` booleans.
+    """
     codes = np.asarray(codes, np.int64)
     actions = np.asarray(actions, np.int64)
     if codes.ndim != 2 or actions.shape != (len(codes),):
         raise ValueError(f"need (B, K) codes and (B,) actions, got {codes.shape} and {actions.shape}")
-    out, written = codes.copy(), np.zeros(codes.shape, bool)
-    by_action: dict[int, list[Rule]] = {}
-    for r in rules.rules:
-        by_action.setdefault(r.action, []).append(r)
-    for a, group in by_action.items():
-        rows = np.flatnonzero(actions == a)
-        if not rows.size:
+    out = codes.copy()
+    k = codes.shape[1]
+    if not codes.size:
+        return out
+    groups = rules.dense_groups
+    n_codes = 1 << rules.bits
+    valid = (codes >= 0) & (codes < n_codes) & ((actions >= 0) & (actions < N_ACTIONS))[:, None]
+    key = np.where(valid, actions[:, None] * n_codes + codes, -1).ravel()  # (B*K,) one key per (row, object)
+    order = np.argsort(key, kind="stable")
+    sorted_key = key[order]
+    starts = np.flatnonzero(np.r_[True, sorted_key[1:] != sorted_key[:-1]])
+    ends = np.r_[starts[1:], len(key)]
+    for s, e in zip(starts.tolist(), ends.tolist()):
+        kv = int(sorted_key[s])
+        group = groups.get(divmod(kv, n_codes)) if kv >= 0 else None
+        if group is None:
             continue
-        sub = codes[rows]  # (n, K)
-        totals: dict[int, np.ndarray] = {}
-        for r in group:
-            ok = sub == r.code_from  # (n, K)
-            if not ok.any():
-                continue
-            for x, (lo, hi) in r.bounds().items():
-                if x not in totals:
-                    totals[x] = (sub == x).sum(1)
-                others = totals[x][:, None] - (sub == x)  # (n, K) others with code x
-                ok &= (others >= lo) & (others < hi)
-            rr, kk = np.nonzero(ok)
-            rr = rows[rr]
-            clash = written[rr, kk] & (out[rr, kk] != r.code_to)
-            if clash.any():
-                raise AmbiguousRulesError(f"action {a}: rules with different outcomes match row {int(rr[clash][0])}")
-            out[rr, kk] = r.code_to
-            written[rr, kk] = True
+        cols, lo, hi, code_to = group
+        c = kv % n_codes
+        step = max(1, max_cells // max(1, lo.size))
+        for cs in range(s, e, step):
+            pos = order[cs:min(e, cs + step)]
+            rows, objs = pos // k, pos % k
+            others = (codes[rows][:, :, None] == cols).sum(1) - (cols == c)  # (n, C) OTHER objects with each code
+            others = np.minimum(others, COUNT_CAP).astype(np.int16)  # clipped: see _dense_group
+            fires = np.all((others[:, None, :] >= lo) & (others[:, None, :] < hi), axis=2)  # (n, R)
+            p, r = np.nonzero(fires)
+            if len(p) and np.bincount(p, minlength=len(pos)).max() > 1:
+                raise AmbiguousRulesError(f"action {kv // n_codes}: rules with different outcomes match row "
+                                          f"{int(rows[np.bincount(p).argmax()])}")
+            out[rows[p], objs[p]] = code_to[r]
     return out

@@ -33,7 +33,7 @@ from pddl_export.pddl_writer import (
 from pddl_export.files import atomic_write_text
 from pddl_export.distil import NotEquivariantError, distil_rules
 from pddl_export.fidelity import rule_fidelity
-from pddl_export.rules import AmbiguousRulesError, Rule, RuleSet, apply_rules, apply_rules_batch
+from pddl_export.rules import COUNT_CAP, AmbiguousRulesError, Rule, RuleSet, _first_overlap, apply_rules, apply_rules_batch
 from pddl_export.symbolic import N_ACTIONS
 
 NEAR, FAR, STICK, RIDER, UNDER, STICK_M, RIDER_M = 1, 2, 3, 4, 5, 6, 7
@@ -251,6 +251,29 @@ def test_rule_and_ruleset_validation():
         RuleSet(2, (1, 2, 3), 2, (Rule(0, 1, 4),), 1)  # code 4 does not fit in 2 bits
     assert Rule(0, 1, 2, requires=(3,), fewer_than=((3, 2),)).matches({3: 1})
     assert not Rule(0, 1, 2, requires=(3,), fewer_than=((3, 2),)).matches({3: 2})
+    with pytest.raises(ValueError, match="count bound above"):  # bounds are compared as int16
+        RuleSet(2, (1, 2, 3), 2, (Rule(0, 1, 2, at_least=((3, COUNT_CAP + 1),)),), 1)
+    assert RuleSet(2, (1, 2, 3), 2, (Rule(0, 1, 2, at_least=((3, COUNT_CAP),)),), 1).n_rules == 1
+
+
+def test_overlap_check_and_batch_application_in_chunks():
+    """The overlap check and apply_rules_batch work in chunks; any chunk size gives the same answers."""
+    # eight disjoint rules of action 4 on code 1: exactly x other objects with code 3, x = 0..7
+    rules = tuple(Rule(4, 1, 2, at_least=((3, x),) if x > 1 else (), requires=(3,) if x == 1 else (),
+                       forbids=(3,) if x == 0 else (), fewer_than=((3, x + 1),) if x > 0 else ()) for x in range(8))
+    rs = RuleSet(2, (1, 2, 3), 9, rules, 8)
+    lo, hi = rs.dense_groups[(4, 1)][1:3]
+    assert lo.dtype == np.int16 and lo.shape == (8, 1)
+    assert _first_overlap(lo, hi, max_cells=1) is None and _first_overlap(lo, hi) is None
+    hi2 = hi.copy()
+    hi2[5, 0] = 7  # box 5 now also holds counts 6: overlaps box 6
+    assert _first_overlap(lo, hi2, max_cells=1) == _first_overlap(lo, hi2) == (5, 6)
+    rng = np.random.default_rng(3)
+    codes, actions = rng.choice([1, 2, 3], size=(300, 9)), rng.choice([4, 5], size=300)
+    want = np.stack([apply_rules(rs, row, int(a)) for row, a in zip(codes, actions)])
+    for cells in (1, 7, 1 << 22):
+        assert np.array_equal(apply_rules_batch(rs, codes, actions, max_cells=cells), want)
+    assert (want != codes).any() and (want == codes).any()
 
 
 def test_non_equivariant_network_is_refused():

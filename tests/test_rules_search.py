@@ -1,6 +1,6 @@
 """In-process search over the exported rules: compiled successors, batched A*, layered BFS, dead ends.
 
-RuleSuccessors is checked against the reference semantics (apply_rules_batch) on random rule sets
+RuleSuccessors is checked against apply_rules_batch and apply_rules on random rule sets
 and on the pretrained run's rules; the searches against exhaustive enumeration of the reachable
 states (reachable_transitions + networkx shortest paths): same reachability, optimal lengths for
 BFS, valid plans for A*, and the code-distance dead-end test never cuts off a reachable goal.
@@ -45,6 +45,9 @@ def test_compiled_successors_equal_the_reference_semantics(seed):
     for k in (1, 2, 3, 4):
         states = np.array(list(itertools.product(VOCAB, repeat=k)), np.int64)
         assert np.array_equal(succ(states), _reference(rules, states, succ.actions)), k
+        if k <= 2:  # and the row-by-row semantics, independent of both batched forms
+            rows = [[apply_rules(rules, s, int(a)) for a in succ.actions] for s in states]
+            assert np.array_equal(succ(states), np.array(rows).reshape(len(states), len(succ.actions), k)), k
 
 
 def test_compiled_successors_on_the_pretrained_rules():

@@ -159,6 +159,7 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     rules = distil_rules(enum)
     t_rules = time.perf_counter() - t1
     fid = rule_fidelity(rules, enum)
+    t_fid = time.perf_counter() - t1 - t_rules
     domain = conditional_domain(rules, model_hash)
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / "domain.pddl", domain)
@@ -187,7 +188,7 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
         "pddl_disagreements": [] if pf is None else [m.as_row() for m in pf.disagreements],
         "outcomes": outcomes_report,
         "seconds": {"vocabulary": round(t_vocab, 1), "enumeration": round(enum.seconds, 1),
-                    "rules": round(t_rules, 1), "pddl_fidelity": round(t_pddl, 1)},
+                    "rules": round(t_rules, 1), "rule_fidelity": round(t_fid, 1), "pddl_fidelity": round(t_pddl, 1)},
         "versions": versions(),
     }
     atomic_write_json(out / "report.json", report)
