@@ -322,3 +322,7 @@ def test_cli_process_exit_codes(tmp_path):
     r = subprocess.run(run + ["scenarios", "no_such_scenario"], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert r.returncode == 2 and r.stderr.strip().count("\n") == 0
     assert r.stderr.startswith("symlearn scenarios: error: unknown scenario 'no_such_scenario'; known: p1_lone_move")
+    for cmd in ("export-pddl", "train-transition"):  # --threads: a positive count, refused before any work
+        r = subprocess.run(run + [cmd, "--run", str(tmp_path / "r"), "--data", str(tmp_path / "d"), "--threads", "0"],
+                           cwd=ROOT, capture_output=True, text=True, timeout=120)
+        assert r.returncode == 2 and "argument --threads: '0' must be a positive integer" in r.stderr, r.stderr

@@ -75,3 +75,15 @@ class OneLineParser(argparse.ArgumentParser):
 
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+THREADS_HELP = ("torch CPU threads (default: torch's, one per core); use 1 per process when other jobs share the "
+                "cores: OpenMP threads that wait for busy cores slow the networks several-fold")
+
+
+def set_threads(n: int | None) -> None:
+    """torch.set_num_threads(n) when a --threads value was given."""
+    if n:
+        import torch
+
+        torch.set_num_threads(n)

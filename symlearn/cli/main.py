@@ -11,8 +11,8 @@ import sys
 import time
 from pathlib import Path
 
-from symlearn.cli.args import (OneLineParser, int_range, non_negative_finite_float, non_negative_int,
-                               positive_finite_float, positive_int)
+from symlearn.cli.args import (THREADS_HELP, OneLineParser, int_range, non_negative_finite_float, non_negative_int,
+                               positive_finite_float, positive_int, set_threads)
 from symlearn.cli.pipeline import add_pipeline_command
 from symlearn.cli.planning import add_planning_commands
 from symlearn.cli.report import add_report_command
@@ -82,10 +82,7 @@ def cmd_train(args: argparse.Namespace) -> int:
     if args.constant_lr:
         over["cosine_lr"] = False
     cfg = TrainConfig.from_preset(args.preset, bf16=not args.no_bf16, compile=args.compile, **over)
-    if args.threads:
-        import torch
-
-        torch.set_num_threads(args.threads)
+    set_threads(args.threads)
     _init_distributed()
     print(f"train: preset {cfg.preset}, {cfg.epochs} epochs, seed {cfg.seed}, attention {cfg.model.attention} "
           f"-> {args.out}", file=sys.stderr)
@@ -137,6 +134,7 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
              "pddl_fidelity_cases": args.pddl_fidelity_cases, "scenes": args.scenes, "seed": args.seed,
              "outcome_min_ratio": args.outcome_min_ratio, "larger_scenes": args.larger_scenes}
     cfg = ExportConfig(**{k: v for k, v in given.items() if v is not None})  # unset flags keep ExportConfig's defaults
+    set_threads(args.threads)
     out = Path(args.out) if args.out else None
     rep = export_pddl(Path(args.run), Path(args.data), cfg, out, extra_data=tuple(Path(d) for d in args.extra_data))
     where = out or Path(args.run) / "pddl"
@@ -256,6 +254,7 @@ def add_export_pddl_command(sub) -> None:
                    help="outcomes.json (rules-outcomes): keep an object's second likeliest next code where it is "
                         "at least this fraction as likely as the likeliest (default 0.05)")
     x.add_argument("--seed", type=int, help="seed of the sampled PDDL fidelity cases (default 0)")
+    x.add_argument("--threads", type=positive_int, help=THREADS_HELP)
     x.set_defaults(func=cmd_export_pddl)
 
 

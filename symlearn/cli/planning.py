@@ -24,7 +24,8 @@ import math
 import sys
 from pathlib import Path
 
-from symlearn.cli.args import int_range, non_negative_int, planner_list, positive_finite_float, positive_int
+from symlearn.cli.args import (THREADS_HELP, int_range, non_negative_int, planner_list, positive_finite_float, positive_int,
+                               set_threads)
 
 
 MAX_TIMEOUT_S = 86_400.0  # one day: larger values are typos, and the SAS+ planners need a finite limit
@@ -48,6 +49,7 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
     over = {k: v for k, v in (("epochs", args.epochs), ("copy_prior", args.copy_prior),
                               ("attention_rounds", args.attention_rounds)) if v is not None}
     cfg = TransitionConfig.from_preset(args.preset, **over)
+    set_threads(args.threads)
     print(f"train-transition: preset {cfg.preset}, {cfg.attention_rounds} attention round(s), {cfg.epochs} epochs, "
           f"seed {args.seed}, run {args.run}, "
           f"data {args.data}" + "".join(f" + {d}" for d in args.extra_data), file=sys.stderr)
@@ -106,12 +108,6 @@ def _cmd_structure_problems(args: argparse.Namespace) -> int:
     return 0
 
 
-def _set_threads(args: argparse.Namespace) -> None:
-    import torch
-
-    torch.set_num_threads(args.threads)
-
-
 def cmd_plan(args: argparse.Namespace) -> int:
     from symlearn.learning.checkpoint import load_effect_model
     from symlearn.planning.execution import ExecutionConfig, run_problem
@@ -121,7 +117,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.learned_transition import LearnedTransition
 
-    _set_threads(args)
+    set_threads(args.threads)
     problem = load_problem(Path(args.problem))
     write_dir = path_under(Path(args.run) / "pddl" / "problems", problem.name)  # the name is checked at load
     fn = make_planners([args.planner], Path(args.run), write_dir=write_dir, risk_weight=args.risk_weight)[args.planner]
@@ -152,7 +148,7 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
     from symlearn.planning.benchmark import benchmark, format_goal_placement, format_table
     from symlearn.planning.benchmark_plots import format_grid, write_plots
 
-    _set_threads(args)
+    set_threads(args.threads)
     res = benchmark(Path(args.run), args.problems, args.planners, Path(args.out), closed_loop=args.closed_loop,
                     timeout_s=args.timeout, max_replans=args.max_replans, show_progress=not args.quiet,
                     record_dir=Path(args.record) if args.record else None, risk_weight=args.risk_weight)
@@ -191,6 +187,7 @@ def add_train_transition_command(sub) -> None:
     t.add_argument("--attention-rounds", type=positive_int,
                    help="self-attention rounds over the scene (the paper and the presets: 1)")
     t.add_argument("--seed", type=int, default=0)
+    t.add_argument("--threads", type=positive_int, help=THREADS_HELP)
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=cmd_train_transition)
 
