@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import torch
 
-from conftest import cli, cli_json
+from conftest import TINY_TRANSITION_ARGS, TINY_TRAIN_ARGS, cli, cli_json
 
 ROOT = Path(__file__).resolve().parents[1]
 N_ACTIONS = 36
@@ -118,6 +118,25 @@ def test_train_bf16_path(tiny_data, tiny_run, tmp_path):
     assert rc == 0 and "attentive" in text
     ev = json.loads((run / "eval.json").read_text())
     assert all(0 < v < 2000 for v in ev["effect_mae_mm"].values()) and ev["trained_on"] == ev["data_fingerprint"]
+
+
+def test_other_code_length_runs_through_the_pipeline(tiny_data, tmp_path):
+    """--bits 4: 4-bit codes from the encoder through m(z) to the exported rules (at most 16 symbols)."""
+    from symlearn.planning.export import training_codes
+
+    run = tmp_path / "b4"
+    cli_json("train", "--data", tiny_data.path, "--out", run, *TINY_TRAIN_ARGS, "--bits", 4, "--quiet")
+    assert json.loads((run / "config.json").read_text())["train_config"]["model"]["bits"] == 4
+    pre, post = training_codes(run, tiny_data.path)
+    assert pre.max() < 16 and post.max() < 16 and (pre >= 0).sum() > 0
+    t = cli_json("train-transition", "--run", run, "--data", tiny_data.path, *TINY_TRANSITION_ARGS, "--quiet")
+    assert 0 <= t["test"]["bit_accuracy"] <= 1
+    rc, _ = cli("export-pddl", "--run", run, "--data", tiny_data.path, "--max-objects", 2, "--pddl-fidelity-cases", 20)
+    rules = json.loads((run / "pddl" / "rules.json").read_text())
+    rep = json.loads((run / "pddl" / "report.json").read_text())
+    assert rc == 0 and rules["bits"] == 4 and rep["fidelity"] == 1.0 and rep["pddl_fidelity"] == 1.0
+    assert all(len(c) == 4 for c in rules["vocabulary"]) and set(rules["vocabulary"]) <= {
+        format(c, "04b") for c in np.unique(np.concatenate([pre[pre >= 0], post[post >= 0]]))}
 
 
 def test_evaluate_table1_symbols(tiny_data, tiny_run, tiny_run_copy):

@@ -76,7 +76,7 @@ def cmd_train(args: argparse.Namespace) -> int:
                                    stability_weight=args.stability_weight,
                                    stability_margin=args.stability_margin,
                                    distinct_weight=args.distinct_weight,
-                                   distinct_margin=args.distinct_margin).items() if v is not None}
+                                   distinct_margin=args.distinct_margin, bits=args.bits).items() if v is not None}
     if args.no_attention:
         over["attention"] = False
     if args.constant_lr:
@@ -187,6 +187,8 @@ def add_train_command(sub) -> None:
     t.add_argument("--lr", type=positive_finite_float)
     t.add_argument("--seed", type=non_negative_int)
     t.add_argument("--max-train-samples", type=positive_int, help="train on the first N samples only")
+    t.add_argument("--bits", type=positive_int,
+                   help="code length of each object's symbol, 1-16 (default 8, the paper's: at most 256 symbols)")
     t.add_argument("--no-attention", action="store_true", help="the DeepSym baseline without attention")
     t.add_argument("--rider-weight", type=positive_finite_float,
                    help="loss weight of riders, objects carried by the held one (default 1)")
