@@ -246,7 +246,8 @@ def add_export_pddl_command(sub) -> None:
                    help="training objects a code needs to enter the vocabulary (default 1)")
     x.add_argument("--scenes", choices=["observed", "all"],
                    help="enumerate the code multisets of training scenes (default) or every multiset")
-    x.add_argument("--closure", action="store_true", default=None, help="with --scenes all: add codes the network produces")
+    x.add_argument("--closure", action="store_true", default=None,
+                   help="with --scenes all: add codes the network produces")
     x.add_argument("--larger-scenes", action="store_true", default=None,
                    help="with --scenes observed: also enumerate the sub-scenes of up to --max-objects codes of "
                         "observed scenes with more objects")

@@ -24,8 +24,8 @@ import math
 import sys
 from pathlib import Path
 
-from symlearn.cli.args import (THREADS_HELP, int_range, non_negative_int, planner_list, positive_finite_float, positive_int,
-                               set_threads)
+from symlearn.cli.args import (THREADS_HELP, int_range, non_negative_int, planner_list, positive_finite_float,
+                               positive_int, set_threads)
 
 
 MAX_TIMEOUT_S = 86_400.0  # one day: larger values are typos, and the SAS+ planners need a finite limit
