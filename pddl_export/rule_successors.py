@@ -4,7 +4,9 @@ apply_rules_batch (pddl_export.rules) answers one (state, action) per row; a sea
 action's successor of every frontier state, and over joint states of 4-5 objects it meets
 millions of them. RuleSuccessors answers all actions at once: it groups rules by own code,
 touches only the objects that hold that code, and tests all of a code's rules, whatever their
-action, in one comparison. Tests check it against apply_rules_batch and the row-by-row apply_rules. States pack into one int64 key (pack_states) for duplicate detection.
+action, in one comparison (RuleSet.dense_groups stacked per own code). Tests check it against
+apply_rules_batch and the row-by-row apply_rules. States pack into one int64 key (pack_states)
+for duplicate detection.
 
     >>> from pddl_export.rules import Rule, RuleSet
     >>> rs = RuleSet(bits=2, vocabulary=(1, 2, 3), max_objects=2, n_rules_before_generalization=1,
@@ -19,7 +21,7 @@ from functools import cached_property
 
 import numpy as np
 
-from pddl_export.rules import INF, RuleSet
+from pddl_export.rules import COUNT_CAP, RuleSet
 
 MAX_PACKED_BITS = 62  # a packed state must fit in a non-negative int64
 
@@ -48,23 +50,27 @@ class RuleSuccessors:
         self.rules, self.bits, self.chunk = rules, int(rules.bits), int(chunk)
         self.actions = np.array(rules.actions, np.int64)
         column = {int(a): i for i, a in enumerate(self.actions)}
-        self._context = np.array(sorted({x for r in rules.rules for x in r.bounds()}), np.int64)
+        dense = rules.dense_groups  # per (action, own code), as RuleSet built them; stacked here per own code
+        self._context = np.array(sorted({int(x) for cols, *_ in dense.values() for x in cols}), np.int64)
         where = {int(x): i for i, x in enumerate(self._context)}
         by_code: dict[int, list] = {}
-        for r in rules.rules:
-            by_code.setdefault(r.code_from, []).append(r)
+        for (a, c), group in dense.items():
+            by_code.setdefault(c, []).append((column[a], group))
         self._groups = {}  # own code -> (context columns, (R, C) lo, (R, C) hi, (R,) action column, (R,) code_to)
-        for c, group in sorted(by_code.items()):
-            cols = sorted({where[x] for r in group for x in r.bounds()})
-            lo = np.zeros((len(group), len(cols)), np.int64)
-            hi = np.full((len(group), len(cols)), INF, np.int64)
-            for i, r in enumerate(group):
-                for x, (l, h) in r.bounds().items():
-                    j = cols.index(where[x])
-                    lo[i, j], hi[i, j] = l, h
+        for c, parts in sorted(by_code.items()):
+            cols = sorted({where[int(x)] for _, (codes, *_) in parts for x in codes})
+            pos = {j: i for i, j in enumerate(cols)}
+            n = sum(len(group[3]) for _, group in parts)
+            lo = np.zeros((n, len(cols)), np.int16)
+            hi = np.full((n, len(cols)), COUNT_CAP + 1, np.int16)
+            row = 0
+            for _, (codes, glo, ghi, _) in parts:
+                idx = [pos[where[int(x)]] for x in codes]
+                lo[row:row + len(glo), idx], hi[row:row + len(glo), idx] = glo, ghi
+                row += len(glo)
             self._groups[c] = (np.array(cols, np.int64), lo, hi,
-                               np.array([column[r.action] for r in group], np.int64),
-                               np.array([r.code_to for r in group], np.int64))
+                               np.concatenate([np.full(len(g[3]), a, np.int64) for a, g in parts]),
+                               np.concatenate([g[3] for _, g in parts]))
 
     @cached_property
     def code_changes(self) -> frozenset[tuple[int, int]]:
@@ -86,6 +92,7 @@ class RuleSuccessors:
                 cols, lo, hi, acol, code_to = self._groups[c]
                 rows, pos = np.nonzero(part == c)
                 others = counts[rows][:, cols] - (self._context[cols] == c)  # (n, C_c) counts among the OTHER objects
+                others = np.minimum(others, COUNT_CAP).astype(np.int16)  # as the int16 bounds (rules._dense_group)
                 fires = np.all((others[:, None, :] >= lo) & (others[:, None, :] < hi), axis=2)  # (n, R)
                 p, r = np.nonzero(fires)
                 out[lo_row + rows[p], acol[r], pos[p]] = code_to[r]

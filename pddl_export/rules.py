@@ -223,7 +223,7 @@ class RuleSet:
     @property
     def dense_groups(self) -> dict[tuple[int, int], DenseGroup]:
         """(action, own code) -> (C,) context codes, (R, C) lo, (R, C) hi, (R,) code_to: its rules as arrays
-        (int16 bounds, see _dense_group), built once for the overlap check and apply_rules_batch."""
+        (int16 bounds, see _dense_group), built once for the overlap check, apply_rules_batch and RuleSuccessors."""
         return self._dense
 
 
@@ -281,11 +281,11 @@ def apply_rules_batch(rules: RuleSet, codes: np.ndarray, actions: np.ndarray, ma
     ends = np.r_[starts[1:], len(key)]
     for s, e in zip(starts.tolist(), ends.tolist()):
         kv = int(sorted_key[s])
-        group = groups.get(divmod(kv, n_codes)) if kv >= 0 else None
+        a, c = divmod(kv, n_codes)
+        group = groups.get((a, c)) if kv >= 0 else None
         if group is None:
             continue
         cols, lo, hi, code_to = group
-        c = kv % n_codes
         step = max(1, max_cells // max(1, lo.size))
         for cs in range(s, e, step):
             pos = order[cs:min(e, cs + step)]
@@ -294,8 +294,9 @@ def apply_rules_batch(rules: RuleSet, codes: np.ndarray, actions: np.ndarray, ma
             others = np.minimum(others, COUNT_CAP).astype(np.int16)  # clipped: see _dense_group
             fires = np.all((others[:, None, :] >= lo) & (others[:, None, :] < hi), axis=2)  # (n, R)
             p, r = np.nonzero(fires)
-            if len(p) and np.bincount(p, minlength=len(pos)).max() > 1:
-                raise AmbiguousRulesError(f"action {kv // n_codes}: rules with different outcomes match row "
-                                          f"{int(rows[np.bincount(p).argmax()])}")
+            hits = np.bincount(p, minlength=len(pos))
+            if len(p) and hits.max() > 1:
+                raise AmbiguousRulesError(f"action {a}: rules with different outcomes match row "
+                                          f"{int(rows[hits.argmax()])}")
             out[rows[p], objs[p]] = code_to[r]
     return out

@@ -129,6 +129,7 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     (for instance 1-5-object sets the effect model never saw, as `train-transition --extra-data`).
     """
     from symlearn.data.dataset import data_fingerprint, data_records, distinct_extra_data
+    from symlearn.learning.checkpoint import load_effect_model
     from symlearn.symbolic.learned_transition import LearnedTransition
     from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
 
@@ -138,8 +139,6 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     model_hash = sha256_file(run_dir / TRANSITION_FILE)[:16]
     extra_data = distinct_extra_data(data_dir, extra_data)
     t0 = time.perf_counter()
-    from symlearn.learning.checkpoint import load_effect_model
-
     model, _ = load_effect_model(run_dir)
     code_sets = [training_codes(run_dir, d, model) for d in (data_dir, *extra_data)]
     arrays = [a for pair in code_sets for a in pair]
@@ -187,8 +186,8 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
         "pddl_fidelity_cases": None if pf is None else pf.n_cases,
         "pddl_disagreements": [] if pf is None else [m.as_row() for m in pf.disagreements],
         "outcomes": outcomes_report,
-        "seconds": {"vocabulary": round(t_vocab, 1), "enumeration": round(enum.seconds, 1),
-                    "rules": round(t_rules, 1), "rule_fidelity": round(t_fid, 1), "pddl_fidelity": round(t_pddl, 1)},
+        "seconds": {"vocabulary": round(t_vocab, 1), "enumeration": round(enum.seconds, 1), "rules": round(t_rules, 1),
+                    "rule_fidelity": round(t_fid, 1), "pddl_fidelity": round(t_pddl, 1)},
         "versions": versions(),
     }
     atomic_write_json(out / "report.json", report)
