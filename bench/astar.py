@@ -23,7 +23,6 @@ from symlearn.learning.checkpoint import load_effect_model
 from symlearn.data.dataset import load_split
 from symlearn.provenance import atomic_write_json, bench_context
 from symlearn.symbolic.learned_transition import LearnedTransition
-from symlearn.symbolic.transition_data import encode_crops
 
 
 class OneActionPerCall:
@@ -38,11 +37,11 @@ class OneActionPerCall:
 
 def problems(run: Path, data: Path, n: int, length: int, seed: int, transition: LearnedTransition):
     """n (start codes, goal codes) pairs from test-split scenes, goals from network rollouts."""
-    model, _ = load_effect_model(run)
+    reader = transition.reader(load_effect_model(run)[0])  # the codes m(z) reads, location bits included
     split = load_split(data, "test")
     rng = np.random.default_rng(seed)
     idx = rng.choice(len(split.action), size=min(n, len(split.action)), replace=False)
-    bits = encode_crops(model, split.pre_depth[idx], split.pre_origin[idx], split.mask[idx])
+    bits = reader.encode(split.pre_depth[idx], split.pre_origin[idx], split.mask[idx])
     codes = codes_from_bits(bits.astype(np.int64))
     out = []
     for row, i in enumerate(idx):

@@ -93,15 +93,13 @@ def main() -> int:
 
     torch.set_num_threads(1)
     from pddl_export.files import atomic_write_json
-    from symlearn.learning.checkpoint import load_effect_model
     from symlearn.provenance import bench_context
-    from symlearn.symbolic.learned_transition import LearnedTransition
+    from symlearn.symbolic.learned_transition import planning_models
     from symlearn.symbolic.transition_training import encode_splits
 
     t0 = time.perf_counter()
-    encoder, _ = load_effect_model(args.run)
+    encoder, transition = planning_models(args.run)
     splits = encode_splits(encoder, args.data, 512)
-    transition = LearnedTransition.from_run(args.run)
     table = observed_table(splits)
     result = {"run": str(args.run), "data": str(args.data), "table_entries": len(table),
               "rollout_scene_accuracy": rollouts(transition, table, splits["test"], args.steps),

@@ -48,7 +48,7 @@ def main() -> int:
     torch.set_num_threads(1)
     from pddl_export.files import atomic_write_json
     from symlearn.data.dataset import data_fingerprint, load_split
-    from symlearn.learning.checkpoint import load_effect_model
+    from symlearn.symbolic.learned_transition import planning_models
     from symlearn.provenance import bench_context
     from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, load_transition
     from symlearn.symbolic.transition_data import build_transition_data
@@ -62,7 +62,7 @@ def main() -> int:
     if len(labels) != len(paths):
         raise SystemExit(f"--labels names {len(labels)} runs, --runs gives {len(paths)}")
     for run, label in zip(paths, labels):
-        encoder, _ = load_effect_model(run)
+        encoder, _ = planning_models(run)  # the codes m(z) reads, location bits included
         net, _ = load_transition(run / TRANSITION_FILE)
         trained = json.loads((run / METRICS_FILE).read_text())
         rec = {"transition_data": [trained["data"], *(e["data"] for e in trained.get("extra_data", []))],

@@ -43,15 +43,19 @@ def timeout_seconds(text: str) -> float:
 
 
 def cmd_train_transition(args: argparse.Namespace) -> int:
+    from symlearn.symbolic.locations import LOCATION_BITS
     from symlearn.symbolic.transition_model import TransitionConfig
     from symlearn.symbolic.transition_training import train_transition
 
     over = {k: v for k, v in (("epochs", args.epochs), ("copy_prior", args.copy_prior),
                               ("attention_rounds", args.attention_rounds)) if v is not None}
+    if args.location_bits:
+        over["location_bits"] = LOCATION_BITS
     cfg = TransitionConfig.from_preset(args.preset, **over)
     set_threads(args.threads)
-    print(f"train-transition: preset {cfg.preset}, {cfg.attention_rounds} attention round(s), {cfg.epochs} epochs, "
-          f"seed {args.seed}, run {args.run}, "
+    located = f", {cfg.location_bits} location bits" if cfg.location_bits else ""
+    print(f"train-transition: preset {cfg.preset}, {cfg.attention_rounds} attention round(s){located}, "
+          f"{cfg.epochs} epochs, seed {args.seed}, run {args.run}, "
           f"data {args.data}" + "".join(f" + {d}" for d in args.extra_data), file=sys.stderr)
     m = train_transition(Path(args.run), Path(args.data), cfg, seed=args.seed, show_progress=not args.quiet,
                          extra_data=tuple(Path(d) for d in args.extra_data))
@@ -109,20 +113,18 @@ def _cmd_structure_problems(args: argparse.Namespace) -> int:
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
-    from symlearn.learning.checkpoint import load_effect_model
     from symlearn.planning.execution import ExecutionConfig, run_problem
     from symlearn.planning.planners import make_planners
     from symlearn.planning.paths import path_under
     from symlearn.planning.problem import load_problem
     from symlearn.sim.simulator import TabletopSimulator
-    from symlearn.symbolic.learned_transition import LearnedTransition
+    from symlearn.symbolic.learned_transition import planning_models
 
     set_threads(args.threads)
     problem = load_problem(Path(args.problem))
     write_dir = path_under(Path(args.run) / "pddl" / "problems", problem.name)  # the name is checked at load
     fn = make_planners([args.planner], Path(args.run), write_dir=write_dir, risk_weight=args.risk_weight)[args.planner]
-    encoder, _ = load_effect_model(Path(args.run))
-    transition = LearnedTransition.from_run(Path(args.run))
+    encoder, transition = planning_models(Path(args.run))
     cfg = ExecutionConfig(closed_loop=args.closed_loop, max_replans=args.max_replans, timeout_s=args.timeout)
     recorder = None
     if args.record:
@@ -186,6 +188,9 @@ def add_train_transition_command(sub) -> None:
     t.add_argument("--copy-prior", type=float, help="logit bias toward keeping each input bit (preset's if unset)")
     t.add_argument("--attention-rounds", type=positive_int,
                    help="self-attention rounds over the scene (the paper and the presets: 1)")
+    t.add_argument("--location-bits", action="store_true",
+                   help="codes end with 4 bits read from each crop's geometry: the nearest table location and "
+                        "whether the object stands off it (docs/DESIGN.md, 'Location bits')")
     t.add_argument("--seed", type=int, default=0)
     t.add_argument("--threads", type=positive_int, help=THREADS_HELP)
     t.add_argument("--quiet", action="store_true")

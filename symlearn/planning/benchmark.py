@@ -317,15 +317,13 @@ def _run_rows(run_dir: Path, problems: list[SetProblem], fns: dict, log: RowLog,
               timeout_s: float, max_replans: int, show_progress: bool,
               record_dir: Path | None = None) -> list[ProblemRun]:
     """Every (problem, planner, loop) row in order: finished ones from the log, the rest run and logged."""
-    from symlearn.learning.checkpoint import load_effect_model
     from symlearn.sim.simulator import TabletopSimulator
-    from symlearn.symbolic.learned_transition import LearnedTransition
+    from symlearn.symbolic.learned_transition import planning_models
 
     loops = [False, True] if closed_loop else [False]
     todo = [(p, name, loop) for p in problems for name in fns for loop in loops if (p.key, name, loop) not in log.done]
     if todo:
-        encoder, _ = load_effect_model(run_dir)
-        transition = LearnedTransition.from_run(run_dir)
+        encoder, transition = planning_models(run_dir)
         rules = _current_rules(run_dir, fns)
         first_plans: dict[tuple, object] = {}  # (problem key, planner) -> the open loop's plan
         with TabletopSimulator() as sim:

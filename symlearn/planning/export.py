@@ -28,7 +28,7 @@ from pddl_export.files import atomic_write_text, sha256_file
 from pddl_export.outcome_rules import MIN_OUTCOME_RATIO, OUTCOMES_FILE, distil_outcomes, outcomes_to_json
 from pddl_export.pddl_writer import conditional_domain
 from pddl_export.rules_io import PDDL_DIR, rules_to_json
-from pddl_export.symbolic import code_str
+from pddl_export.symbolic import code_str, codes_from_bits
 from symlearn.provenance import atomic_write_json, versions
 
 
@@ -64,19 +64,24 @@ class ExportConfig:
 
 
 def training_codes(run_dir: Path, data_dir: Path, model=None) -> tuple[np.ndarray, np.ndarray]:
-    """The encoder's integer codes of every training sample's objects before and after: two (N, K), -1 padding.
+    """The codes of every training sample's objects before and after, as m(z) reads them: two (N, K), -1 padding.
 
-    model: the run's effect model when already loaded (it is loaded from run_dir otherwise).
+    model: the run's effect model or SymbolReader when already loaded; else loaded from run_dir, with m(z)'s
+    location bits once the run has a transition.pt.
     """
-    from symlearn.learning.checkpoint import load_effect_model
     from symlearn.data.dataset import load_split
-    from symlearn.symbolic.symbols import encode_codes
+    from symlearn.learning.checkpoint import load_effect_model
+    from symlearn.symbolic.learned_transition import planning_models
+    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
+    from symlearn.symbolic.transition_data import symbol_reader
 
     if model is None:
-        model, _ = load_effect_model(run_dir)
+        model = (planning_models(run_dir)[0] if (Path(run_dir) / TRANSITION_FILE).exists()
+                 else load_effect_model(Path(run_dir))[0])
+    reader = symbol_reader(model)
     data = load_split(data_dir, "train")
-    return (encode_codes(model, data.pre_depth, data.pre_origin, data.mask),
-            encode_codes(model, data.post_depth, data.post_origin, data.mask))
+    return tuple(np.where(data.mask, codes_from_bits(reader.encode(depth, origin, data.mask).round()), -1)
+                 for depth, origin in ((data.pre_depth, data.pre_origin), (data.post_depth, data.post_origin)))
 
 
 def code_counts(*code_arrays: np.ndarray) -> dict[int, int]:
@@ -129,17 +134,15 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     (for instance 1-5-object sets the effect model never saw, as `train-transition --extra-data`).
     """
     from symlearn.data.dataset import data_fingerprint, data_records, distinct_extra_data
-    from symlearn.learning.checkpoint import load_effect_model
-    from symlearn.symbolic.learned_transition import LearnedTransition
+    from symlearn.symbolic.learned_transition import planning_models
     from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
 
     run_dir = Path(run_dir)
     out = Path(out_dir) if out_dir else run_dir / PDDL_DIR
-    transition = LearnedTransition.from_run(run_dir)
+    model, transition = planning_models(run_dir)
     model_hash = sha256_file(run_dir / TRANSITION_FILE)[:16]
     extra_data = distinct_extra_data(data_dir, extra_data)
     t0 = time.perf_counter()
-    model, _ = load_effect_model(run_dir)
     code_sets = [training_codes(run_dir, d, model) for d in (data_dir, *extra_data)]
     arrays = [a for pair in code_sets for a in pair]
     counts = code_counts(*arrays)

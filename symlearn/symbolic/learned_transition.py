@@ -15,8 +15,11 @@ from pathlib import Path
 import numpy as np
 
 from pddl_export.symbolic import bits_from_codes, codes_from_bits
-from symlearn.learning.checkpoint import effect_model_sha256
+from symlearn.learning.checkpoint import effect_model_sha256, load_effect_model
+from symlearn.learning.models import AttentiveDeepSym
+from symlearn.sim.camera import CameraConfig
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, TransitionError, load_transition
+from symlearn.symbolic.transition_data import SymbolReader
 from symlearn.symbolic.transition_model import TransitionNet, predict_probabilities, predict_scored
 from symlearn.world import N_ACTIONS
 
@@ -24,10 +27,21 @@ from symlearn.world import N_ACTIONS
 class LearnedTransition:
     """m(z) as a pddl_export.symbolic.TransitionFn: integer codes in, thresholded integer codes out."""
 
-    def __init__(self, net: TransitionNet, batch_size: int = 4096) -> None:
+    def __init__(self, net: TransitionNet, batch_size: int = 4096, location_camera: CameraConfig | None = None) -> None:
         self.net = net.eval()
         self.bits = int(net.cfg.bits)
         self.batch_size = batch_size
+        if (location_camera is None) != (net.cfg.location_bits == 0):
+            raise TransitionError(f"a transition with {net.cfg.location_bits} location bits needs "
+                                  f"{'a' if net.cfg.location_bits else 'no'} camera to read them")
+        self.location_camera = location_camera  # the camera location bits are read through, None without them
+
+    def reader(self, model: AttentiveDeepSym) -> SymbolReader:
+        """What turns crops into this model's codes: the effect model's encoder, plus location bits if it has them."""
+        if int(model.cfg.bits) + self.net.cfg.location_bits != self.bits:
+            raise TransitionError(f"an effect model of {model.cfg.bits}-bit codes cannot give this transition's "
+                                  f"{self.bits}-bit codes")
+        return SymbolReader(model, self.location_camera)
 
     @classmethod
     def from_run(cls, run_dir: Path, check_encoder: bool = True) -> "LearnedTransition":
@@ -39,7 +53,12 @@ class LearnedTransition:
             if best.exists() and meta.get("effect_model_sha256") != effect_model_sha256(run_dir):
                 raise TransitionError(f"{run_dir / TRANSITION_FILE} was trained on another effect model than "
                                       f"{best}; re-run 'symlearn train-transition'")
-        return cls(net)
+        cam = meta.get("location_camera")
+        try:
+            camera = None if cam is None else CameraConfig.from_json(cam)
+        except (TypeError, AttributeError) as e:
+            raise TransitionError(f"{run_dir / TRANSITION_FILE} records an unreadable location camera ({e})") from None
+        return cls(net, location_camera=camera)
 
     def __call__(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
         """(B, K) int codes and (B,) action ids -> (B, K) int64 next codes."""
@@ -76,3 +95,10 @@ class LearnedTransition:
         if actions.size and (actions.min() < 0 or actions.max() >= N_ACTIONS):
             raise ValueError(f"action ids must lie in 0..{N_ACTIONS - 1}")
         return codes, actions
+
+
+def planning_models(run_dir: Path) -> tuple[SymbolReader, LearnedTransition]:
+    """RUN's m(z) and what reads crops into its codes: the effect model's encoder, plus m(z)'s location bits if any."""
+    transition = LearnedTransition.from_run(Path(run_dir))
+    model, _ = load_effect_model(Path(run_dir))
+    return transition.reader(model), transition

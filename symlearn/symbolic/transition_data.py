@@ -2,7 +2,8 @@
 
 The training pairs of m(z) are the effect model's own codes of the before- and after-crops of
 every data sample (encoder in eval mode: deterministic threshold). The same encoder turns a
-live simulator observation into codes for planning.
+live simulator observation into codes for planning. A SymbolReader with a camera appends each
+object's location bits (symlearn.symbolic.locations) to its code, in training and planning alike.
 """
 from __future__ import annotations
 
@@ -16,6 +17,8 @@ from pddl_export.symbolic import codes_from_bits
 from symlearn.data.dataset import InteractionData
 from symlearn.data.model_input import model_inputs
 from symlearn.learning.models import AttentiveDeepSym
+from symlearn.sim.camera import CameraConfig, crop_centres_xy
+from symlearn.symbolic.locations import LOCATION_BITS, location_bits
 
 
 @dataclass(frozen=True)
@@ -75,17 +78,46 @@ def encode_crops(model: AttentiveDeepSym, depth: np.ndarray, origin: np.ndarray,
     return np.concatenate(out) if out else np.zeros((0, depth.shape[1], bits), np.float32)
 
 
-def build_transition_data(model: AttentiveDeepSym, data: InteractionData,
+@dataclass(frozen=True)
+class SymbolReader:
+    """What planning calls an object's symbol: the effect model's code, then its location bits if `camera` is set."""
+
+    model: AttentiveDeepSym
+    camera: CameraConfig | None = None  # the camera the crops were rendered with; None: the learned code alone
+
+    @property
+    def bits(self) -> int:
+        return int(self.model.cfg.bits) + (LOCATION_BITS if self.camera is not None else 0)
+
+    def encode(self, depth: np.ndarray, origin: np.ndarray, mask: np.ndarray, batch_size: int = 256,
+               image_size: int = 256) -> np.ndarray:
+        """(N, K, S, S) depth crops, (N, K, 2) origins, (N, K) mask -> (N, K, bits) float32 0/1, padding zero."""
+        codes = encode_crops(self.model, depth, origin, mask, batch_size, image_size)
+        if self.camera is None:
+            return codes
+        loc = np.zeros((*codes.shape[:2], LOCATION_BITS), np.float32)
+        for i in range(0, depth.shape[0], batch_size):  # chunks: the back-projection holds (B, K, S, S) floats
+            loc[i:i + batch_size] = location_bits(crop_centres_xy(depth[i:i + batch_size], origin[i:i + batch_size],
+                                                                  self.camera))
+        return np.concatenate([codes, np.where(np.asarray(mask, bool)[..., None], loc, 0.0)], -1).astype(np.float32)
+
+
+def symbol_reader(model: AttentiveDeepSym | SymbolReader) -> SymbolReader:
+    """A SymbolReader as given, or one that reads the learned code alone."""
+    return model if isinstance(model, SymbolReader) else SymbolReader(model)
+
+
+def build_transition_data(model: AttentiveDeepSym | SymbolReader, data: InteractionData,
                           batch_size: int = 256) -> TransitionData:
-    """Encode a split's before- and after-crops with the effect model's encoder."""
-    mask = data.mask
-    before = encode_crops(model, data.pre_depth, data.pre_origin, mask, batch_size)
-    after = encode_crops(model, data.post_depth, data.post_origin, mask, batch_size)
+    """Encode a split's before- and after-crops with the effect model's encoder (and location bits, if read)."""
+    mask, reader = data.mask, symbol_reader(model)
+    before = reader.encode(data.pre_depth, data.pre_origin, mask, batch_size)
+    after = reader.encode(data.post_depth, data.post_origin, mask, batch_size)
     return TransitionData(before, data.action.astype(np.int64), after, mask,
                           data.episode.astype(np.int32), data.step.astype(np.int64))
 
 
-def encode_observation(model: AttentiveDeepSym, obs) -> np.ndarray:
+def encode_observation(model: AttentiveDeepSym | SymbolReader, obs) -> np.ndarray:
     """A live simulator Observation -> (k,) int64 codes, one per object, MSB first.
 
     Crops go through float16 first, as they are stored in the data set the encoder was trained on,
@@ -96,5 +128,5 @@ def encode_observation(model: AttentiveDeepSym, obs) -> np.ndarray:
     if crops.shape[1] == 0:
         return np.zeros(0, np.int64)
     mask = np.ones(crops.shape[:2], bool)
-    bits = encode_crops(model, crops, origins, mask, image_size=int(obs.depth.shape[0]))  # (1, k, bits)
+    bits = symbol_reader(model).encode(crops, origins, mask, image_size=int(obs.depth.shape[0]))  # (1, k, bits)
     return codes_from_bits(bits[0])

@@ -18,6 +18,7 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
+from symlearn.symbolic.locations import LOCATION_BITS
 from symlearn.world import N_ACTIONS
 
 
@@ -26,7 +27,7 @@ class TransitionConfig:
     """Architecture and training of m(z); `paper` follows the paper's layer counts, `quick` is small."""
 
     preset: str = "paper"
-    bits: int = 8  # code length; always taken from the effect model the codes come from
+    bits: int = 8  # code length: the effect model's, plus location_bits
     hidden: int = 128  # width of every dense layer and of the attention
     n_heads: int = 4  # attention heads (hidden must be divisible by it)
     epochs: int = 200  # the network is tiny: 200 epochs of 10,000 samples take about a minute on CPU
@@ -36,6 +37,7 @@ class TransitionConfig:
     encode_batch_size: int = 256  # scenes per encoder forward pass while building the data set
     copy_prior: float = 0.0  # added to each logit toward the input bit, so "no change" is the default
     attention_rounds: int = 1  # self-attention rounds over the scene; the paper has 1 (docs/DESIGN.md on more)
+    location_bits: int = 0  # 0, or LOCATION_BITS: codes end with where each object stands (symbolic.locations)
 
     def __post_init__(self) -> None:
         if self.hidden % self.n_heads:
@@ -48,6 +50,9 @@ class TransitionConfig:
             raise ValueError(f"lr={self.lr} must be positive")
         if not (isinstance(self.attention_rounds, int) and self.attention_rounds >= 1):
             raise ValueError(f"attention_rounds={self.attention_rounds!r} must be an integer >= 1")
+        if self.location_bits not in (0, LOCATION_BITS) or self.location_bits >= self.bits:
+            raise ValueError(f"location_bits={self.location_bits!r} must be 0 or {LOCATION_BITS}, "
+                             f"and fewer than bits={self.bits}")
 
     @staticmethod
     def from_preset(name: str, **overrides) -> "TransitionConfig":
@@ -67,7 +72,7 @@ class TransitionConfig:
         unknown = set(d) - names
         if unknown:
             raise ValueError(f"unknown transition config fields {sorted(unknown)}")
-        return TransitionConfig(**d)  # a file from before copy_prior (attention_rounds) gets its default, 0 (1)
+        return TransitionConfig(**d)  # a file from before copy_prior (attention_rounds, location_bits) gets its default
 
 
 TRANSITION_PRESETS = {

@@ -17,13 +17,16 @@ from typing import Callable
 
 import torch
 
-from symlearn.data.dataset import data_fingerprint, data_records, distinct_extra_data, load_split
+from symlearn.data.dataset import (DataError, data_fingerprint, data_records, distinct_extra_data, load_manifest,
+                                   load_split)
 from symlearn.learning.checkpoint import analysis_device, effect_model_sha256, load_effect_model
 from symlearn.learning.models import AttentiveDeepSym
 from pddl_export.files import finite_or_null
 from symlearn.provenance import atomic_write_json, versions
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, save_transition
-from symlearn.symbolic.transition_data import TransitionData, build_transition_data, concat_transition_data
+from symlearn.sim.camera import CameraConfig
+from symlearn.symbolic.transition_data import (SymbolReader, TransitionData, build_transition_data,
+                                               concat_transition_data)
 from symlearn.symbolic.transition_metrics import evaluate_transition
 from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet, masked_bce
 
@@ -41,11 +44,13 @@ def train_transition(run_dir: Path, data_dir: Path, cfg: TransitionConfig, seed:
     extra_data = distinct_extra_data(data_dir, extra_data)
     t_start = time.perf_counter()
     encoder, ck = load_effect_model(run_dir, device=analysis_device())
-    cfg = dataclasses.replace(cfg, bits=ck.config.bits)
+    cfg = dataclasses.replace(cfg, bits=ck.config.bits + cfg.location_bits)
     fingerprint = data_fingerprint(data_dir)
     extra_fp = data_records(extra_data)
-    splits = encode_splits(encoder, data_dir, cfg.encode_batch_size)
-    extras = [encode_splits(encoder, d, cfg.encode_batch_size) for d in extra_data]
+    camera = data_camera(data_dir, extra_data) if cfg.location_bits else None
+    reader = SymbolReader(encoder, camera)
+    splits = encode_splits(reader, data_dir, cfg.encode_batch_size)
+    extras = [encode_splits(reader, d, cfg.encode_batch_size) for d in extra_data]
     train = concat_transition_data([splits["train"], *(e["train"] for e in extras)])
     val = concat_transition_data([splits["val"], *(e["val"] for e in extras)])
     encode_s = time.perf_counter() - t_start
@@ -53,6 +58,7 @@ def train_transition(run_dir: Path, data_dir: Path, cfg: TransitionConfig, seed:
     meta = {"transition_config": cfg.to_json(), "seed": seed, "data": str(data_dir),
             "data_fingerprint": fingerprint, "extra_data": extra_fp, "effect_model": "best.pt",
             "effect_model_sha256": effect_model_sha256(run_dir), "effect_model_bits": ck.config.bits,
+            "location_camera": None if camera is None else dataclasses.asdict(camera),
             "best_val_loss": best, "versions": versions()}
     save_transition(run_dir / TRANSITION_FILE, net, meta)
     metrics = {**meta, "history": history,
@@ -65,7 +71,24 @@ def train_transition(run_dir: Path, data_dir: Path, cfg: TransitionConfig, seed:
     return metrics
 
 
-def encode_splits(encoder: AttentiveDeepSym, data_dir: Path, batch_size: int) -> dict[str, TransitionData]:
+def data_camera(data_dir: Path, extra_data: tuple[Path, ...] = ()) -> CameraConfig:
+    """The camera the data sets' crops were rendered with (location bits back-project through it); one for all sets."""
+    cams = {}
+    for d in (data_dir, *extra_data):
+        settings = load_manifest(Path(d)).get("settings", {})
+        cam = settings.get("sim", {}).get("camera")
+        if not isinstance(cam, dict):
+            raise DataError(f"{Path(d) / 'manifest.json'} records no camera (settings.sim.camera): "
+                            "location bits cannot be read from its crops")
+        cams[str(d)] = CameraConfig.from_json(cam)
+    if len(set(cams.values())) > 1:
+        raise DataError(f"the data sets were rendered with different cameras ({', '.join(cams)}): "
+                        "location bits need one")
+    return next(iter(cams.values()))
+
+
+def encode_splits(encoder: AttentiveDeepSym | SymbolReader, data_dir: Path,
+                  batch_size: int) -> dict[str, TransitionData]:
     """The train, val and test splits encoded by the effect model: m(z)'s training, selection and test pairs."""
     return {s: build_transition_data(encoder, load_split(data_dir, s), batch_size) for s in ("train", "val", "test")}
 

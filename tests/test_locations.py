@@ -1,0 +1,89 @@
+"""Location bits: back-projected crop centres, the bits read from them, and m(z) trained on codes that end with them."""
+from __future__ import annotations
+
+import dataclasses
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+from conftest import TINY_TRANSITION_ARGS, cli, cli_json
+from pddl_export.symbolic import bits_from_codes
+from symlearn.sim.camera import CameraConfig, crop_centres_xy
+from symlearn.symbolic.locations import LOCATION_BITS, UNSEEN, location_bits
+from symlearn.world import LOCATIONS, TABLE_TOP_Z, ObjectState, ObjectType, Scene
+
+CUBE_Z = TABLE_TOP_Z + 0.05
+
+
+def test_location_bits_name_the_nearest_location_and_the_off_flag():
+    xy = np.float32([[0.80, 0.19], [0.50, -0.20], [np.nan, np.nan], [0.5, 0.33]])
+    bits = location_bits(xy)
+    assert bits.shape == (4, LOCATION_BITS) and bits.dtype == np.float32
+    nearest = (bits[:, :3] * [4, 2, 1]).sum(1).astype(int).tolist()
+    assert nearest == [2, 3, UNSEEN, 5] and bits[:, 3].tolist() == [0, 1, 1, 0]  # 1 cm on, 10 cm off, unseen, 3 cm
+    assert location_bits(np.zeros((2, 0, 2))).shape == (2, 0, LOCATION_BITS)
+
+
+def test_crop_centres_land_on_the_objects_and_name_their_locations(sim):
+    """A cube on location 4, a cube 10 cm off location 2, a stick on location 3: centres within 2.5 cm, bits right."""
+    scene = Scene((ObjectState(ObjectType.CUBE, (*LOCATIONS[4], CUBE_Z)),
+                   ObjectState(ObjectType.CUBE, (LOCATIONS[2][0], LOCATIONS[2][1] + 0.10, CUBE_Z)),
+                   ObjectState(ObjectType.STICK, (*LOCATIONS[3], TABLE_TOP_Z + 0.025))))
+    sim.reset(scene)
+    obs = sim.observe()
+    xy = crop_centres_xy(np.asarray(obs.crops, np.float32), obs.origins, sim.cfg.camera)
+    truth = np.array([o.position[:2] for o in sim.get_scene().objects])
+    assert np.abs(xy - truth).max() < 0.025
+    bits = location_bits(xy)
+    assert (bits[:, :3] * [4, 2, 1]).sum(1).astype(int).tolist() == [4, 2, 3] and bits[:, 3].tolist() == [0, 1, 0]
+    empty = crop_centres_xy(np.zeros((1, 64, 64), np.float32), np.zeros((1, 2)), CameraConfig())
+    assert np.isnan(empty).all()  # no visible pixel: no centre
+
+
+def test_train_transition_with_location_bits_plans_on_12_bit_codes(tiny_run, tiny_run_copy, sim):
+    """--location-bits: m(z) on 12-bit codes whose last 4 bits are read from geometry, through export and planning."""
+    from symlearn.learning.models import AttentiveDeepSym
+    from symlearn.planning.scenes import scene_codes
+    from symlearn.symbolic.learned_transition import LearnedTransition, planning_models
+
+    run = tiny_run_copy
+    out = cli_json("train-transition", "--run", run, "--data", tiny_run.data, *TINY_TRANSITION_ARGS,
+                   "--location-bits", "--quiet")
+    assert 0 <= out["test"]["bit_accuracy"] <= 1
+    meta = json.loads((run / "transition_metrics.json").read_text())
+    assert meta["transition_config"]["location_bits"] == 4 and meta["transition_config"]["bits"] == 12
+    assert CameraConfig.from_json(meta["location_camera"]) == CameraConfig()
+    reader, transition = planning_models(run)
+    assert reader.bits == transition.bits == 12
+    scene = Scene((ObjectState(ObjectType.CUBE, (*LOCATIONS[1], CUBE_Z)),
+                   ObjectState(ObjectType.CUBE, (*LOCATIONS[5], CUBE_Z))))
+    codes = scene_codes(sim, reader, scene)
+    tail = bits_from_codes(codes, 12)[:, 8:]
+    assert (tail[:, :3] @ [4, 2, 1]).tolist() == [1, 5] and tail[:, 3].tolist() == [0, 0]
+    plain = scene_codes(sim, reader.model, scene)  # the learned codes are the first 8 bits, unchanged
+    assert (codes >> 4).tolist() == plain.tolist()
+
+    rc, _ = cli("export-pddl", "--run", run, "--data", tiny_run.data, "--max-objects", 2, "--pddl-fidelity-cases", 20)
+    rules = json.loads((run / "pddl" / "rules.json").read_text())
+    rep = json.loads((run / "pddl" / "report.json").read_text())
+    assert rc == 0 and rules["bits"] == 12 and rep["fidelity"] == 1.0 and rep["pddl_fidelity"] == 1.0
+
+    assert LearnedTransition.from_run(tiny_run.path).reader(reader.model).bits == 8  # the run without them
+    with pytest.raises(ValueError, match="cannot give this transition's 12-bit codes"):
+        transition.reader(AttentiveDeepSym(dataclasses.replace(reader.model.cfg, bits=6)))
+
+
+def test_location_bits_refuse_data_sets_of_different_cameras(tiny_data, tiny_k45, tmp_path):
+    from symlearn.data.dataset import DataError
+    from symlearn.symbolic.transition_training import data_camera
+
+    assert data_camera(tiny_data.path, (tiny_k45,)) == CameraConfig()
+    other = tmp_path / "k45"
+    shutil.copytree(tiny_k45, other)
+    m = json.loads((other / "manifest.json").read_text())
+    m["settings"]["sim"]["camera"]["fov_deg"] = 50.0
+    (other / "manifest.json").write_text(json.dumps(m))
+    with pytest.raises(DataError, match="different cameras"):
+        data_camera(tiny_data.path, (other,))
