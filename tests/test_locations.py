@@ -11,19 +11,24 @@ import pytest
 from conftest import TINY_TRANSITION_ARGS, cli, cli_json
 from pddl_export.symbolic import bits_from_codes
 from symlearn.sim.camera import CameraConfig, crop_centres_xy
-from symlearn.symbolic.locations import LOCATION_BITS, UNSEEN, location_bits
+from symlearn.symbolic.locations import UNSEEN, location_bits
 from symlearn.world import LOCATIONS, TABLE_TOP_Z, ObjectState, ObjectType, Scene
 
 CUBE_Z = TABLE_TOP_Z + 0.05
 
 
-def test_location_bits_name_the_nearest_location_and_the_off_flag():
-    xy = np.float32([[0.80, 0.19], [0.50, -0.20], [np.nan, np.nan], [0.5, 0.33]])
-    bits = location_bits(xy)
-    assert bits.shape == (4, LOCATION_BITS) and bits.dtype == np.float32
-    nearest = (bits[:, :3] * [4, 2, 1]).sum(1).astype(int).tolist()
-    assert nearest == [2, 3, UNSEEN, 5] and bits[:, 3].tolist() == [0, 1, 1, 0]  # 1 cm on, 10 cm off, unseen, 3 cm
-    assert location_bits(np.zeros((2, 0, 2))).shape == (2, 0, LOCATION_BITS)
+def test_location_bits_name_the_nearest_location_and_the_off_field():
+    # 1 cm on; 10 cm off toward +y; unseen; 3 cm on; 12 cm off in x; 8 cm off toward -y
+    xy = np.float32([[0.80, 0.19], [0.50, -0.20], [np.nan, np.nan], [0.5, 0.33], [0.62, 0.0], [0.8, -0.26]])
+    four, five = location_bits(xy, 4), location_bits(xy, 5)
+    assert four.shape == (6, 4) and five.shape == (6, 5) and five.dtype == np.float32
+    nearest = (five[:, :3] @ [4, 2, 1]).astype(int).tolist()
+    assert nearest == [2, 3, UNSEEN, 5, 4, 0] and np.array_equal(four[:, :3], five[:, :3])
+    assert four[:, 3].tolist() == [0, 1, 1, 0, 1, 1]  # off (or unseen)
+    assert (five[:, 3:] @ [2, 1]).astype(int).tolist() == [0, 2, 3, 0, 3, 1]  # on, +y, unseen, on, x, -y
+    assert location_bits(np.zeros((2, 0, 2))).shape == (2, 0, 5)
+    with pytest.raises(ValueError, match="location bits must be one of"):
+        location_bits(xy, 3)
 
 
 def test_crop_centres_land_on_the_objects_and_name_their_locations(sim):
@@ -36,42 +41,46 @@ def test_crop_centres_land_on_the_objects_and_name_their_locations(sim):
     xy = crop_centres_xy(np.asarray(obs.crops, np.float32), obs.origins, sim.cfg.camera)
     truth = np.array([o.position[:2] for o in sim.get_scene().objects])
     assert np.abs(xy - truth).max() < 0.025
-    bits = location_bits(xy)
-    assert (bits[:, :3] * [4, 2, 1]).sum(1).astype(int).tolist() == [4, 2, 3] and bits[:, 3].tolist() == [0, 1, 0]
+    bits = location_bits(xy, 5)
+    assert (bits[:, :3] @ [4, 2, 1]).astype(int).tolist() == [4, 2, 3]
+    assert (bits[:, 3:] @ [2, 1]).astype(int).tolist() == [0, 2, 0]  # on, off toward +y, on
     empty = crop_centres_xy(np.zeros((1, 64, 64), np.float32), np.zeros((1, 2)), CameraConfig())
     assert np.isnan(empty).all()  # no visible pixel: no centre
 
 
-def test_train_transition_with_location_bits_plans_on_12_bit_codes(tiny_run, tiny_run_copy, sim):
-    """--location-bits: m(z) on 12-bit codes whose last 4 bits are read from geometry, through export and planning."""
+def test_train_transition_with_location_bits_plans_on_13_bit_codes(tiny_run, tiny_run_copy, sim):
+    """--location-bits: m(z) on 13-bit codes whose last 5 bits are read from geometry, through export and planning."""
     from symlearn.learning.models import AttentiveDeepSym
     from symlearn.planning.scenes import scene_codes
     from symlearn.symbolic.learned_transition import LearnedTransition, planning_models
+    from symlearn.symbolic.transition_data import SymbolReader
 
     run = tiny_run_copy
     out = cli_json("train-transition", "--run", run, "--data", tiny_run.data, *TINY_TRANSITION_ARGS,
                    "--location-bits", "--quiet")
     assert 0 <= out["test"]["bit_accuracy"] <= 1
     meta = json.loads((run / "transition_metrics.json").read_text())
-    assert meta["transition_config"]["location_bits"] == 4 and meta["transition_config"]["bits"] == 12
+    assert meta["transition_config"]["location_bits"] == 5 and meta["transition_config"]["bits"] == 13
     assert CameraConfig.from_json(meta["location_camera"]) == CameraConfig()
     reader, transition = planning_models(run)
-    assert reader.bits == transition.bits == 12
+    assert reader.bits == transition.bits == 13
     scene = Scene((ObjectState(ObjectType.CUBE, (*LOCATIONS[1], CUBE_Z)),
                    ObjectState(ObjectType.CUBE, (*LOCATIONS[5], CUBE_Z))))
     codes = scene_codes(sim, reader, scene)
-    tail = bits_from_codes(codes, 12)[:, 8:]
-    assert (tail[:, :3] @ [4, 2, 1]).tolist() == [1, 5] and tail[:, 3].tolist() == [0, 0]
+    tail = bits_from_codes(codes, 13)[:, 8:]
+    assert (tail[:, :3] @ [4, 2, 1]).tolist() == [1, 5] and tail[:, 3:].sum() == 0
     plain = scene_codes(sim, reader.model, scene)  # the learned codes are the first 8 bits, unchanged
-    assert (codes >> 4).tolist() == plain.tolist()
+    assert (codes >> 5).tolist() == plain.tolist()
 
     rc, _ = cli("export-pddl", "--run", run, "--data", tiny_run.data, "--max-objects", 2, "--pddl-fidelity-cases", 20)
     rules = json.loads((run / "pddl" / "rules.json").read_text())
     rep = json.loads((run / "pddl" / "report.json").read_text())
-    assert rc == 0 and rules["bits"] == 12 and rep["fidelity"] == 1.0 and rep["pddl_fidelity"] == 1.0
+    assert rc == 0 and rules["bits"] == 13 and rep["fidelity"] == 1.0 and rep["pddl_fidelity"] == 1.0
 
     assert LearnedTransition.from_run(tiny_run.path).reader(reader.model).bits == 8  # the run without them
-    with pytest.raises(ValueError, match="cannot give this transition's 12-bit codes"):
+    with pytest.raises(ValueError, match="with the camera the crops were rendered with"):
+        SymbolReader(reader.model, None, 5)
+    with pytest.raises(ValueError, match="cannot give this transition's 13-bit codes"):
         transition.reader(AttentiveDeepSym(dataclasses.replace(reader.model.cfg, bits=6)))
 
 

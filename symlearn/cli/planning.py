@@ -26,6 +26,7 @@ from pathlib import Path
 
 from symlearn.cli.args import (THREADS_HELP, int_range, non_negative_int, planner_list, positive_finite_float,
                                positive_int, set_threads)
+from symlearn.symbolic.locations import DEFAULT_LOCATION_BITS, LOCATION_BITS
 
 
 MAX_TIMEOUT_S = 86_400.0  # one day: larger values are typos, and the SAS+ planners need a finite limit
@@ -43,14 +44,13 @@ def timeout_seconds(text: str) -> float:
 
 
 def cmd_train_transition(args: argparse.Namespace) -> int:
-    from symlearn.symbolic.locations import LOCATION_BITS
     from symlearn.symbolic.transition_model import TransitionConfig
     from symlearn.symbolic.transition_training import train_transition
 
     over = {k: v for k, v in (("epochs", args.epochs), ("copy_prior", args.copy_prior),
                               ("attention_rounds", args.attention_rounds)) if v is not None}
     if args.location_bits:
-        over["location_bits"] = LOCATION_BITS
+        over["location_bits"] = args.location_bits
     cfg = TransitionConfig.from_preset(args.preset, **over)
     set_threads(args.threads)
     located = f", {cfg.location_bits} location bits" if cfg.location_bits else ""
@@ -188,9 +188,10 @@ def add_train_transition_command(sub) -> None:
     t.add_argument("--copy-prior", type=float, help="logit bias toward keeping each input bit (preset's if unset)")
     t.add_argument("--attention-rounds", type=positive_int,
                    help="self-attention rounds over the scene (the paper and the presets: 1)")
-    t.add_argument("--location-bits", action="store_true",
-                   help="codes end with 4 bits read from each crop's geometry: the nearest table location and "
-                        "whether the object stands off it (docs/DESIGN.md, 'Location bits')")
+    t.add_argument("--location-bits", type=int, nargs="?", const=DEFAULT_LOCATION_BITS, choices=LOCATION_BITS,
+                   metavar="N", help="codes end with N bits read from each crop's geometry: the nearest table "
+                   "location, then whether (4) or which way (5, without N) the object stands off it "
+                   "(docs/DESIGN.md, 'Location bits')")
     t.add_argument("--seed", type=int, default=0)
     t.add_argument("--threads", type=positive_int, help=THREADS_HELP)
     t.add_argument("--quiet", action="store_true")

@@ -41,7 +41,7 @@ class LearnedTransition:
         if int(model.cfg.bits) + self.net.cfg.location_bits != self.bits:
             raise TransitionError(f"an effect model of {model.cfg.bits}-bit codes cannot give this transition's "
                                   f"{self.bits}-bit codes")
-        return SymbolReader(model, self.location_camera)
+        return SymbolReader(model, self.location_camera, self.net.cfg.location_bits)
 
     @classmethod
     def from_run(cls, run_dir: Path, check_encoder: bool = True) -> "LearnedTransition":

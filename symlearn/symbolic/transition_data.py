@@ -80,25 +80,31 @@ def encode_crops(model: AttentiveDeepSym, depth: np.ndarray, origin: np.ndarray,
 
 @dataclass(frozen=True)
 class SymbolReader:
-    """What planning calls an object's symbol: the effect model's code, then its location bits if `camera` is set."""
+    """What planning calls an object's symbol: the effect model's code, then `location_bits` location bits."""
 
     model: AttentiveDeepSym
-    camera: CameraConfig | None = None  # the camera the crops were rendered with; None: the learned code alone
+    camera: CameraConfig | None = None  # the camera the crops were rendered with; needed with location bits
+    location_bits: int = 0  # 0: the learned code alone; else one of locations.LOCATION_BITS
+
+    def __post_init__(self) -> None:
+        if self.location_bits not in (0, *LOCATION_BITS) or (self.location_bits > 0) != (self.camera is not None):
+            raise ValueError(f"location_bits={self.location_bits!r} must be 0 (no camera) or one of "
+                             f"{LOCATION_BITS} (with the camera the crops were rendered with)")
 
     @property
     def bits(self) -> int:
-        return int(self.model.cfg.bits) + (LOCATION_BITS if self.camera is not None else 0)
+        return int(self.model.cfg.bits) + self.location_bits
 
     def encode(self, depth: np.ndarray, origin: np.ndarray, mask: np.ndarray, batch_size: int = 256,
                image_size: int = 256) -> np.ndarray:
         """(N, K, S, S) depth crops, (N, K, 2) origins, (N, K) mask -> (N, K, bits) float32 0/1, padding zero."""
         codes = encode_crops(self.model, depth, origin, mask, batch_size, image_size)
-        if self.camera is None:
+        if not self.location_bits:
             return codes
-        loc = np.zeros((*codes.shape[:2], LOCATION_BITS), np.float32)
+        loc = np.zeros((*codes.shape[:2], self.location_bits), np.float32)
         for i in range(0, depth.shape[0], batch_size):  # chunks: the back-projection holds (B, K, S, S) floats
             loc[i:i + batch_size] = location_bits(crop_centres_xy(depth[i:i + batch_size], origin[i:i + batch_size],
-                                                                  self.camera))
+                                                                  self.camera), self.location_bits)
         return np.concatenate([codes, np.where(np.asarray(mask, bool)[..., None], loc, 0.0)], -1).astype(np.float32)
 
 

@@ -37,7 +37,7 @@ class TransitionConfig:
     encode_batch_size: int = 256  # scenes per encoder forward pass while building the data set
     copy_prior: float = 0.0  # added to each logit toward the input bit, so "no change" is the default
     attention_rounds: int = 1  # self-attention rounds over the scene; the paper has 1 (docs/DESIGN.md on more)
-    location_bits: int = 0  # 0, or LOCATION_BITS: codes end with where each object stands (symbolic.locations)
+    location_bits: int = 0  # 0, or one of LOCATION_BITS: codes end with where each object stands (symbolic.locations)
 
     def __post_init__(self) -> None:
         if self.hidden % self.n_heads:
@@ -50,8 +50,8 @@ class TransitionConfig:
             raise ValueError(f"lr={self.lr} must be positive")
         if not (isinstance(self.attention_rounds, int) and self.attention_rounds >= 1):
             raise ValueError(f"attention_rounds={self.attention_rounds!r} must be an integer >= 1")
-        if self.location_bits not in (0, LOCATION_BITS) or self.location_bits >= self.bits:
-            raise ValueError(f"location_bits={self.location_bits!r} must be 0 or {LOCATION_BITS}, "
+        if self.location_bits not in (0, *LOCATION_BITS) or self.location_bits >= self.bits:
+            raise ValueError(f"location_bits={self.location_bits!r} must be 0 or one of {LOCATION_BITS}, "
                              f"and fewer than bits={self.bits}")
 
     @staticmethod

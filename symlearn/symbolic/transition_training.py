@@ -48,7 +48,7 @@ def train_transition(run_dir: Path, data_dir: Path, cfg: TransitionConfig, seed:
     fingerprint = data_fingerprint(data_dir)
     extra_fp = data_records(extra_data)
     camera = data_camera(data_dir, extra_data) if cfg.location_bits else None
-    reader = SymbolReader(encoder, camera)
+    reader = SymbolReader(encoder, camera, cfg.location_bits)
     splits = encode_splits(reader, data_dir, cfg.encode_batch_size)
     extras = [encode_splits(reader, d, cfg.encode_batch_size) for d in extra_data]
     train = concat_transition_data([splits["train"], *(e["train"] for e in extras)])
