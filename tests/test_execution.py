@@ -484,6 +484,12 @@ def test_cli_parses_planning_commands():
             p.parse_args(["benchmark", "--run", "r", "--problems", "d", "--out", "o", "--risk-weight", bad])
     a = p.parse_args(["train-transition", "--run", "r", "--data", "d", "--preset", "quick", "--epochs", "4"])
     assert (a.preset, a.epochs, a.seed) == ("quick", 4, 0) and a.func.__name__ == "cmd_train_transition"
+    assert a.location_bits is None  # the learned codes alone
+    base = ["train-transition", "--run", "r", "--data", "d"]
+    assert p.parse_args([*base, "--location-bits"]).location_bits == 4  # the flag alone: nearest location + off
+    assert p.parse_args([*base, "--location-bits", "5"]).location_bits == 5
+    with pytest.raises(SystemExit):
+        p.parse_args([*base, "--location-bits", "3"])
 
 
 def test_cli_problems_command(tmp_path):

@@ -26,7 +26,7 @@ def test_location_bits_name_the_nearest_location_and_the_off_field():
     assert nearest == [2, 3, UNSEEN, 5, 4, 0] and np.array_equal(four[:, :3], five[:, :3])
     assert four[:, 3].tolist() == [0, 1, 1, 0, 1, 1]  # off (or unseen)
     assert (five[:, 3:] @ [2, 1]).astype(int).tolist() == [0, 2, 3, 0, 3, 1]  # on, +y, unseen, on, x, -y
-    assert location_bits(np.zeros((2, 0, 2))).shape == (2, 0, 5)
+    assert location_bits(np.zeros((2, 0, 2))).shape == (2, 0, 4)  # the default: nearest location + off flag
     with pytest.raises(ValueError, match="location bits must be one of"):
         location_bits(xy, 3)
 
@@ -49,7 +49,7 @@ def test_crop_centres_land_on_the_objects_and_name_their_locations(sim):
 
 
 def test_train_transition_with_location_bits_plans_on_13_bit_codes(tiny_run, tiny_run_copy, sim):
-    """--location-bits: m(z) on 13-bit codes whose last 5 bits are read from geometry, through export and planning."""
+    """--location-bits 5: m(z) on 13-bit codes whose last 5 bits are read from geometry, through export and planning."""
     from symlearn.learning.models import AttentiveDeepSym
     from symlearn.planning.scenes import scene_codes
     from symlearn.symbolic.learned_transition import LearnedTransition, planning_models
@@ -57,7 +57,7 @@ def test_train_transition_with_location_bits_plans_on_13_bit_codes(tiny_run, tin
 
     run = tiny_run_copy
     out = cli_json("train-transition", "--run", run, "--data", tiny_run.data, *TINY_TRANSITION_ARGS,
-                   "--location-bits", "--quiet")
+                   "--location-bits", 5, "--quiet")
     assert 0 <= out["test"]["bit_accuracy"] <= 1
     meta = json.loads((run / "transition_metrics.json").read_text())
     assert meta["transition_config"]["location_bits"] == 5 and meta["transition_config"]["bits"] == 13

@@ -5,9 +5,9 @@ object stands: a stick at location 0 or 1 of the far row can get one code. A pla
 goal's codes with an object one location (18-32 cm) off, which the benchmark counts as symbol aliasing
 (docs/RESULTS.md, "Location bits"). `symlearn train-transition --location-bits [N]` trains m(z) on codes followed
 by N bits that geometry gives: the table location nearest the object (3 bits, 0-5; UNSEEN for an object with no
-visible pixel), then whether the object stands more than OFF_LOCATION_M from it: with N = 4 one bit (off), with
-N = 5 (the default) two bits that also say which way (OFF_DIRECTIONS: on, off toward -y, off toward +y, off
-mainly in x). Both come from the same crops and window origins the encoder sees, back-projected through the
+visible pixel), then whether the object stands more than OFF_LOCATION_M from it: with N = 4 (the default) one bit, off or
+not; with N = 5 two bits that also say which way (OFF_DIRECTIONS: on, off toward -y, off toward +y, off mainly
+in x). The direction gives better rollouts but no better plans (docs/RESULTS.md), so 4 is the default. Both come from the same crops and window origins the encoder sees, back-projected through the
 camera, so stored samples and live observations get the same bits. On the paper set they agree with the recorded
 poses for every object on a location; the side of an off object agrees for all of them.
 
@@ -22,7 +22,7 @@ import numpy as np
 from symlearn.world import LOCATIONS
 
 LOCATION_BITS = (4, 5)  # the field sizes m(z) accepts: 3 bits of nearest location, then an off flag or an off direction
-DEFAULT_LOCATION_BITS = 5
+DEFAULT_LOCATION_BITS = 4
 OFF_LOCATION_M = 0.05  # as Problem.goal_off_locations: more than 5 cm (xy) from every location is off
 UNSEEN = 7  # the nearest-location field of an object with no visible pixel (its off field is all ones)
 OFF_DIRECTIONS = ("on", "-y", "+y", "x")  # the 2-bit off field of N = 5, in value order
