@@ -100,3 +100,37 @@ def test_stability_run_builds_structures_with_the_in_process_rule_search(tmp_pat
     assert rc == 0, text
     line = [ln for ln in text.splitlines() if ln.startswith(name)][-1]
     assert "success True" in line and "failure None" in line, line
+
+
+LOCATED = PRETRAINED.parent / "quick-stab12k-located"
+
+
+def test_located_run_shares_the_effect_model_and_reads_12_bit_codes(sim):
+    """The third shipped run: the second run's effect model, byte for byte, with an m(z) on codes that end with 4
+    location bits; the live codes of a scene end with each object's location, and the rules are its m(z)'s."""
+    from symlearn.planning.scenes import scene_codes
+    from symlearn.symbolic.learned_transition import planning_models
+    from symlearn.world import LOCATIONS, TABLE_TOP_Z, ObjectState, ObjectType, Scene
+
+    size = sum(p.stat().st_size for p in LOCATED.rglob("*") if p.is_file())
+    assert size <= 6e6, size
+    assert sha256_file(LOCATED / "best.pt") == sha256_file(STABLE / "best.pt")
+    reader, transition = planning_models(LOCATED)
+    assert reader.bits == transition.bits == 12 and transition.net.cfg.location_bits == 4
+    rules, model_hash = load_rules(LOCATED)
+    assert model_hash == sha256_file(LOCATED / "transition.pt")[:16] and rules.bits == 12
+    scene = Scene((ObjectState(ObjectType.CUBE, (*LOCATIONS[0], TABLE_TOP_Z + 0.05)),
+                   ObjectState(ObjectType.CUBE, (*LOCATIONS[4], TABLE_TOP_Z + 0.05))))
+    codes = scene_codes(sim, reader, scene)
+    assert ((codes >> 1) & 7).tolist() == [0, 4] and (codes & 1).tolist() == [0, 0]  # locations 0 and 4, on them
+
+
+@pytest.mark.parametrize("planner", ["astar-outcomes", "rules-outcomes"])
+def test_located_run_builds_a_structure_in_simulation(tmp_path, planner):
+    run = tmp_path / "run"
+    shutil.copytree(LOCATED, run)
+    rc, text = cli("plan", "--run", run, "--problem", PRETRAINED / "problems" / "cube_on_carried_stick.json",
+                   "--planner", planner, "--closed-loop")
+    assert rc == 0, text
+    line = [ln for ln in text.splitlines() if ln.startswith("cube_on_carried_stick")][-1]
+    assert "success True" in line and "failure None" in line, line
