@@ -42,11 +42,11 @@ class PerCallCodeGraph(RuleSuccessors):
 def tasks(run: Path, data: Path, n: int, seed: int) -> list[tuple[list[int], tuple[int, ...]]]:
     """(start codes, goal codes) pairs: test scenes in the vocabulary, goals 2-6 rule steps away."""
     from symlearn.data.dataset import load_split
-    from symlearn.learning.checkpoint import load_effect_model
+    from symlearn.symbolic.learned_transition import planning_models
     from symlearn.symbolic.symbols import encode_codes
 
     rules, _ = load_rules(run)
-    model, _ = load_effect_model(run)
+    model, _ = planning_models(run)  # the codes the rules were distilled on, location bits included
     split = load_split(data, "test")
     codes = encode_codes(model, split.pre_depth, split.pre_origin, split.mask)
     vocab, rng, out = set(rules.vocabulary), np.random.default_rng(seed), []

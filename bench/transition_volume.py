@@ -50,7 +50,6 @@ def main() -> int:
     from symlearn.data.dataset import data_fingerprint, load_split
     from symlearn.symbolic.learned_transition import planning_models
     from symlearn.provenance import bench_context
-    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, load_transition
     from symlearn.symbolic.transition_data import build_transition_data
     from symlearn.symbolic.transition_training import METRICS_FILE
 
@@ -62,8 +61,8 @@ def main() -> int:
     if len(labels) != len(paths):
         raise SystemExit(f"--labels names {len(labels)} runs, --runs gives {len(paths)}")
     for run, label in zip(paths, labels):
-        encoder, _ = planning_models(run)  # the codes m(z) reads, location bits included
-        net, _ = load_transition(run / TRANSITION_FILE)
+        encoder, transition = planning_models(run)  # the codes m(z) reads, location bits included
+        net = transition.net
         trained = json.loads((run / METRICS_FILE).read_text())
         rec = {"transition_data": [trained["data"], *(e["data"] for e in trained.get("extra_data", []))],
                "transition_seed": trained["seed"], "test": {}}

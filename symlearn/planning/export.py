@@ -28,7 +28,7 @@ from pddl_export.files import atomic_write_text, sha256_file
 from pddl_export.outcome_rules import MIN_OUTCOME_RATIO, OUTCOMES_FILE, distil_outcomes, outcomes_to_json
 from pddl_export.pddl_writer import conditional_domain
 from pddl_export.rules_io import PDDL_DIR, rules_to_json
-from pddl_export.symbolic import code_str, codes_from_bits
+from pddl_export.symbolic import code_str
 from symlearn.provenance import atomic_write_json, versions
 
 
@@ -72,16 +72,15 @@ def training_codes(run_dir: Path, data_dir: Path, model=None) -> tuple[np.ndarra
     from symlearn.data.dataset import load_split
     from symlearn.learning.checkpoint import load_effect_model
     from symlearn.symbolic.learned_transition import planning_models
+    from symlearn.symbolic.symbols import encode_codes
     from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
-    from symlearn.symbolic.transition_data import symbol_reader
 
     if model is None:
         model = (planning_models(run_dir)[0] if (Path(run_dir) / TRANSITION_FILE).exists()
                  else load_effect_model(Path(run_dir))[0])
-    reader = symbol_reader(model)
     data = load_split(data_dir, "train")
-    return tuple(np.where(data.mask, codes_from_bits(reader.encode(depth, origin, data.mask).round()), -1)
-                 for depth, origin in ((data.pre_depth, data.pre_origin), (data.post_depth, data.post_origin)))
+    return (encode_codes(model, data.pre_depth, data.pre_origin, data.mask),
+            encode_codes(model, data.post_depth, data.post_origin, data.mask))
 
 
 def code_counts(*code_arrays: np.ndarray) -> dict[int, int]:
@@ -139,11 +138,11 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
 
     run_dir = Path(run_dir)
     out = Path(out_dir) if out_dir else run_dir / PDDL_DIR
-    model, transition = planning_models(run_dir)
+    reader, transition = planning_models(run_dir)
     model_hash = sha256_file(run_dir / TRANSITION_FILE)[:16]
     extra_data = distinct_extra_data(data_dir, extra_data)
     t0 = time.perf_counter()
-    code_sets = [training_codes(run_dir, d, model) for d in (data_dir, *extra_data)]
+    code_sets = [training_codes(run_dir, d, reader) for d in (data_dir, *extra_data)]
     arrays = [a for pair in code_sets for a in pair]
     counts = code_counts(*arrays)
     vocab = sorted(c for c, n in counts.items() if n >= cfg.min_count)

@@ -119,8 +119,9 @@ def crop_centres_xy(depth: np.ndarray, origins: np.ndarray, cam: CameraConfig) -
     seen = depth > 0
     n = seen.sum((-2, -1))
     with np.errstate(invalid="ignore", divide="ignore"):
-        mean_d = depth.sum((-2, -1)) / n  # sum of d * (fwd + x * right + y * up) over the pixels, per axis:
-        sum_dx = (depth * x_ndc[..., None, :]).sum((-2, -1)) / n
-        sum_dy = (depth * y_ndc[..., :, None]).sum((-2, -1)) / n
-    xyz = eye + mean_d[..., None] * fwd + sum_dx[..., None] * right + sum_dy[..., None] * cam_up
+        # the mean of eye + d * (fwd + x * right + y * up) over the visible pixels, term by term
+        mean_d = depth.sum((-2, -1)) / n
+        mean_dx = (depth * x_ndc[..., None, :]).sum((-2, -1)) / n
+        mean_dy = (depth * y_ndc[..., :, None]).sum((-2, -1)) / n
+    xyz = eye + mean_d[..., None] * fwd + mean_dx[..., None] * right + mean_dy[..., None] * cam_up
     return np.where((n > 0)[..., None], xyz[..., :2], np.nan).astype(np.float32)

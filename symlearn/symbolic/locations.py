@@ -7,8 +7,9 @@ goal's codes with an object one location (18-32 cm) off, which the benchmark cou
 by N bits that geometry gives: the table location nearest the object (3 bits, 0-5; UNSEEN for an object with no
 visible pixel), then whether the object stands more than OFF_LOCATION_M from it: with N = 4 (the default) one bit, off or
 not; with N = 5 two bits that also say which way (OFF_DIRECTIONS: on, off toward -y, off toward +y, off mainly
-in x). The direction gives better rollouts but no better plans (docs/RESULTS.md), so 4 is the default. Both come from the same crops and window origins the encoder sees, back-projected through the
-camera, so stored samples and live observations get the same bits. On the paper set they agree with the recorded
+in x). The direction gives better rollouts but no better plans (docs/RESULTS.md), so 4 is the default. Both
+come from the same crops and window origins the encoder sees, back-projected through the camera, so stored
+samples and live observations get the same bits. On the paper set they agree with the recorded
 poses for every object on a location; the side of an off object agrees for all of them.
 
     >>> bits = location_bits(np.float32([[0.80, 0.19], [0.50, -0.20], [np.nan, np.nan]]), 5)

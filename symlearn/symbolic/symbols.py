@@ -15,16 +15,19 @@ import numpy as np
 from pddl_export.symbolic import code_str, codes_from_bits
 from symlearn.data.dataset import InteractionData, data_fingerprint, load_split
 from symlearn.learning.checkpoint import analysis_device, load_effect_model, stage_record
+from symlearn.learning.models import AttentiveDeepSym
 from symlearn.provenance import atomic_write_bytes, atomic_write_json
-from symlearn.symbolic.transition_data import encode_crops
+from symlearn.symbolic.transition_data import SymbolReader, symbol_reader
 from symlearn.world import LOCATIONS, N_LOCATIONS, OBJECT_SIZE, ObjectType
 
 MOVED_M = 0.01
 
 
-def encode_codes(model, depth: np.ndarray, origin: np.ndarray, mask: np.ndarray) -> np.ndarray:
-    """(N, K, S, S) depth crops -> (N, K) integer codes (eval-mode threshold); padding gets -1."""
-    return np.where(mask, codes_from_bits(encode_crops(model, depth, origin, mask).round()), -1)
+def encode_codes(model: AttentiveDeepSym | SymbolReader, depth: np.ndarray, origin: np.ndarray,
+                 mask: np.ndarray) -> np.ndarray:
+    """(N, K, S, S) depth crops -> (N, K) integer codes (eval-mode threshold, and location bits if the reader
+    has them); padding gets -1."""
+    return np.where(mask, codes_from_bits(symbol_reader(model).encode(depth, origin, mask).round()), -1)
 
 
 def picked_objects(data: InteractionData) -> np.ndarray:
