@@ -68,7 +68,7 @@ def time_tasks(run: Path, task_list, timeout_s: float, seed: int) -> dict:
     """Plan every task both ways; per-call seconds and the plans."""
     rules, _ = load_rules(run)
     outcomes, _ = load_outcomes(run)
-    costs = outcomes.cost_table()
+    costs = outcomes.alternative_costs()
     times: dict[str, dict[int, float]] = {"per_call": {}, "once": {}}
     plans: dict[str, dict[int, tuple]] = {"per_call": {}, "once": {}}
     # as in `symlearn benchmark`: one pair of successor functions for every call of the planner

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import json
 import time
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,7 +34,7 @@ from pddl_export.distil import distil_rules
 from pddl_export.enumeration import Enumeration, SceneBlock
 from pddl_export.rules import RuleSet
 from pddl_export.rules_io import PDDL_DIR, rules_from_json, rules_to_json
-from pddl_export.symbolic import N_ACTIONS, OutcomeTransitionFn, bit_flip_costs, code_str, codes_from_bits
+from pddl_export.symbolic import OutcomeTransitionFn, bit_flip_costs, code_str, codes_from_bits
 
 OUTCOMES_FILE = "outcomes.json"
 MIN_OUTCOME_RATIO = 0.05  # an alternative is kept where it is at least this fraction as likely as the likeliest
@@ -89,13 +90,38 @@ class OutcomeRules:
         if any(not (np.isfinite(c) and c >= 0) for *_, c in self.costs):
             raise ValueError("alternative costs must be finite and >= 0")
 
-    def cost_table(self) -> np.ndarray:
-        """(36, 2**bits, 2**bits) float32: the cost of (action, code_from -> code_to); inf where no alternative."""
-        n = 1 << self.rules.bits
-        table = np.full((N_ACTIONS, n, n), np.inf, np.float32)
-        for a, c, d, cost in self.costs:
-            table[a, c, d] = cost
-        return table
+    def alternative_costs(self) -> "AlternativeCosts":
+        """The costs as a lookup the search calls with arrays of (action, code_from, code_to)."""
+        return AlternativeCosts.from_costs(self.costs, self.rules.bits)
+
+
+@dataclass(frozen=True, eq=False)
+class AlternativeCosts:
+    """Extra -log P of each (action, code_from -> code_to) alternative, inf where there is none.
+
+    Held as sorted keys, so memory follows the number of alternatives: a dense (36, 2**bits, 2**bits)
+    table would take 2.4 GB at 12 bits and 36 GB at 14 (codes with location bits).
+    """
+
+    bits: int
+    keys: np.ndarray  # (N,) sorted int64: action << 2 * bits | code_from << bits | code_to
+    values: np.ndarray  # (N,) float64
+
+    @staticmethod
+    def from_costs(costs: Iterable[tuple[int, int, int, float]], bits: int) -> "AlternativeCosts":
+        """From (action, code_from, code_to, cost) entries; a repeated key keeps its last cost."""
+        entries = {(int(a) << 2 * bits) | (int(c) << bits) | int(d): float(x) for a, c, d, x in costs}
+        keys = np.array(sorted(entries), np.int64)
+        return AlternativeCosts(int(bits), keys, np.array([entries[k] for k in keys.tolist()], np.float64))
+
+    def __call__(self, actions: np.ndarray, code_from: np.ndarray, code_to: np.ndarray) -> np.ndarray:
+        """Broadcast arrays of action ids and codes -> the cost of each alternative (inf: none)."""
+        a, c, d = np.broadcast_arrays(*(np.asarray(x, np.int64) for x in (actions, code_from, code_to)))
+        key = (a << 2 * self.bits) | (c << self.bits) | d
+        if not len(self.keys):
+            return np.full(key.shape, np.inf)
+        at = np.minimum(np.searchsorted(self.keys, key), len(self.keys) - 1)
+        return np.where(self.keys[at] == key, self.values[at], np.inf)
 
 
 def _second_enumeration(second: SecondOutcome, enumeration: Enumeration

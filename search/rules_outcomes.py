@@ -10,11 +10,12 @@ successor only. Objects that share a code may part here (one takes its second ou
 the symmetry proofs of search.rules_search do not hold and are not used; the dead-end test
 uses code distances over both rule sets.
 
+    >>> from pddl_export.outcome_rules import AlternativeCosts
     >>> from pddl_export.rules import Rule, RuleSet
     >>> from pddl_export.rule_successors import RuleSuccessors
     >>> main = RuleSet(2, (1, 2, 3), 2, (Rule(action=5, code_from=1, code_to=2),), 1)
     >>> alt = RuleSet(2, (1, 2, 3), 2, (Rule(action=5, code_from=1, code_to=3),), 1)
-    >>> cost = np.full((36, 4, 4), np.inf, np.float32); cost[5, 1, 3] = 1.2
+    >>> cost = AlternativeCosts.from_costs([(5, 1, 3, 1.2)], bits=2)
     >>> res = plan_rules_outcomes(RuleSuccessors(main), RuleSuccessors(alt), cost, [1], SymbolicGoal((3,)),
     ...                           risk_weight=1.0, timeout_s=5)
     >>> res.plan, res.predicted_states, round(res.extra["cost"], 3)
@@ -28,6 +29,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
+from pddl_export.outcome_rules import AlternativeCosts
 from pddl_export.rule_successors import RuleSuccessors
 from pddl_export.symbolic import N_ACTIONS, SymbolicGoal, code_str
 from search.astar import astar, outcome_result
@@ -47,13 +49,13 @@ def _all_actions(succ: RuleSuccessors, states: np.ndarray) -> np.ndarray:
     return out
 
 
-def outcome_steps(main: RuleSuccessors, alternates: RuleSuccessors, costs: np.ndarray, states: np.ndarray,
+def outcome_steps(main: RuleSuccessors, alternates: RuleSuccessors, costs: AlternativeCosts, states: np.ndarray,
                   risk_weight: float, max_deviations: int = MAX_DEVIATIONS) -> list[list[tuple[int, State, float]]]:
     """Per state of (B, K): (action, next state, cost) for the rules' step and its one-object deviations."""
     nxt = _all_actions(main, states)  # (B, 36, K)
     alt = _all_actions(alternates, states)
     own = np.broadcast_to(states[:, None, :], alt.shape)
-    dev_cost = np.where(alt != nxt, costs[np.arange(N_ACTIONS)[None, :, None], own, alt], np.inf)  # (B, 36, K)
+    dev_cost = np.where(alt != nxt, costs(np.arange(N_ACTIONS)[None, :, None], own, alt), np.inf)  # (B, 36, K)
     m = min(max_deviations, states.shape[1])
     pick = np.argsort(dev_cost, axis=2, kind="stable")[..., :m]  # (B, 36, m) the cheapest deviations
     pick_cost = np.take_along_axis(dev_cost, pick, 2)
@@ -74,7 +76,7 @@ def outcome_steps(main: RuleSuccessors, alternates: RuleSuccessors, costs: np.nd
 def plan_rules_outcomes(
     main: RuleSuccessors,
     alternates: RuleSuccessors,
-    costs: np.ndarray,
+    costs: AlternativeCosts,
     start: Sequence[int],
     goal: SymbolicGoal,
     *,
@@ -88,7 +90,7 @@ def plan_rules_outcomes(
 ) -> PlanResult:
     """A* from start codes (K,) to goal over the rules' step and one-object second outcomes (module doc).
 
-    costs: (36, 2**bits, 2**bits) extra -log P of each alternative (OutcomeRules.cost_table).
+    costs: the extra -log P of each alternative (OutcomeRules.alternative_costs).
     batch: states popped per successor call, as in rules-astar; with batch > 1 a costlier plan popped in
     the same batch as a cheaper one's last state may be returned (batch=1: plain A*, one state per pop).
     """
@@ -97,8 +99,8 @@ def plan_rules_outcomes(
         raise ValueError(f"risk_weight must be a finite number > 0, got {risk_weight}")
     if max_deviations < 0:
         raise ValueError(f"max_deviations must be >= 0, got {max_deviations}")
-    if main.bits != alternates.bits or costs.shape != (N_ACTIONS, 1 << main.bits, 1 << main.bits):
-        raise ValueError(f"rules of {main.bits} and {alternates.bits} bits and a cost table of shape {costs.shape} "
+    if not main.bits == alternates.bits == costs.bits:
+        raise ValueError(f"rules of {main.bits} and {alternates.bits} bits and costs of {costs.bits}-bit codes "
                          "do not match")
     start_arr = checked_start(start, goal, main.bits)
     seen = seen or {}

@@ -7,11 +7,11 @@ import pytest
 
 from pddl_export.enumeration import enumerate_transitions
 from pddl_export.fidelity import rule_fidelity
-from pddl_export.outcome_rules import (OUTCOMES_FILE, OutcomeRules, SecondOutcome, distil_outcomes, load_outcomes,
-                                       outcomes_from_json, outcomes_to_json, second_codes)
+from pddl_export.outcome_rules import (OUTCOMES_FILE, AlternativeCosts, OutcomeRules, SecondOutcome, distil_outcomes,
+                                       load_outcomes, outcomes_from_json, outcomes_to_json, second_codes)
 from pddl_export.rule_successors import RuleSuccessors
 from pddl_export.rules import Rule, RuleSet
-from pddl_export.symbolic import N_ACTIONS, SymbolicGoal, codes_from_bits
+from pddl_export.symbolic import SymbolicGoal, codes_from_bits
 from search.result import PlanStatus
 from search.rules_outcomes import outcome_steps, plan_rules_outcomes
 from search.rules_search import plan_rules
@@ -71,9 +71,14 @@ def test_distilled_outcomes_reproduce_the_second_codes_and_their_costs():
     others = {k: x for k, x in costs.items() if k[:2] != (2, 4)}  # the rest flip one bit, 9 times less likely
     assert len(others) == 35 * 3 + 2 and {k[:2] for k in others} == {(a, c) for a in range(36) for c in (1, 4, 6)} - {(2, 4)}
     assert all(x == pytest.approx(np.log(9)) and bin(c ^ d).count("1") == 1 for (a, c, d), x in others.items())
-    table = outcomes.cost_table()
-    assert table.shape == (N_ACTIONS, 8, 8) and table[2, 4, 5] == pytest.approx(np.log(4.0))
-    assert np.isinf(table[2, 4, 6])
+    table = outcomes.alternative_costs()
+    assert table.bits == 3 and len(table.keys) == len(outcomes.costs)
+    assert table(2, 4, 5) == pytest.approx(np.log(4.0)) and np.isinf(table(2, 4, 6))
+    got = table(np.array([[2], [2], [0]]), np.array([4, 4, 7]), np.array([[5], [4], [3]]))  # broadcast, (3, 3)
+    assert got.shape == (3, 3) and got[0, 0] == pytest.approx(np.log(4.0)) and got[1, 1] == pytest.approx(np.log(7 / 3))
+    assert np.isinf(got[2]).all() and np.isinf(AlternativeCosts.from_costs([], 3)(1, 2, 3))
+    wide = AlternativeCosts.from_costs([(35, (1 << 14) - 1, 5, 0.25)], 14)  # 14-bit codes: no dense 36 GB table
+    assert wide(35, (1 << 14) - 1, 5) == 0.25 and np.isinf(wide(35, 5, (1 << 14) - 1)) and wide.keys.nbytes == 8
     # a ratio above every certain bit's odds keeps action 2's alternatives only
     strict, _ = distil_outcomes(toy, enum, 0.2)
     assert {a for a, *_ in strict.costs} == {2} and {r.action for r in strict.rules.rules} == {2}
@@ -105,12 +110,8 @@ def _toy_rules(*rules: Rule) -> RuleSet:
                    rules=rules)
 
 
-def _costs(**entries: float) -> np.ndarray:
-    table = np.full((N_ACTIONS, 4, 4), np.inf, np.float32)
-    for key, x in entries.items():
-        a, c, d = (int(v) for v in key[1:].split("_"))
-        table[a, c, d] = x
-    return table
+def _costs(**entries: float) -> AlternativeCosts:
+    return AlternativeCosts.from_costs([(*(int(v) for v in key[1:].split("_")), x) for key, x in entries.items()], 2)
 
 
 def test_a_goal_only_a_second_outcome_reaches():
@@ -172,8 +173,8 @@ def test_each_action_keeps_the_cheapest_deviations():
         assert {s[1] for s in steps[1:]} == want
         assert sorted(round(s[2], 4) for s in steps[1:]) == sorted([1.1, 1.1, 1.4][:m])
     with pytest.raises(ValueError, match="do not match"):
-        plan_rules_outcomes(RuleSuccessors(main), RuleSuccessors(alt), np.zeros((36, 8, 8)), [1], SymbolicGoal((2,)),
-                            risk_weight=1.0, timeout_s=1)
+        plan_rules_outcomes(RuleSuccessors(main), RuleSuccessors(alt), AlternativeCosts.from_costs([], 3), [1],
+                            SymbolicGoal((2,)), risk_weight=1.0, timeout_s=1)
     with pytest.raises(ValueError, match="risk_weight"):
         plan_rules_outcomes(RuleSuccessors(main), RuleSuccessors(alt), costs, [1], SymbolicGoal((2,)),
                             risk_weight=0.0, timeout_s=1)

@@ -295,7 +295,7 @@ class _RulesOutcomesPlanner(_InProcessRulesPlanner):
     def __init__(self, rules: RuleSet, outcomes: OutcomeRules, model_hash: str, risk_weight: float) -> None:
         super().__init__(rules, model_hash, OUTCOME_RULES_PLANNER, "outcomes", "in-process", None)
         self.outcomes, self.risk_weight = outcomes, risk_weight
-        self._alternates, self._costs = RuleSuccessors(outcomes.rules), outcomes.cost_table()
+        self._alternates, self._costs = RuleSuccessors(outcomes.rules), outcomes.alternative_costs()
 
     def __call__(self, transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
         return self._checked(transition, plan_rules_outcomes(
