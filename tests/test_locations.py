@@ -26,6 +26,12 @@ def test_location_bits_name_the_nearest_location_and_the_off_field():
     assert nearest == [2, 3, UNSEEN, 5, 4, 0] and np.array_equal(four[:, :3], five[:, :3])
     assert four[:, 3].tolist() == [0, 1, 1, 0, 1, 1]  # off (or unseen)
     assert (five[:, 3:] @ [2, 1]).astype(int).tolist() == [0, 2, 3, 0, 3, 1]  # on, +y, unseen, on, x, -y
+    six = location_bits(xy, 6)
+    assert six.shape == (6, 6) and np.array_equal(six[:, :3], five[:, :3])
+    assert (six[:, 3:] @ [4, 2, 1]).astype(int).tolist() == [0, 5, 7, 0, 7, 1]  # +y 9-15 cm, x, -y 5-9 cm
+    far = location_bits(np.float32([[0.8, 0.36], [0.5, 0.18], [0.5, -0.366], [0.8, -0.315]]), 6)  # 18, 12, 6.6, 13.5
+    assert (far[:, :3] @ [4, 2, 1]).astype(int).tolist() == [2, 5, 3, 0]
+    assert (far[:, 3:] @ [4, 2, 1]).astype(int).tolist() == [6, 2, 1, 2]  # +y far, -y mid, -y near, -y mid
     assert location_bits(np.zeros((2, 0, 2))).shape == (2, 0, 4)  # the default: nearest location + off flag
     with pytest.raises(ValueError, match="location bits must be one of"):
         location_bits(xy, 3)

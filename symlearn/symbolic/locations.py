@@ -7,7 +7,10 @@ goal's codes with an object one location (18-32 cm) off, which the benchmark cou
 by N bits that geometry gives: the table location nearest the object (3 bits, 0-5; UNSEEN for an object with no
 visible pixel), then whether the object stands more than OFF_LOCATION_M from it: with N = 4 (the default) one bit, off or
 not; with N = 5 two bits that also say which way (OFF_DIRECTIONS: on, off toward -y, off toward +y, off mainly
-in x). The direction gives better rollouts but no better plans (docs/RESULTS.md), so 4 is the default. Both
+in x); with N = 6 three bits that say which way and how far (OFF_PLACES: on, -y or +y by 5-9, 9-15 or over 15 cm,
+off mainly in x). Objects land off a location by a few distances (a stick grasped at its end: 18 cm; tipped over
+a neighbour: 6-8 cm; pushed: 10-14 cm), and a plan that puts a stick off by the wrong one misses a 2 cm goal.
+The direction gives better rollouts but no better plans (docs/RESULTS.md), so 4 is the default. All
 come from the same crops and window origins the encoder sees, back-projected through the camera, so stored
 samples and live observations get the same bits. On the paper set they agree with the recorded
 poses for every object on a location; the side of an off object agrees for all of them.
@@ -22,11 +25,13 @@ import numpy as np
 
 from symlearn.world import LOCATIONS
 
-LOCATION_BITS = (4, 5)  # the field sizes m(z) accepts: 3 bits of nearest location, then an off flag or an off direction
+LOCATION_BITS = (4, 5, 6)  # field sizes m(z) accepts: 3 bits of nearest location, then an off flag, direction or place
 DEFAULT_LOCATION_BITS = 4
 OFF_LOCATION_M = 0.05  # as Problem.goal_off_locations: more than 5 cm (xy) from every location is off
 UNSEEN = 7  # the nearest-location field of an object with no visible pixel (its off field is all ones)
 OFF_DIRECTIONS = ("on", "-y", "+y", "x")  # the 2-bit off field of N = 5, in value order
+OFF_DISTANCE_EDGES_M = (0.09, 0.15)  # N = 6: how far off in y, in three bands (5-9, 9-15, over 15 cm)
+OFF_PLACES = ("on", "-y near", "-y mid", "-y far", "+y near", "+y mid", "+y far", "x")  # the 3-bit field of N = 6
 
 
 def location_bits(xy: np.ndarray, n_bits: int = DEFAULT_LOCATION_BITS) -> np.ndarray:
@@ -41,11 +46,16 @@ def location_bits(xy: np.ndarray, n_bits: int = DEFAULT_LOCATION_BITS) -> np.nda
     nearest = np.argmin(dist, -1)
     offset = np.take_along_axis(delta, nearest[..., None, None], -2)[..., 0, :]  # (..., 2) from that location
     off = dist.min(-1) > OFF_LOCATION_M
+    in_x = np.abs(offset[..., 0]) > np.abs(offset[..., 1])
     if n_bits == 4:
         field, width = off.astype(np.int64), 1
-    else:
-        way = np.where(np.abs(offset[..., 0]) > np.abs(offset[..., 1]), 3, np.where(offset[..., 1] < 0, 1, 2))
+    elif n_bits == 5:
+        way = np.where(in_x, 3, np.where(offset[..., 1] < 0, 1, 2))
         field, width = np.where(off, way, 0), 2
+    else:
+        band = 1 + np.searchsorted(np.asarray(OFF_DISTANCE_EDGES_M), np.abs(offset[..., 1]), side="right")
+        place = np.where(in_x, 7, np.where(offset[..., 1] < 0, band, 3 + band))
+        field, width = np.where(off, place, 0), 3
     nearest = np.where(seen, nearest, UNSEEN)
     field = np.where(seen, field, (1 << width) - 1)
     value = (nearest << width) | field
