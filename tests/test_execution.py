@@ -487,9 +487,10 @@ def test_cli_parses_planning_commands():
     assert a.location_bits is None  # the learned codes alone
     base = ["train-transition", "--run", "r", "--data", "d"]
     assert p.parse_args([*base, "--location-bits"]).location_bits == 4  # the flag alone: nearest location + off
-    assert p.parse_args([*base, "--location-bits", "5"]).location_bits == 5
-    with pytest.raises(SystemExit):
-        p.parse_args([*base, "--location-bits", "3"])
+    assert [p.parse_args([*base, "--location-bits", n]).location_bits for n in "567"] == [5, 6, 7]
+    for bad in ("3", "8"):
+        with pytest.raises(SystemExit):
+            p.parse_args([*base, "--location-bits", bad])
 
 
 def test_cli_problems_command(tmp_path):

@@ -10,7 +10,7 @@ import pytest
 
 from conftest import TINY_TRANSITION_ARGS, cli, cli_json
 from pddl_export.symbolic import bits_from_codes
-from symlearn.sim.camera import CameraConfig, crop_centres_xy
+from symlearn.sim.camera import CameraConfig, crop_centres_xy, crop_geometry
 from symlearn.symbolic.locations import UNSEEN, location_bits
 from symlearn.world import LOCATIONS, TABLE_TOP_Z, ObjectState, ObjectType, Scene
 
@@ -32,6 +32,12 @@ def test_location_bits_name_the_nearest_location_and_the_off_field():
     far = location_bits(np.float32([[0.8, 0.36], [0.5, 0.18], [0.5, -0.366], [0.8, -0.315]]), 6)  # 18, 12, 6.6, 13.5
     assert (far[:, :3] @ [4, 2, 1]).astype(int).tolist() == [2, 5, 3, 0]
     assert (far[:, 3:] @ [4, 2, 1]).astype(int).tolist() == [6, 2, 1, 2]  # +y far, -y mid, -y near, -y mid
+    top = TABLE_TOP_Z + np.float32([0.1, 0.2, np.nan, 0.051, 0.149, 0.4])  # layers 2, 4, unseen, 1, 3, over 7
+    seven = location_bits(xy, 7, top)
+    assert seven.shape == (6, 7) and np.array_equal(seven[:, :4], four)
+    assert (seven[:, 4:] @ [4, 2, 1]).astype(int).tolist() == [2, 4, 7, 1, 3, 7]
+    with pytest.raises(ValueError, match="top height"):
+        location_bits(xy, 7)
     assert location_bits(np.zeros((2, 0, 2))).shape == (2, 0, 4)  # the default: nearest location + off flag
     with pytest.raises(ValueError, match="location bits must be one of"):
         location_bits(xy, 3)
@@ -52,6 +58,21 @@ def test_crop_centres_land_on_the_objects_and_name_their_locations(sim):
     assert (bits[:, 3:] @ [2, 1]).astype(int).tolist() == [0, 2, 0]  # on, off toward +y, on
     empty = crop_centres_xy(np.zeros((1, 64, 64), np.float32), np.zeros((1, 2)), CameraConfig())
     assert np.isnan(empty).all()  # no visible pixel: no centre
+
+
+def test_crop_tops_tell_a_stack_apart(sim):
+    """Two cubes stacked on location 1 and a stick on location 3: tops within 5 mm, height layers 2, 4 and 1."""
+    scene = Scene((ObjectState(ObjectType.CUBE, (*LOCATIONS[1], CUBE_Z)),
+                   ObjectState(ObjectType.CUBE, (*LOCATIONS[1], CUBE_Z + 0.1)),
+                   ObjectState(ObjectType.STICK, (*LOCATIONS[3], TABLE_TOP_Z + 0.025))))
+    sim.reset(scene)
+    obs = sim.observe()
+    xy, top = crop_geometry(np.asarray(obs.crops, np.float32), obs.origins, sim.cfg.camera)
+    assert np.abs(top - (TABLE_TOP_Z + np.float32([0.1, 0.2, 0.05]))).max() < 0.005
+    assert np.abs(xy[:2] - np.float32(LOCATIONS[1])).max() < 0.025  # the bottom cube's sides still show
+    bits = location_bits(xy, 7, top)
+    assert (bits[:, 4:] @ [4, 2, 1]).astype(int).tolist() == [2, 4, 1]
+    assert (bits[:, :3] @ [4, 2, 1]).astype(int).tolist() == [1, 1, 3]
 
 
 def test_train_transition_with_location_bits_plans_on_13_bit_codes(tiny_run, tiny_run_copy, sim):
@@ -77,6 +98,11 @@ def test_train_transition_with_location_bits_plans_on_13_bit_codes(tiny_run, tin
     assert (tail[:, :3] @ [4, 2, 1]).tolist() == [1, 5] and tail[:, 3:].sum() == 0
     plain = scene_codes(sim, reader.model, scene)  # the learned codes are the first 8 bits, unchanged
     assert (codes >> 5).tolist() == plain.tolist()
+    stacked = Scene((ObjectState(ObjectType.CUBE, (*LOCATIONS[1], CUBE_Z)),
+                     ObjectState(ObjectType.CUBE, (*LOCATIONS[1], CUBE_Z + 0.1))))
+    high = scene_codes(sim, SymbolReader(reader.model, reader.camera, 7), stacked)  # 4 bits, then the height
+    assert (high & 7).tolist() == [2, 4] and ((high >> 3) & 15).tolist() == [2, 2] and (high >> 7).tolist() == \
+        scene_codes(sim, reader.model, stacked).tolist()
 
     rc, _ = cli("export-pddl", "--run", run, "--data", tiny_run.data, "--max-objects", 2, "--pddl-fidelity-cases", 20)
     rules = json.loads((run / "pddl" / "rules.json").read_text())

@@ -10,6 +10,8 @@ not; with N = 5 two bits that also say which way (OFF_DIRECTIONS: on, off toward
 in x); with N = 6 three bits that say which way and how far (OFF_PLACES: on, -y or +y by 5-9, 9-15 or over 15 cm,
 off mainly in x). Objects land off a location by a few distances (a stick grasped at its end: 18 cm; tipped over
 a neighbour: 6-8 cm; pushed: 10-14 cm), and a plan that puts a stick off by the wrong one misses a 2 cm goal.
+With N = 7 the 4-bit field is followed by 3 bits of height: the object's top above the table in 5 cm layers
+(HEIGHT_STEP_M, 0-7), which tells a cube at the bottom of a stack from one on top of it.
 The direction gives better rollouts but no better plans (docs/RESULTS.md), so 4 is the default. All
 come from the same crops and window origins the encoder sees, back-projected through the camera, so stored
 samples and live observations get the same bits. On the paper set they agree with the recorded
@@ -23,21 +25,33 @@ from __future__ import annotations
 
 import numpy as np
 
-from symlearn.world import LOCATIONS
+from symlearn.world import LOCATIONS, TABLE_TOP_Z
 
-LOCATION_BITS = (4, 5, 6)  # field sizes m(z) accepts: 3 bits of nearest location, then an off flag, direction or place
+LOCATION_BITS = (4, 5, 6, 7)  # sizes m(z) accepts: 3 bits of nearest location, an off flag, direction or place,
+# and with 7 the off flag and 3 bits of height
 DEFAULT_LOCATION_BITS = 4
 OFF_LOCATION_M = 0.05  # as Problem.goal_off_locations: more than 5 cm (xy) from every location is off
 UNSEEN = 7  # the nearest-location field of an object with no visible pixel (its off field is all ones)
 OFF_DIRECTIONS = ("on", "-y", "+y", "x")  # the 2-bit off field of N = 5, in value order
 OFF_DISTANCE_EDGES_M = (0.09, 0.15)  # N = 6: how far off in y, in three bands (5-9, 9-15, over 15 cm)
 OFF_PLACES = ("on", "-y near", "-y mid", "-y far", "+y near", "+y mid", "+y far", "x")  # the 3-bit field of N = 6
+HEIGHT_STEP_M = 0.05  # N = 7: an object's top above the table, in layers of this height (a cube's half side)
 
 
-def location_bits(xy: np.ndarray, n_bits: int = DEFAULT_LOCATION_BITS) -> np.ndarray:
-    """(..., 2) world xy (NaN: not seen) -> (..., n_bits) float32 0/1, MSB first: nearest location, then off field."""
+def location_bits(xy: np.ndarray, n_bits: int = DEFAULT_LOCATION_BITS, top: np.ndarray | None = None) -> np.ndarray:
+    """(..., 2) world xy (NaN: not seen) -> (..., n_bits) float32 0/1, MSB first: nearest location, then off field.
+
+    N = 7 also needs `top`, (...,) the world z of each object's highest visible point (camera.crop_geometry).
+    """
     if n_bits not in LOCATION_BITS:
         raise ValueError(f"location bits must be one of {LOCATION_BITS}, got {n_bits!r}")
+    if n_bits == 7:
+        if top is None:
+            raise ValueError("7 location bits need each object's top height (top=...)")
+        layers = np.rint((np.asarray(top, np.float64) - TABLE_TOP_Z) / HEIGHT_STEP_M)
+        height = np.clip(np.where(np.isfinite(layers), layers, 7), 0, 7).astype(np.int64)
+        bits = location_bits(xy, 4)
+        return np.concatenate([bits, ((height[..., None] >> np.arange(2, -1, -1)) & 1).astype(np.float32)], -1)
     xy = np.asarray(xy, np.float64)
     locs = np.asarray(LOCATIONS, np.float64)  # (6, 2)
     seen = np.isfinite(xy).all(-1)
