@@ -38,7 +38,7 @@ def test_location_bits_name_the_nearest_location_and_the_off_field():
     assert (seven[:, 4:] @ [4, 2, 1]).astype(int).tolist() == [2, 4, 7, 1, 3, 7]
     with pytest.raises(ValueError, match="top height"):
         location_bits(xy, 7)
-    assert location_bits(np.zeros((2, 0, 2))).shape == (2, 0, 4)  # the default: nearest location + off flag
+    assert location_bits(np.zeros((2, 0, 2)), 4).shape == (2, 0, 4)
     with pytest.raises(ValueError, match="location bits must be one of"):
         location_bits(xy, 3)
 

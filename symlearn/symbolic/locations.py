@@ -5,14 +5,14 @@ object stands: a stick at location 0 or 1 of the far row can get one code. A pla
 goal's codes with an object one location (18-32 cm) off, which the benchmark counts as symbol aliasing
 (docs/RESULTS.md, "Location bits"). `symlearn train-transition --location-bits [N]` trains m(z) on codes followed
 by N bits that geometry gives: the table location nearest the object (3 bits, 0-5; UNSEEN for an object with no
-visible pixel), then whether the object stands more than OFF_LOCATION_M from it: with N = 4 (the default) one bit, off or
+visible pixel), then whether the object stands more than OFF_LOCATION_M from it: with N = 4 one bit, off or
 not; with N = 5 two bits that also say which way (OFF_DIRECTIONS: on, off toward -y, off toward +y, off mainly
 in x); with N = 6 three bits that say which way and how far (OFF_PLACES: on, -y or +y by 5-9, 9-15 or over 15 cm,
 off mainly in x). Objects land off a location by a few distances (a stick grasped at its end: 18 cm; tipped over
 a neighbour: 6-8 cm; pushed: 10-14 cm), and a plan that puts a stick off by the wrong one misses a 2 cm goal.
-With N = 7 the 4-bit field is followed by 3 bits of height: the object's top above the table in 5 cm layers
-(HEIGHT_STEP_M, 0-7), which tells a cube at the bottom of a stack from one on top of it.
-The direction gives better rollouts but no better plans (docs/RESULTS.md), so 4 is the default. All
+With N = 7 (the default) the 4-bit field is followed by 3 bits of height: the object's top above the table in
+5 cm layers (HEIGHT_STEP_M, 0-7), which tells a cube at the bottom of a stack from one on top of it. Over three
+seeds 7 bits plan best with m(z) itself (docs/RESULTS.md, "Height bits"); 4, 5 and 6 are kept to compare. All
 come from the same crops and window origins the encoder sees, back-projected through the camera, so stored
 samples and live observations get the same bits. On the paper set they agree with the recorded
 poses for every object on a location; the side of an off object agrees for all of them.
@@ -29,7 +29,7 @@ from symlearn.world import LOCATIONS, TABLE_TOP_Z
 
 LOCATION_BITS = (4, 5, 6, 7)  # sizes m(z) accepts: 3 bits of nearest location, an off flag, direction or place,
 # and with 7 the off flag and 3 bits of height
-DEFAULT_LOCATION_BITS = 4
+DEFAULT_LOCATION_BITS = 7  # what the bare --location-bits means
 OFF_LOCATION_M = 0.05  # as Problem.goal_off_locations: more than 5 cm (xy) from every location is off
 UNSEEN = 7  # the nearest-location field of an object with no visible pixel (its off field is all ones)
 OFF_DIRECTIONS = ("on", "-y", "+y", "x")  # the 2-bit off field of N = 5, in value order
@@ -38,7 +38,7 @@ OFF_PLACES = ("on", "-y near", "-y mid", "-y far", "+y near", "+y mid", "+y far"
 HEIGHT_STEP_M = 0.05  # N = 7: an object's top above the table, in layers of this height (a cube's half side)
 
 
-def location_bits(xy: np.ndarray, n_bits: int = DEFAULT_LOCATION_BITS, top: np.ndarray | None = None) -> np.ndarray:
+def location_bits(xy: np.ndarray, n_bits: int, top: np.ndarray | None = None) -> np.ndarray:
     """(..., 2) world xy (NaN: not seen) -> (..., n_bits) float32 0/1, MSB first: nearest location, then off field.
 
     N = 7 also needs `top`, (...,) the world z of each object's highest visible point (camera.crop_geometry).
