@@ -10,7 +10,7 @@ import pytest
 
 from conftest import TINY_TRANSITION_ARGS, cli, cli_json
 from pddl_export.symbolic import bits_from_codes
-from symlearn.sim.camera import CameraConfig, crop_centres_xy, crop_geometry
+from symlearn.sim.camera import CameraConfig, crop_centres_xy, crop_tops_z
 from symlearn.symbolic.locations import UNSEEN, location_bits
 from symlearn.world import LOCATIONS, TABLE_TOP_Z, ObjectState, ObjectType, Scene
 
@@ -67,7 +67,8 @@ def test_crop_tops_tell_a_stack_apart(sim):
                    ObjectState(ObjectType.STICK, (*LOCATIONS[3], TABLE_TOP_Z + 0.025))))
     sim.reset(scene)
     obs = sim.observe()
-    xy, top = crop_geometry(np.asarray(obs.crops, np.float32), obs.origins, sim.cfg.camera)
+    crops = np.asarray(obs.crops, np.float32)
+    xy, top = crop_centres_xy(crops, obs.origins, sim.cfg.camera), crop_tops_z(crops, obs.origins, sim.cfg.camera)
     assert np.abs(top - (TABLE_TOP_Z + np.float32([0.1, 0.2, 0.05]))).max() < 0.005
     assert np.abs(xy[:2] - np.float32(LOCATIONS[1])).max() < 0.025  # the bottom cube's sides still show
     bits = location_bits(xy, 7, top)

@@ -95,25 +95,9 @@ def position_channels(origins: np.ndarray, crop: int, image_size: int) -> np.nda
     return np.stack([x, y], axis=-3).astype(np.float32)
 
 
-def crop_centres_xy(depth: np.ndarray, origins: np.ndarray, cam: CameraConfig) -> np.ndarray:
-    """(..., S, S) metric depth crops and (..., 2) window origins -> (..., 2) world xy of each crop's visible pixels.
-
-    Every pixel with depth is back-projected through the camera (OpenGL convention: row 0 at the top, depth
-    along the view axis) and the points are averaged; NaN where a crop has no visible pixel. On the paper set
-    the mean lies within 1.1 cm (cubes) and 0.8 cm (sticks, median) of the object's centre.
-    """
-    return crop_geometry(depth, origins, cam)[0]
-
-
-def crop_geometry(depth: np.ndarray, origins: np.ndarray, cam: CameraConfig) -> tuple[np.ndarray, np.ndarray]:
-    """Each crop's visible pixels back-projected: (..., 2) mean world xy, and (...,) the highest point's world z.
-
-    The top says how high an object stands: on the 1-5-object set, 90% of the cubes lying flat read within 2 mm
-    of their true top (5 cm per layer above the table). NaN for both where a crop has no visible pixel.
-    """
-    depth = np.asarray(depth, np.float32)
+def _window_rays(origins: np.ndarray, s: int, cam: CameraConfig):
+    """The camera's eye and axes, and the (..., S) view-ray slopes over each S x S window's columns and rows."""
     origins = np.asarray(origins, np.float32)
-    s = depth.shape[-1]
     eye, target, up = (np.asarray(v, np.float64) for v in (cam.eye, cam.target, cam.up))
     fwd = (target - eye) / np.linalg.norm(target - eye)
     right = np.cross(fwd, up)
@@ -125,16 +109,37 @@ def crop_geometry(depth: np.ndarray, origins: np.ndarray, cam: CameraConfig) -> 
     cols = origins[..., 1, None] + offs
     x_ndc = (2.0 * cols / cam.size - 1.0) * tan  # (..., S), over the window's columns
     y_ndc = (1.0 - 2.0 * rows / cam.size) * tan  # (..., S), over its rows
-    seen = depth > 0
-    n = seen.sum((-2, -1))
+    return eye, fwd, right, cam_up, x_ndc, y_ndc
+
+
+def crop_centres_xy(depth: np.ndarray, origins: np.ndarray, cam: CameraConfig) -> np.ndarray:
+    """(..., S, S) metric depth crops and (..., 2) window origins -> (..., 2) world xy of each crop's visible pixels.
+
+    Every pixel with depth is back-projected through the camera (OpenGL convention: row 0 at the top, depth
+    along the view axis) and the points are averaged; NaN where a crop has no visible pixel. On the paper set
+    the mean lies within 1.1 cm (cubes) and 0.8 cm (sticks, median) of the object's centre.
+    """
+    depth = np.asarray(depth, np.float32)
+    eye, fwd, right, cam_up, x_ndc, y_ndc = _window_rays(origins, depth.shape[-1], cam)
+    n = (depth > 0).sum((-2, -1))
     with np.errstate(invalid="ignore", divide="ignore"):
         # the mean of eye + d * (fwd + x * right + y * up) over the visible pixels, term by term
         mean_d = depth.sum((-2, -1)) / n
         mean_dx = (depth * x_ndc[..., None, :]).sum((-2, -1)) / n
         mean_dy = (depth * y_ndc[..., :, None]).sum((-2, -1)) / n
     xyz = eye + mean_d[..., None] * fwd + mean_dx[..., None] * right + mean_dy[..., None] * cam_up
+    return np.where((n > 0)[..., None], xyz[..., :2], np.nan).astype(np.float32)
+
+
+def crop_tops_z(depth: np.ndarray, origins: np.ndarray, cam: CameraConfig) -> np.ndarray:
+    """(..., S, S) metric depth crops and (..., 2) window origins -> (...,) world z of each crop's highest pixel.
+
+    The top says how high an object stands: on the 1-5-object set, 90% of the cubes lying flat read within 2 mm
+    of their true top (5 cm per layer above the table). NaN where a crop has no visible pixel.
+    """
+    depth = np.asarray(depth, np.float32)
+    eye, fwd, right, cam_up, x_ndc, y_ndc = _window_rays(origins, depth.shape[-1], cam)
+    seen = depth > 0
     z = eye[2] + depth * (fwd[2] + x_ndc[..., None, :] * right[2] + y_ndc[..., :, None] * cam_up[2])
-    top = np.where(seen, z, -np.inf).max((-2, -1)) if s else np.full(depth.shape[:-2], -np.inf)
-    found = n > 0
-    return (np.where(found[..., None], xyz[..., :2], np.nan).astype(np.float32),
-            np.where(found, top, np.nan).astype(np.float32))
+    top = np.where(seen, z, -np.inf).max((-2, -1)) if depth.shape[-1] else np.full(depth.shape[:-2], -np.inf)
+    return np.where(seen.any((-2, -1)), top, np.nan).astype(np.float32)

@@ -41,17 +41,12 @@ HEIGHT_STEP_M = 0.05  # N = 7: an object's top above the table, in layers of thi
 def location_bits(xy: np.ndarray, n_bits: int, top: np.ndarray | None = None) -> np.ndarray:
     """(..., 2) world xy (NaN: not seen) -> (..., n_bits) float32 0/1, MSB first: nearest location, then off field.
 
-    N = 7 also needs `top`, (...,) the world z of each object's highest visible point (camera.crop_geometry).
+    N = 7 also needs `top`, (...,) the world z of each object's highest visible point (camera.crop_tops_z).
     """
     if n_bits not in LOCATION_BITS:
         raise ValueError(f"location bits must be one of {LOCATION_BITS}, got {n_bits!r}")
-    if n_bits == 7:
-        if top is None:
-            raise ValueError("7 location bits need each object's top height (top=...)")
-        layers = np.rint((np.asarray(top, np.float64) - TABLE_TOP_Z) / HEIGHT_STEP_M)
-        height = np.clip(np.where(np.isfinite(layers), layers, 7), 0, 7).astype(np.int64)
-        bits = location_bits(xy, 4)
-        return np.concatenate([bits, ((height[..., None] >> np.arange(2, -1, -1)) & 1).astype(np.float32)], -1)
+    if n_bits == 7 and top is None:
+        raise ValueError("7 location bits need each object's top height (top=...)")
     xy = np.asarray(xy, np.float64)
     locs = np.asarray(LOCATIONS, np.float64)  # (6, 2)
     seen = np.isfinite(xy).all(-1)
@@ -66,10 +61,14 @@ def location_bits(xy: np.ndarray, n_bits: int, top: np.ndarray | None = None) ->
     elif n_bits == 5:
         way = np.where(in_x, 3, np.where(offset[..., 1] < 0, 1, 2))
         field, width = np.where(off, way, 0), 2
-    else:
+    elif n_bits == 6:
         band = 1 + np.searchsorted(np.asarray(OFF_DISTANCE_EDGES_M), np.abs(offset[..., 1]), side="right")
         place = np.where(in_x, 7, np.where(offset[..., 1] < 0, band, 3 + band))
         field, width = np.where(off, place, 0), 3
+    else:  # the off flag, then the top's layer above the table (an unseen object's is all ones, as its flag)
+        layers = np.rint((np.asarray(top, np.float64) - TABLE_TOP_Z) / HEIGHT_STEP_M)
+        height = np.clip(np.where(np.isfinite(layers), layers, 7), 0, 7).astype(np.int64)
+        field, width = (off.astype(np.int64) << 3) | height, 4
     nearest = np.where(seen, nearest, UNSEEN)
     field = np.where(seen, field, (1 << width) - 1)
     value = (nearest << width) | field
