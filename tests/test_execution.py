@@ -487,8 +487,8 @@ def test_cli_parses_planning_commands():
     assert a.location_bits is None  # the learned codes alone
     base = ["train-transition", "--run", "r", "--data", "d"]
     assert p.parse_args([*base, "--location-bits"]).location_bits == 7  # the flag alone: location, off, height
-    assert [p.parse_args([*base, "--location-bits", n]).location_bits for n in "4567"] == [4, 5, 6, 7]
-    for bad in ("3", "8"):
+    assert [p.parse_args([*base, "--location-bits", n]).location_bits for n in "45679"] == [4, 5, 6, 7, 9]
+    for bad in ("3", "8", "10"):
         with pytest.raises(SystemExit):
             p.parse_args([*base, "--location-bits", bad])
 

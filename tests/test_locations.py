@@ -38,6 +38,10 @@ def test_location_bits_name_the_nearest_location_and_the_off_field():
     assert (seven[:, 4:] @ [4, 2, 1]).astype(int).tolist() == [2, 4, 7, 1, 3, 7]
     with pytest.raises(ValueError, match="top height"):
         location_bits(xy, 7)
+    nine = location_bits(xy, 9, top)  # the place of 6 bits, then the height of 7
+    assert nine.shape == (6, 9) and np.array_equal(nine[:, :6], six) and np.array_equal(nine[:, 6:], seven[:, 4:])
+    with pytest.raises(ValueError, match="9 location bits need each object's top height"):
+        location_bits(xy, 9)
     assert location_bits(np.zeros((2, 0, 2)), 4).shape == (2, 0, 4)
     with pytest.raises(ValueError, match="location bits must be one of"):
         location_bits(xy, 3)
@@ -104,6 +108,9 @@ def test_train_transition_with_location_bits_plans_on_13_bit_codes(tiny_run, tin
     high = scene_codes(sim, SymbolReader(reader.model, reader.camera, 7), stacked)  # 4 bits, then the height
     assert (high & 7).tolist() == [2, 4] and ((high >> 3) & 15).tolist() == [2, 2] and (high >> 7).tolist() == \
         scene_codes(sim, reader.model, stacked).tolist()
+    placed = scene_codes(sim, SymbolReader(reader.model, reader.camera, 9), stacked)  # place (on: 0), then height
+    assert (placed & 7).tolist() == [2, 4] and ((placed >> 3) & 63).tolist() == [1 << 3, 1 << 3]
+    assert (placed >> 9).tolist() == (high >> 7).tolist()
 
     rc, _ = cli("export-pddl", "--run", run, "--data", tiny_run.data, "--max-objects", 2, "--pddl-fidelity-cases", 20)
     rules = json.loads((run / "pddl" / "rules.json").read_text())

@@ -12,7 +12,8 @@ off mainly in x). Objects land off a location by a few distances (a stick graspe
 a neighbour: 6-8 cm; pushed: 10-14 cm), and a plan that puts a stick off by the wrong one misses a 2 cm goal.
 With N = 7 (the default) the 4-bit field is followed by 3 bits of height: the object's top above the table in
 5 cm layers (HEIGHT_STEP_M, 0-7), which tells a cube at the bottom of a stack from one on top of it. Over three
-seeds 7 bits plan best with m(z) itself (docs/RESULTS.md, "Height bits"); 4, 5 and 6 are kept to compare. All
+seeds 7 bits plan best with m(z) itself (docs/RESULTS.md, "Height bits"); 4, 5 and 6 are kept to compare. N = 9
+joins the two: the 3-bit place of N = 6, then the 3 height bits of N = 7 (docs/RESULTS.md, "Place and height"). All
 come from the same crops and window origins the encoder sees, back-projected through the camera, so stored
 samples and live observations get the same bits. On the paper set they agree with the recorded
 poses for every object on a location; the side of an off object agrees for all of them.
@@ -27,26 +28,27 @@ import numpy as np
 
 from symlearn.world import LOCATIONS, TABLE_TOP_Z
 
-LOCATION_BITS = (4, 5, 6, 7)  # sizes m(z) accepts: 3 bits of nearest location, an off flag, direction or place,
-# and with 7 the off flag and 3 bits of height
+LOCATION_BITS = (4, 5, 6, 7, 9)  # sizes m(z) accepts: 3 bits of nearest location, an off flag, direction or
+# place; with 7 the off flag and 3 bits of height, with 9 the place and 3 bits of height
 DEFAULT_LOCATION_BITS = 7  # what the bare --location-bits means
 OFF_LOCATION_M = 0.05  # as Problem.goal_off_locations: more than 5 cm (xy) from every location is off
 UNSEEN = 7  # the nearest-location field of an object with no visible pixel (its off field is all ones)
 OFF_DIRECTIONS = ("on", "-y", "+y", "x")  # the 2-bit off field of N = 5, in value order
 OFF_DISTANCE_EDGES_M = (0.09, 0.15)  # N = 6: how far off in y, in three bands (5-9, 9-15, over 15 cm)
 OFF_PLACES = ("on", "-y near", "-y mid", "-y far", "+y near", "+y mid", "+y far", "x")  # the 3-bit field of N = 6
-HEIGHT_STEP_M = 0.05  # N = 7: an object's top above the table, in layers of this height (a cube's half side)
+HEIGHT_STEP_M = 0.05  # N = 7, 9: an object's top above the table, in layers of this height (a cube's half side)
+HEIGHTED_BITS = (7, 9)  # the sizes that end with the 3 height bits, and so need each object's top
 
 
 def location_bits(xy: np.ndarray, n_bits: int, top: np.ndarray | None = None) -> np.ndarray:
     """(..., 2) world xy (NaN: not seen) -> (..., n_bits) float32 0/1, MSB first: nearest location, then off field.
 
-    N = 7 also needs `top`, (...,) the world z of each object's highest visible point (camera.crop_tops_z).
+    N = 7 and 9 also need `top`, (...,) the world z of each object's highest visible point (camera.crop_tops_z).
     """
     if n_bits not in LOCATION_BITS:
         raise ValueError(f"location bits must be one of {LOCATION_BITS}, got {n_bits!r}")
-    if n_bits == 7 and top is None:
-        raise ValueError("7 location bits need each object's top height (top=...)")
+    if n_bits in HEIGHTED_BITS and top is None:
+        raise ValueError(f"{n_bits} location bits need each object's top height (top=...)")
     xy = np.asarray(xy, np.float64)
     locs = np.asarray(LOCATIONS, np.float64)  # (6, 2)
     seen = np.isfinite(xy).all(-1)
@@ -61,14 +63,14 @@ def location_bits(xy: np.ndarray, n_bits: int, top: np.ndarray | None = None) ->
     elif n_bits == 5:
         way = np.where(in_x, 3, np.where(offset[..., 1] < 0, 1, 2))
         field, width = np.where(off, way, 0), 2
-    elif n_bits == 6:
+    else:
         band = 1 + np.searchsorted(np.asarray(OFF_DISTANCE_EDGES_M), np.abs(offset[..., 1]), side="right")
-        place = np.where(in_x, 7, np.where(offset[..., 1] < 0, band, 3 + band))
-        field, width = np.where(off, place, 0), 3
-    else:  # the off flag, then the top's layer above the table (an unseen object's is all ones, as its flag)
+        place = np.where(off, np.where(in_x, 7, np.where(offset[..., 1] < 0, band, 3 + band)), 0)
+        field, width = (off.astype(np.int64), 1) if n_bits == 7 else (place, 3)  # 7: the flag; 6 and 9: the place
+    if n_bits in HEIGHTED_BITS:  # then the top's layer above the table (an unseen object's is all ones, as its field)
         layers = np.rint((np.asarray(top, np.float64) - TABLE_TOP_Z) / HEIGHT_STEP_M)
         height = np.clip(np.where(np.isfinite(layers), layers, 7), 0, 7).astype(np.int64)
-        field, width = (off.astype(np.int64) << 3) | height, 4
+        field, width = (field << 3) | height, width + 3
     nearest = np.where(seen, nearest, UNSEEN)
     field = np.where(seen, field, (1 << width) - 1)
     value = (nearest << width) | field

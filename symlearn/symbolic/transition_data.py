@@ -18,7 +18,7 @@ from symlearn.data.dataset import InteractionData
 from symlearn.data.model_input import model_inputs
 from symlearn.learning.models import AttentiveDeepSym
 from symlearn.sim.camera import CameraConfig, crop_centres_xy, crop_tops_z
-from symlearn.symbolic.locations import LOCATION_BITS, location_bits
+from symlearn.symbolic.locations import HEIGHTED_BITS, LOCATION_BITS, location_bits
 
 
 @dataclass(frozen=True)
@@ -104,7 +104,7 @@ class SymbolReader:
         loc = np.zeros((*codes.shape[:2], self.location_bits), np.float32)
         for i in range(0, depth.shape[0], batch_size):  # chunks: the back-projection holds (B, K, S, S) floats
             d, o = depth[i:i + batch_size], origin[i:i + batch_size]
-            top = crop_tops_z(d, o, self.camera) if self.location_bits == 7 else None  # only 7 bits read heights
+            top = crop_tops_z(d, o, self.camera) if self.location_bits in HEIGHTED_BITS else None  # only these read heights
             loc[i:i + batch_size] = location_bits(crop_centres_xy(d, o, self.camera), self.location_bits, top)
         return np.concatenate([codes, np.where(np.asarray(mask, bool)[..., None], loc, 0.0)], -1).astype(np.float32)
 

@@ -19,6 +19,9 @@ import torch.nn as nn
 import torch.nn.functional as F
 
 from symlearn.symbolic.locations import LOCATION_BITS
+
+# An 8-bit learned code and 9 location bits make 17; the rule searches hold (objects, 2**bits) tables, 8 MB at 20.
+MAX_TRANSITION_BITS = 20
 from symlearn.world import N_ACTIONS
 
 
@@ -42,8 +45,8 @@ class TransitionConfig:
     def __post_init__(self) -> None:
         if self.hidden % self.n_heads:
             raise ValueError(f"hidden {self.hidden} is not divisible by n_heads {self.n_heads}")
-        if not 1 <= self.bits <= 16:
-            raise ValueError(f"bits={self.bits} must lie in 1..16")
+        if not 1 <= self.bits <= MAX_TRANSITION_BITS:
+            raise ValueError(f"bits={self.bits} must lie in 1..{MAX_TRANSITION_BITS}")
         if self.epochs < 1 or self.batch_size < 1 or self.encode_batch_size < 1:
             raise ValueError("epochs, batch_size and encode_batch_size must be positive")
         if not self.lr > 0:
