@@ -35,6 +35,8 @@ A goal that the network's most likely predictions never reach, but a likely enou
 does, then gets a plan; execution checks each step and replans when the world picks another outcome.
 The bits are independent given the input, so the n most likely outcomes are the likeliest state with
 subsets of its n - 1 least certain bits flipped (exact: any other flip is less likely than each of these).
+A mixture m(z) (a transition with `modes` > 1 and `mode_outcomes`) names its outcomes itself: each
+mode's likeliest state, however many bits apart, scored under the whole mixture.
 """
 from __future__ import annotations
 
@@ -114,6 +116,8 @@ def likely_outcomes(probs: np.ndarray, max_outcomes: int, min_ratio: float) -> l
 def outcome_successors(transition: OutcomeTransitionFn, state: State, max_outcomes: int,
                        min_ratio: float) -> list[tuple[int, State, float]]:
     """(action, next_state, -log P) for each likely outcome of each action that changes state; one batched call."""
+    if int(getattr(transition, "modes", 1)) > 1 and callable(getattr(transition, "mode_outcomes", None)):
+        return mode_successors(transition, state, max_outcomes, min_ratio)
     batch = np.repeat(np.asarray(state, np.int64)[None], N_ACTIONS, 0)  # (36, K)
     bits = int(transition.bits)
     probs = np.asarray(transition.bit_probabilities(batch, np.arange(N_ACTIONS, dtype=np.int64)), np.float64)
@@ -121,6 +125,31 @@ def outcome_successors(transition: OutcomeTransitionFn, state: State, max_outcom
         raise ValueError(f"bit probabilities must be (36, {len(state)}, {bits}) in [0, 1], got shape {probs.shape}")
     return [(a, nxt, nll) for a, row in enumerate(likely_outcomes(probs, max_outcomes, min_ratio))
             for nxt, nll in row if nxt != state]
+
+
+def mode_successors(transition, state: State, max_outcomes: int, min_ratio: float) -> list[tuple[int, State, float]]:
+    """As outcome_successors, from a mixture's modes: per action its distinct mode states, likeliest first,
+    at most max_outcomes, each at least min_ratio times as likely as the likeliest."""
+    batch = np.repeat(np.asarray(state, np.int64)[None], N_ACTIONS, 0)
+    states, nll = transition.mode_outcomes(batch, np.arange(N_ACTIONS, dtype=np.int64))
+    states, nll = np.asarray(states, np.int64), np.asarray(nll, np.float64)
+    if states.ndim != 3 or states.shape[::2] != (N_ACTIONS, len(state)) or nll.shape != states.shape[:2]:
+        raise ValueError(f"mode outcomes must be (36, M, {len(state)}) states and (36, M) -log P, "
+                         f"got {states.shape} and {nll.shape}")
+    _check_codes(states.reshape(-1, len(state)), (states.shape[0] * states.shape[1], len(state)),
+                 int(transition.bits), "mode outcome")
+    order, limit, out = np.argsort(nll, axis=1, kind="stable"), -np.log(min_ratio), []
+    for a in range(N_ACTIONS):
+        kept: set[State] = set()
+        for j in order[a]:
+            if len(kept) == max_outcomes or nll[a, j] - nll[a, order[a, 0]] > limit:
+                break
+            nxt = tuple(states[a, j].tolist())
+            if nxt not in kept:
+                kept.add(nxt)
+                if nxt != state:
+                    out.append((a, nxt, float(nll[a, j])))
+    return out
 
 
 def _check_request(transition: TransitionFn, start_arr: np.ndarray, goal: SymbolicGoal, risk_weight: float,

@@ -416,3 +416,69 @@ def test_extra_data_joins_training_and_is_tested_apart(tiny_run, tiny_run_copy, 
     rc, _ = cli("train-transition", "--run", tiny_run_copy, "--data", tiny_run.data, "--extra-data",
                 tiny_run.data, *TINY_TRANSITION_ARGS, "--quiet")
     assert rc != 0 and "must differ" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------------------- outcome modes (a mixture m(z))
+
+
+def _two_outcome_data(n: int = 400, seed: int = 0) -> tuple[TransitionData, np.ndarray, np.ndarray, np.ndarray]:
+    """One start scene; action 0 leads to arrangement A (70%) or B (30%), which differ in 6 bits of object 0
+    and 2 of object 1; every other action leaves the scene as it is. Returns the data, start, A and B bits."""
+    rng = np.random.default_rng(seed)
+    start = np.float32([[0, 0, 0, 0, 0, 0, 0, 1], [1, 0, 1, 0, 0, 0, 0, 0]])
+    a = np.float32([[1, 1, 0, 0, 0, 0, 0, 1], [1, 0, 1, 0, 0, 0, 0, 0]])
+    b = np.float32([[1, 0, 1, 1, 1, 1, 1, 1], [1, 0, 1, 0, 0, 0, 1, 1]])
+    action = np.where(rng.random(n) < 0.5, 0, rng.integers(1, 36, n))
+    after = np.where((action == 0)[:, None, None], np.where((rng.random(n) < 0.7)[:, None, None], a, b), start)
+    data = TransitionData(np.repeat(start[None], n, 0), action.astype(np.int64), after.astype(np.float32),
+                          np.ones((n, 2), bool), np.arange(n, dtype=np.int32), np.zeros(n, np.int64))
+    return data, start, a, b
+
+
+def test_modes_config_refuses_bad_counts_and_one_mode_is_the_paper_net():
+    from symlearn.symbolic.transition_model import predict_modes, predict_scored, transition_loss
+    for bad in (0, 17, 2.0):
+        with pytest.raises(ValueError, match="modes="):
+            TransitionConfig(modes=bad)
+    net = _net(seed=2)
+    assert not hasattr(net, "weight_head") and net.post[-1].out_features == BITS
+    rng = np.random.default_rng(3)
+    bits = (rng.random((36, 3, BITS)) < 0.5).astype(np.float32)
+    mask, actions = np.ones((36, 3), bool), np.arange(36)
+    states, nll = predict_modes(net, bits, mask, actions)
+    codes, nll1 = predict_scored(net, bits, mask, actions)
+    assert states.shape == (36, 1, 3, BITS) and np.array_equal(states[:, 0], codes)
+    np.testing.assert_allclose(nll[:, 0], nll1, rtol=1e-6)
+    t = [torch.from_numpy(v) for v in (bits, mask, actions)]
+    with torch.no_grad():
+        out = net(*t)
+        assert float(transition_loss(out, t[0], t[1])) == pytest.approx(float(masked_bce(out.logits, t[0], t[1])))
+
+
+def test_a_mixture_names_both_outcomes_whole_where_independent_bits_cannot(tmp_path):
+    """Trained on a 70/30 choice between two arrangements many bits apart, two modes give both at about
+    -log 0.7 and -log 0.3, and astar-outcomes' successors hold B; the paper's net only mixes bits."""
+    from search.learned_astar import outcome_successors
+    from symlearn.symbolic.transition_training import fit_transition
+
+    data, start, a, b = _two_outcome_data()
+    codes = lambda x: tuple(int(c) for c in (x * (1 << np.arange(BITS - 1, -1, -1))).sum(-1))  # noqa: E731
+    nets = {m: fit_transition(TransitionConfig.from_preset("quick", bits=BITS, epochs=60, modes=m), data, data, seed=0)
+            for m in (1, 2)}
+    mix = LearnedTransition(nets[2][0])
+    states, nll = mix.mode_outcomes(np.array([codes(start)]), np.array([0]))
+    got = {tuple(s): float(x) for s, x in zip(states[0].tolist(), nll[0])}
+    assert set(got) == {codes(a), codes(b)}
+    assert got[codes(a)] == pytest.approx(-np.log(0.7), abs=0.15) and got[codes(b)] == pytest.approx(-np.log(0.3), abs=0.2)
+    assert tuple(mix(np.array([codes(start)]), np.array([0]))[0]) == codes(a)  # the likeliest mode answers
+    p = mix.bit_probabilities(np.array([codes(start)]), np.array([0]))[0]  # the marginal: 0.3 on B's own bits
+    assert p[0, 3] == pytest.approx(0.3, abs=0.1) and p[0, 1] == pytest.approx(0.7, abs=0.1)
+    assert nets[2][1] < nets[1][1]  # the mixture fits the data better than independent bits
+    succ = {(act, nxt) for act, nxt, _ in outcome_successors(mix, codes(start), 4, 0.05)}
+    assert (0, codes(b)) in succ and (0, codes(a)) in succ
+    paper = {(act, nxt) for act, nxt, _ in outcome_successors(LearnedTransition(nets[1][0]), codes(start), 4, 0.05)}
+    assert (0, codes(a)) in paper and (0, codes(b)) not in paper  # 8 bits apart: no subset of 3 flips reaches B
+    save_transition(tmp_path / "t.pt", nets[2][0], {})
+    back, _ = load_transition(tmp_path / "t.pt")
+    assert back.cfg.modes == 2 and LearnedTransition(back).mode_outcomes(np.array([codes(start)]), np.array([0]))[0].tolist() \
+        == states.tolist()

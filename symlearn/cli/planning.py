@@ -44,17 +44,18 @@ def timeout_seconds(text: str) -> float:
 
 
 def cmd_train_transition(args: argparse.Namespace) -> int:
-    from symlearn.symbolic.transition_model import TransitionConfig
+    from symlearn.symbolic.transition_model import MAX_TRANSITION_BITS, TransitionConfig
     from symlearn.symbolic.transition_training import train_transition
 
     over = {k: v for k, v in (("epochs", args.epochs), ("copy_prior", args.copy_prior),
-                              ("attention_rounds", args.attention_rounds)) if v is not None}
-    if args.location_bits:
-        over["location_bits"] = args.location_bits
+                              ("attention_rounds", args.attention_rounds), ("modes", args.modes)) if v is not None}
+    if args.location_bits:  # train_transition sets the width from the effect model; this one only admits the bits
+        over.update(location_bits=args.location_bits, bits=MAX_TRANSITION_BITS)
     cfg = TransitionConfig.from_preset(args.preset, **over)
     set_threads(args.threads)
     located = f", {cfg.location_bits} location bits" if cfg.location_bits else ""
-    print(f"train-transition: preset {cfg.preset}, {cfg.attention_rounds} attention round(s){located}, "
+    modes = f", {cfg.modes} outcome modes" if cfg.modes > 1 else ""
+    print(f"train-transition: preset {cfg.preset}, {cfg.attention_rounds} attention round(s){located}{modes}, "
           f"{cfg.epochs} epochs, seed {args.seed}, run {args.run}, "
           f"data {args.data}" + "".join(f" + {d}" for d in args.extra_data), file=sys.stderr)
     m = train_transition(Path(args.run), Path(args.data), cfg, seed=args.seed, show_progress=not args.quiet,
@@ -188,6 +189,9 @@ def add_train_transition_command(sub) -> None:
     t.add_argument("--copy-prior", type=float, help="logit bias toward keeping each input bit (preset's if unset)")
     t.add_argument("--attention-rounds", type=positive_int,
                    help="self-attention rounds over the scene (the paper and the presets: 1)")
+    t.add_argument("--modes", type=positive_int,
+                   help="whole-scene outcomes of a mixture m(z), which astar-outcomes follows (the paper: 1; "
+                   "docs/DESIGN.md, 'Outcome modes')")
     t.add_argument("--location-bits", type=int, nargs="?", const=DEFAULT_LOCATION_BITS, choices=LOCATION_BITS,
                    metavar="N", help="codes end with N bits read from each crop's geometry: the nearest table "
                    "location, then whether (4), which way (5) or which way and how far (6) the object stands off "

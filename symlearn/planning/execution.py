@@ -108,7 +108,7 @@ class ObservedTransitions:
     """
 
     def __init__(self, inner: TransitionFn, seen: dict | None = None) -> None:
-        self.inner, self.bits = inner, inner.bits
+        self.inner, self.bits, self.modes = inner, inner.bits, int(getattr(inner, "modes", 1))
         # state -> {action: next}; pass another memory's `seen` to share it (one memory, two models)
         self.seen: dict[tuple[int, ...], dict[int, tuple[int, ...]]] = {} if seen is None else seen
 
@@ -139,6 +139,14 @@ class ObservedTransitions:
         for i, nxt in self._observed_rows(codes, actions):
             p[i] = bits_from_codes(np.asarray(nxt, np.int64), self.bits)
         return p
+
+    def mode_outcomes(self, codes: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The inner mixture's mode outcomes; an observed step has one outcome, the observed one, at -log P = 0."""
+        states, nll = self.inner.mode_outcomes(codes, actions)
+        states, nll = np.array(states, np.int64), np.array(nll, np.float64)
+        for i, nxt in self._observed_rows(codes, actions):
+            states[i], nll[i] = nxt, 0.0
+        return states, nll
 
     def _observed_rows(self, codes: np.ndarray, actions: np.ndarray) -> list[tuple[int, tuple[int, ...]]]:
         """(row, observed next state) for every row whose (state, action) execution has seen."""

@@ -6,7 +6,8 @@
 
 A* (search.learned_astar) and the PDDL export call it; `scored` adds how likely each prediction is
 (the most-likely-plan planner, `astar-likely`, charges it), and `bit_probabilities` gives every bit's
-probability, from which `astar-outcomes` draws the other likely outcomes of an action.
+probability, from which `astar-outcomes` draws the other likely outcomes of an action; a mixture m(z)
+(`modes` > 1) gives them whole through `mode_outcomes`.
 """
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ from symlearn.learning.models import AttentiveDeepSym
 from symlearn.sim.camera import CameraConfig
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, TransitionError, load_transition
 from symlearn.symbolic.transition_data import SymbolReader
-from symlearn.symbolic.transition_model import TransitionNet, predict_probabilities, predict_scored
+from symlearn.symbolic.transition_model import TransitionNet, predict_modes, predict_probabilities, predict_scored
 from symlearn.world import N_ACTIONS
 
 
@@ -30,6 +31,7 @@ class LearnedTransition:
     def __init__(self, net: TransitionNet, batch_size: int = 4096, location_camera: CameraConfig | None = None) -> None:
         self.net = net.eval()
         self.bits = int(net.cfg.bits)
+        self.modes = int(net.cfg.modes)
         self.batch_size = batch_size
         if (location_camera is None) != (net.cfg.location_bits == 0):
             raise TransitionError(f"a transition with {net.cfg.location_bits} location bits needs "
@@ -81,6 +83,15 @@ class LearnedTransition:
             return np.zeros((*codes.shape, self.bits))
         return predict_probabilities(self.net, bits_from_codes(codes, self.bits), np.ones(codes.shape, bool),
                                      actions.astype(np.int64), self.batch_size)
+
+    def mode_outcomes(self, codes: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(B, K) codes, (B,) actions -> each mode's likeliest next state (B, M, K) int64 and its -log P (B, M)."""
+        codes, actions = self._checked(codes, actions)
+        if codes.size == 0:
+            return np.zeros((codes.shape[0], self.modes, codes.shape[1]), np.int64), np.zeros((codes.shape[0], self.modes))
+        states, nll = predict_modes(self.net, bits_from_codes(codes, self.bits), np.ones(codes.shape, bool),
+                                    actions.astype(np.int64), self.batch_size)
+        return codes_from_bits(states), nll
 
     def _checked(self, codes: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Refuse codes and actions of the wrong shape, dtype or range."""

@@ -6,6 +6,12 @@ self-attention layer over the scene's objects (padding masked out) and two more 
 layers, giving per-object next-code logits; training minimizes binary cross-entropy per bit
 over the real objects (transition_training.py). attention_rounds > 1 adds further rounds of
 attention (docs/DESIGN.md); the presets keep the paper's one.
+
+modes > 1 makes m(z) a mixture: M whole-scene outcomes, each with its own next-code logits for every
+object and a weight read from the scene, trained on the mixture's likelihood. The paper's net (M = 1)
+scores bits independently, so an action whose outcome is one of two arrangements (a stick that tips or
+stays) gets bits mixed from both, and the second arrangement, which differs in many bits, is never
+among its likely states; a mode names it whole (docs/DESIGN.md, "Outcome modes").
 """
 from __future__ import annotations
 
@@ -19,10 +25,11 @@ import torch.nn as nn
 import torch.nn.functional as F
 
 from symlearn.symbolic.locations import LOCATION_BITS
+from symlearn.world import N_ACTIONS
 
 # An 8-bit learned code and 9 location bits make 17; the rule searches hold (objects, 2**bits) tables, 8 MB at 20.
 MAX_TRANSITION_BITS = 20
-from symlearn.world import N_ACTIONS
+MAX_MODES = 16
 
 
 @dataclass(frozen=True)
@@ -41,6 +48,7 @@ class TransitionConfig:
     copy_prior: float = 0.0  # added to each logit toward the input bit, so "no change" is the default
     attention_rounds: int = 1  # self-attention rounds over the scene; the paper has 1 (docs/DESIGN.md on more)
     location_bits: int = 0  # 0, or one of LOCATION_BITS: codes end with where each object stands (symbolic.locations)
+    modes: int = 1  # whole-scene outcomes of the mixture; 1: the paper's independent bits
 
     def __post_init__(self) -> None:
         if self.hidden % self.n_heads:
@@ -51,6 +59,8 @@ class TransitionConfig:
             raise ValueError("epochs, batch_size and encode_batch_size must be positive")
         if not self.lr > 0:
             raise ValueError(f"lr={self.lr} must be positive")
+        if not (isinstance(self.modes, int) and 1 <= self.modes <= MAX_MODES):
+            raise ValueError(f"modes={self.modes!r} must be an integer in 1..{MAX_MODES}")
         if not (isinstance(self.attention_rounds, int) and self.attention_rounds >= 1):
             raise ValueError(f"attention_rounds={self.attention_rounds!r} must be an integer >= 1")
         if self.location_bits not in (0, *LOCATION_BITS) or self.location_bits >= self.bits:
@@ -75,7 +85,7 @@ class TransitionConfig:
         unknown = set(d) - names
         if unknown:
             raise ValueError(f"unknown transition config fields {sorted(unknown)}")
-        return TransitionConfig(**d)  # a file from before copy_prior (attention_rounds, location_bits) gets its default
+        return TransitionConfig(**d)  # a file from before copy_prior (attention_rounds, location_bits, modes): default
 
 
 TRANSITION_PRESETS = {
@@ -88,8 +98,10 @@ TRANSITION_PRESETS = {
 
 
 class TransitionOutput(NamedTuple):
-    logits: torch.Tensor  # (B, K, bits) next-code logits, zero for padded slots
+    logits: torch.Tensor  # (B, K, bits) next-code logits (of the likeliest mode), zero for padded slots
     codes: torch.Tensor  # (B, K, bits) thresholded next codes in {0, 1}, zero for padded slots
+    mode_weights: torch.Tensor | None = None  # (B, M) log mixture weights; None for one mode
+    mode_logits: torch.Tensor | None = None  # (B, M, K, bits) each mode's next-code logits; None for one mode
 
 
 class TransitionNet(nn.Module):
@@ -107,7 +119,9 @@ class TransitionNet(nn.Module):
         self.pre = nn.Sequential(nn.Linear(cfg.bits + N_ACTIONS, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU())
         self.attn = nn.MultiheadAttention(h, cfg.n_heads, batch_first=True)
         self.rounds = nn.ModuleList(_AttentionRound(h, cfg.n_heads) for _ in range(cfg.attention_rounds - 1))
-        self.post = nn.Sequential(nn.Linear(h, h), nn.ReLU(), nn.Linear(h, cfg.bits))
+        self.post = nn.Sequential(nn.Linear(h, h), nn.ReLU(), nn.Linear(h, cfg.bits * cfg.modes))
+        if cfg.modes > 1:  # the weights, from the scene's mean feature
+            self.weight_head = nn.Sequential(nn.Linear(h, h), nn.ReLU(), nn.Linear(h, cfg.modes))
 
     def forward(self, codes: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor) -> TransitionOutput:
         """Codes (B, K, bits) in {0, 1}, mask (B, K) bool, action ids (B,) -> next-code logits."""
@@ -127,11 +141,20 @@ class TransitionNet(nn.Module):
         h = h + att  # residual: an object keeps its own code's features beside the scene context
         for r in self.rounds:
             h = r(h, pad)
-        logits = self.post(h)
+        m = self.cfg.modes
+        logits = self.post(h).view(b, k, m, self.cfg.bits).transpose(1, 2)  # (B, M, K, bits)
         if self.cfg.copy_prior:  # most (object, action) pairs leave the code as it is
-            logits = logits + self.cfg.copy_prior * (2 * codes - 1)
-        logits = logits * mask[..., None]  # (B, K, bits)
-        return TransitionOutput(logits, (logits > 0).to(codes.dtype) * mask[..., None])
+            logits = logits + self.cfg.copy_prior * (2 * codes[:, None] - 1)
+        logits = logits * mask[:, None, :, None]
+        if m == 1:
+            return TransitionOutput(logits[:, 0], (logits[:, 0] > 0).to(codes.dtype) * mask[..., None])
+        real = mask[..., None].to(h.dtype)
+        pooled = (h * real).sum(1) / real.sum(1).clamp_min(1.0)  # (B, H)
+        weights = F.log_softmax(self.weight_head(pooled), dim=-1)  # (B, M)
+        # each mode's likeliest state, scored by its own weight and bits; the best one answers as the net's
+        score = weights - F.softplus(-logits.abs()).sum((2, 3))
+        best = logits[torch.arange(b), score.argmax(1)]  # (B, K, bits)
+        return TransitionOutput(best, (best > 0).to(codes.dtype) * mask[..., None], weights, logits)
 
 
 class _AttentionRound(nn.Module):
@@ -155,6 +178,21 @@ def masked_bce(logits: torch.Tensor, target: torch.Tensor, mask: torch.Tensor) -
     return (per_bit * m).sum() / (m.sum() * logits.shape[-1]).clamp_min(1.0)
 
 
+def mode_log_likelihoods(out: TransitionOutput, target: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+    """(B, M) log P(target, mode m) = log weight + each real bit's log-likelihood under mode m."""
+    t = target[:, None].expand_as(out.mode_logits)
+    per_bit = F.binary_cross_entropy_with_logits(out.mode_logits, t, reduction="none")  # (B, M, K, bits)
+    return out.mode_weights - (per_bit * mask[:, None, :, None].to(per_bit.dtype)).sum((2, 3))
+
+
+def transition_loss(out: TransitionOutput, target: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+    """The loss m(z) is trained on: masked BCE, or with modes the mixture's negative log-likelihood, per real bit."""
+    if out.mode_logits is None:
+        return masked_bce(out.logits, target, mask)
+    nll = -torch.logsumexp(mode_log_likelihoods(out, target, mask), dim=1)  # (B,)
+    return nll.sum() / (mask.sum() * target.shape[-1]).clamp_min(1)
+
+
 @torch.no_grad()
 def predict_bits(net: TransitionNet, before: np.ndarray, mask: np.ndarray, action: np.ndarray,
                  batch_size: int = 4096) -> np.ndarray:
@@ -176,13 +214,17 @@ def predict_scored(net: TransitionNet, before: np.ndarray, mask: np.ndarray, act
                    batch_size: int = 4096) -> tuple[np.ndarray, np.ndarray]:
     """Thresholded next codes (N, K, bits) and each row's -log P(those codes), (N,) float64.
 
-    The bits are independent Bernoullis given the input, so the thresholded codes are the most
-    likely next state and -log P sums softplus(-|logit|) over the real objects' bits.
+    With one mode the bits are independent Bernoullis given the input, so the thresholded codes are the
+    most likely next state and -log P sums softplus(-|logit|) over the real objects' bits. With modes
+    they are the likeliest mode's likeliest state, scored under the whole mixture.
     """
     codes, nll = [], []
     for m, o in _batched_outputs(net, before, mask, action, batch_size):
         codes.append(o.codes.numpy())
-        nll.append((F.softplus(-o.logits.abs()) * m[..., None]).sum((1, 2)).double().numpy())
+        if o.mode_logits is None:
+            nll.append((F.softplus(-o.logits.abs()) * m[..., None]).sum((1, 2)).double().numpy())
+        else:
+            nll.append((-torch.logsumexp(mode_log_likelihoods(o, o.codes, m), 1)).double().numpy())
     if not codes:
         return np.zeros_like(before, np.float32), np.zeros(before.shape[0])
     return np.concatenate(codes), np.concatenate(nll)
@@ -191,7 +233,41 @@ def predict_scored(net: TransitionNet, before: np.ndarray, mask: np.ndarray, act
 @torch.no_grad()
 def predict_probabilities(net: TransitionNet, before: np.ndarray, mask: np.ndarray, action: np.ndarray,
                           batch_size: int = 4096) -> np.ndarray:
-    """(N, K, bits) float64 P(each next bit is 1), 0 in padded slots: every outcome's probability, not just the likeliest."""
-    out = [(torch.sigmoid(o.logits.double()) * m[..., None]).numpy()
-           for m, o in _batched_outputs(net, before, mask, action, batch_size)]
+    """(N, K, bits) float64 P(each next bit is 1), 0 in padded slots: every outcome's probability, not just the likeliest.
+
+    With modes, the mixture's marginal of each bit.
+    """
+    out = []
+    for m, o in _batched_outputs(net, before, mask, action, batch_size):
+        if o.mode_logits is None:
+            p = torch.sigmoid(o.logits.double())
+        else:
+            p = (o.mode_weights.double().exp()[..., None, None] * torch.sigmoid(o.mode_logits.double())).sum(1)
+        out.append((p * m[..., None]).numpy())
     return np.concatenate(out) if out else np.zeros(before.shape, np.float64)
+
+
+@torch.no_grad()
+def predict_modes(net: TransitionNet, before: np.ndarray, mask: np.ndarray, action: np.ndarray,
+                  batch_size: int = 4096) -> tuple[np.ndarray, np.ndarray]:
+    """Each mode's likeliest next state, (N, M, K, bits) float32 0/1, and its -log P under the mixture, (N, M).
+
+    One mode: the thresholded codes and their -log P, as predict_scored.
+    """
+    states, nll = [], []
+    for m, o in _batched_outputs(net, before, mask, action, batch_size):
+        if o.mode_logits is None:
+            states.append(o.codes[:, None].numpy())
+            nll.append((F.softplus(-o.logits.abs()) * m[..., None]).sum((1, 2))[:, None].double().numpy())
+            continue
+        mode_codes = (o.mode_logits > 0).to(o.codes.dtype) * m[:, None, :, None]  # (B, M, K, bits)
+        b, n_modes = o.mode_weights.shape
+        flat = mode_codes.reshape(b * n_modes, *mode_codes.shape[2:])
+        rep = TransitionOutput(o.logits, o.codes, o.mode_weights.repeat_interleave(n_modes, 0),
+                               o.mode_logits.repeat_interleave(n_modes, 0))  # row i * M + j: state j under row i
+        ll = mode_log_likelihoods(rep, flat, m.repeat_interleave(n_modes, 0))  # (B * M, M)
+        states.append(mode_codes.numpy())
+        nll.append((-torch.logsumexp(ll, 1)).view(b, n_modes).double().numpy())
+    if not states:
+        return np.zeros((0, net.cfg.modes, *before.shape[1:]), np.float32), np.zeros((0, net.cfg.modes))
+    return np.concatenate(states), np.concatenate(nll)

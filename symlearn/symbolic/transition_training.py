@@ -28,7 +28,7 @@ from symlearn.sim.camera import CameraConfig
 from symlearn.symbolic.transition_data import (SymbolReader, TransitionData, build_transition_data,
                                                concat_transition_data)
 from symlearn.symbolic.transition_metrics import evaluate_transition
-from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet, masked_bce
+from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet, transition_loss
 
 METRICS_FILE = "transition_metrics.json"
 
@@ -100,7 +100,7 @@ EpochFn = Callable[[TransitionNet, torch.optim.Optimizer, torch.Generator, int],
 def fit_transition(cfg: TransitionConfig, tr: TransitionData, va: TransitionData, seed: int,
                    show_progress: bool = False,
                    train_epoch: EpochFn | None = None) -> tuple[TransitionNet, float, list[dict]]:
-    """Adam on masked BCE for cfg.epochs; returns the net with its best-validation weights, that loss and the history.
+    """Adam on masked BCE (with modes, the mixture's likelihood) for cfg.epochs; returns the net with its best-validation weights, that loss and the history.
 
     train_epoch replaces the epoch over (before, action, after) pairs (for instance one over multi-step chains);
     validation and keeping the best weights stay the same.
@@ -118,7 +118,7 @@ def fit_transition(cfg: TransitionConfig, tr: TransitionData, va: TransitionData
                       else _train_epoch(net, opt, gen, train_t, cfg, epoch))
         net.eval()
         with torch.no_grad():
-            val_loss = float(masked_bce(net(x_va, m_va, a_va).logits, y_va, m_va))
+            val_loss = float(transition_loss(net(x_va, m_va, a_va), y_va, m_va))
         history.append({"epoch": epoch + 1, "train_loss": round(train_loss, 5), "val_loss": round(val_loss, 5)})
         if val_loss < best:
             best = val_loss
@@ -147,7 +147,7 @@ def _train_epoch(net: TransitionNet, opt: torch.optim.Optimizer, gen: torch.Gene
     for b in range(n_batches):
         idx = perm[b * cfg.batch_size:(b + 1) * cfg.batch_size]
         out = net(x_tr[idx], m_tr[idx], a_tr[idx])
-        loss = masked_bce(out.logits, y_tr[idx], m_tr[idx])
+        loss = transition_loss(out, y_tr[idx], m_tr[idx])
         if not torch.isfinite(loss):
             raise RuntimeError(f"transition loss became {loss.item()} at epoch {epoch + 1}; lower the learning rate")
         opt.zero_grad(set_to_none=True)
