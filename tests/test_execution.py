@@ -491,6 +491,9 @@ def test_cli_parses_planning_commands():
     for bad in ("3", "8", "10"):
         with pytest.raises(SystemExit):
             p.parse_args([*base, "--location-bits", bad])
+    assert p.parse_args(base).modes is None and p.parse_args([*base, "--modes", "4"]).modes == 4
+    with pytest.raises(SystemExit):
+        p.parse_args([*base, "--modes", "0"])
 
 
 def test_cli_problems_command(tmp_path):

@@ -482,3 +482,31 @@ def test_a_mixture_names_both_outcomes_whole_where_independent_bits_cannot(tmp_p
     back, _ = load_transition(tmp_path / "t.pt")
     assert back.cfg.modes == 2 and LearnedTransition(back).mode_outcomes(np.array([codes(start)]), np.array([0]))[0].tolist() \
         == states.tolist()
+
+
+def test_train_transition_with_modes_plans_on_the_mixture(tiny_run, tiny_run_copy):
+    """--modes 3 through the CLI: the config and checkpoint hold 3 modes, and astar-outcomes branches on them."""
+    from search.learned_astar import mode_successors
+    from symlearn.planning.execution import ObservedTransitions
+
+    out = cli_json("train-transition", "--run", tiny_run_copy, "--data", tiny_run.data, *TINY_TRANSITION_ARGS,
+                   "--modes", 3, "--quiet")
+    assert 0 <= out["rollout_scene_accuracy"]["1"] <= 1
+    assert json.loads((tiny_run_copy / METRICS_FILE).read_text())["transition_config"]["modes"] == 3
+    m = LearnedTransition.from_run(tiny_run_copy)
+    assert m.modes == 3 and m.net.weight_head[-1].out_features == 3
+    start = np.array([5, 77], np.int64)
+    states, nll = m.mode_outcomes(start[None].repeat(36, 0), np.arange(36))
+    assert states.shape == (36, 3, 2) and nll.shape == (36, 3) and (nll > 0).all()
+    # every mode state is scored under the whole mixture, so no state is likelier than probability 1
+    assert np.all(nll.min(1) >= 0) and np.allclose(m.scored(start[None].repeat(36, 0), np.arange(36))[1], nll.min(1))
+    succ = mode_successors(m, tuple(start), 4, 0.05)
+    assert succ and all(nxt != tuple(start) for _, nxt, _ in succ)
+    # closed loop: an observed step has one outcome, the observed one, for certain
+    memory = ObservedTransitions(m)
+    memory.record(start, 7, (1, 2))
+    st, ll = memory.mode_outcomes(start[None].repeat(36, 0), np.arange(36))
+    assert (st[7] == [1, 2]).all() and (ll[7] == 0).all() and np.array_equal(st[8], states[8])
+    _, target, _ = max(succ, key=lambda x: x[2])  # the least likely mode outcome the search may take
+    res = plan_symbolic(m, start, SymbolicGoal(target), timeout_s=5, risk_weight=1.0, max_outcomes=4)
+    assert res.found and len(res.plan) == 1 and res.predicted_states[-1] == target
