@@ -249,7 +249,8 @@ def test_up_planner_timeout_is_a_timeout_within_the_limit(planner, rules, tmp_pa
     elapsed = time.perf_counter() - t0
     assert res.status is PlanStatus.TIMEOUT, res.message
     assert elapsed < timeout + 1.5, elapsed
-    assert res.extra["total_time_s"] == pytest.approx(elapsed, abs=0.1)
+    # the call's own clock covers it, up to the process start and reaping around it (longer on a loaded machine)
+    assert elapsed - 0.5 < res.extra["total_time_s"] <= elapsed
     assert set(_children_of(os.getpid())) - before == set()
     assert _procs_mentioning(str(tmp_path)) == []
     assert list(tmp_path.iterdir()) == []
