@@ -195,8 +195,8 @@ def add_train_transition_command(sub) -> None:
     t.add_argument("--location-bits", type=int, nargs="?", const=DEFAULT_LOCATION_BITS, choices=LOCATION_BITS,
                    metavar="N", help="codes end with N bits read from each crop's geometry: the nearest table "
                    "location, then whether (4), which way (5) or which way and how far (6) the object stands off "
-                   "it; 7 (without N): whether, then its height in 5 cm layers; 9: which way and how far, then the height "
-                   "(docs/DESIGN.md, 'Location bits')")
+                   "it; 7 (without N): whether, then its height in 5 cm layers; 9: which way and how far, then "
+                   "the height (docs/DESIGN.md, 'Location bits')")
     t.add_argument("--seed", type=int, default=0)
     t.add_argument("--threads", type=positive_int, help=THREADS_HELP)
     t.add_argument("--quiet", action="store_true")

@@ -88,7 +88,8 @@ class LearnedTransition:
         """(B, K) codes, (B,) actions -> each mode's likeliest next state (B, M, K) int64 and its -log P (B, M)."""
         codes, actions = self._checked(codes, actions)
         if codes.size == 0:
-            return np.zeros((codes.shape[0], self.modes, codes.shape[1]), np.int64), np.zeros((codes.shape[0], self.modes))
+            n, k = codes.shape
+            return np.zeros((n, self.modes, k), np.int64), np.zeros((n, self.modes))
         states, nll = predict_modes(self.net, bits_from_codes(codes, self.bits), np.ones(codes.shape, bool),
                                     actions.astype(np.int64), self.batch_size)
         return codes_from_bits(states), nll
