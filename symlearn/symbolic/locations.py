@@ -58,15 +58,14 @@ def location_bits(xy: np.ndarray, n_bits: int, top: np.ndarray | None = None) ->
     offset = np.take_along_axis(delta, nearest[..., None, None], -2)[..., 0, :]  # (..., 2) from that location
     off = dist.min(-1) > OFF_LOCATION_M
     in_x = np.abs(offset[..., 0]) > np.abs(offset[..., 1])
-    if n_bits == 4:
+    if n_bits in (4, 7):  # the off flag
         field, width = off.astype(np.int64), 1
     elif n_bits == 5:
         way = np.where(in_x, 3, np.where(offset[..., 1] < 0, 1, 2))
         field, width = np.where(off, way, 0), 2
-    else:
+    else:  # 6 and 9: the place
         band = 1 + np.searchsorted(np.asarray(OFF_DISTANCE_EDGES_M), np.abs(offset[..., 1]), side="right")
-        place = np.where(off, np.where(in_x, 7, np.where(offset[..., 1] < 0, band, 3 + band)), 0)
-        field, width = (off.astype(np.int64), 1) if n_bits == 7 else (place, 3)  # 7: the flag; 6 and 9: the place
+        field, width = np.where(off, np.where(in_x, 7, np.where(offset[..., 1] < 0, band, 3 + band)), 0), 3
     if n_bits in HEIGHTED_BITS:  # then the top's layer above the table (an unseen object's is all ones, as its field)
         layers = np.rint((np.asarray(top, np.float64) - TABLE_TOP_Z) / HEIGHT_STEP_M)
         height = np.clip(np.where(np.isfinite(layers), layers, 7), 0, 7).astype(np.int64)

@@ -104,7 +104,8 @@ class SymbolReader:
         loc = np.zeros((*codes.shape[:2], self.location_bits), np.float32)
         for i in range(0, depth.shape[0], batch_size):  # chunks: the back-projection holds (B, K, S, S) floats
             d, o = depth[i:i + batch_size], origin[i:i + batch_size]
-            top = crop_tops_z(d, o, self.camera) if self.location_bits in HEIGHTED_BITS else None  # only these read heights
+            heighted = self.location_bits in HEIGHTED_BITS  # only these read heights
+            top = crop_tops_z(d, o, self.camera) if heighted else None
             loc[i:i + batch_size] = location_bits(crop_centres_xy(d, o, self.camera), self.location_bits, top)
         return np.concatenate([codes, np.where(np.asarray(mask, bool)[..., None], loc, 0.0)], -1).astype(np.float32)
 

@@ -209,6 +209,13 @@ def _batched_outputs(net: TransitionNet, before: np.ndarray, mask: np.ndarray, a
                      torch.from_numpy(np.asarray(action[i:i + batch_size], np.int64)))
 
 
+def _likeliest_nll(o: TransitionOutput, mask: torch.Tensor) -> torch.Tensor:
+    """(B,) -log P(o.codes): one mode sums softplus(-|logit|) over the real bits; a mixture sums over its modes."""
+    if o.mode_logits is None:
+        return (F.softplus(-o.logits.abs()) * mask[..., None]).sum((1, 2))
+    return -torch.logsumexp(mode_log_likelihoods(o, o.codes, mask), 1)
+
+
 @torch.no_grad()
 def predict_scored(net: TransitionNet, before: np.ndarray, mask: np.ndarray, action: np.ndarray,
                    batch_size: int = 4096) -> tuple[np.ndarray, np.ndarray]:
@@ -221,10 +228,7 @@ def predict_scored(net: TransitionNet, before: np.ndarray, mask: np.ndarray, act
     codes, nll = [], []
     for m, o in _batched_outputs(net, before, mask, action, batch_size):
         codes.append(o.codes.numpy())
-        if o.mode_logits is None:
-            nll.append((F.softplus(-o.logits.abs()) * m[..., None]).sum((1, 2)).double().numpy())
-        else:
-            nll.append((-torch.logsumexp(mode_log_likelihoods(o, o.codes, m), 1)).double().numpy())
+        nll.append(_likeliest_nll(o, m).double().numpy())
     if not codes:
         return np.zeros_like(before, np.float32), np.zeros(before.shape[0])
     return np.concatenate(codes), np.concatenate(nll)
@@ -258,7 +262,7 @@ def predict_modes(net: TransitionNet, before: np.ndarray, mask: np.ndarray, acti
     for m, o in _batched_outputs(net, before, mask, action, batch_size):
         if o.mode_logits is None:
             states.append(o.codes[:, None].numpy())
-            nll.append((F.softplus(-o.logits.abs()) * m[..., None]).sum((1, 2))[:, None].double().numpy())
+            nll.append(_likeliest_nll(o, m)[:, None].double().numpy())
             continue
         mode_codes = (o.mode_logits > 0).to(o.codes.dtype) * m[:, None, :, None]  # (B, M, K, bits)
         b, n_modes = o.mode_weights.shape

@@ -100,7 +100,8 @@ EpochFn = Callable[[TransitionNet, torch.optim.Optimizer, torch.Generator, int],
 def fit_transition(cfg: TransitionConfig, tr: TransitionData, va: TransitionData, seed: int,
                    show_progress: bool = False,
                    train_epoch: EpochFn | None = None) -> tuple[TransitionNet, float, list[dict]]:
-    """Adam on masked BCE (with modes, the mixture's likelihood) for cfg.epochs; returns the net with its best-validation weights, that loss and the history.
+    """Adam on masked BCE (with modes, the mixture's likelihood) for cfg.epochs; returns the net with its
+    best-validation weights, that loss and the history.
 
     train_epoch replaces the epoch over (before, action, after) pairs (for instance one over multi-step chains);
     validation and keeping the best weights stay the same.
