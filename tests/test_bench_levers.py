@@ -139,7 +139,7 @@ def test_transition_volume_counts_rollouts_per_object_count():
     from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet
 
     tv = _load("transition_volume")
-    cfg = TransitionConfig.from_preset("quick", bits=8, copy_prior=3.0)
+    cfg = TransitionConfig.from_preset("quick", code_bits=8, copy_prior=3.0)
     net = TransitionNet(cfg).eval()
     torch.nn.init.zeros_(net.post[-1].weight)
     torch.nn.init.zeros_(net.post[-1].bias)

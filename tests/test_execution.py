@@ -71,7 +71,7 @@ def run_dir(tmp_path_factory, encoder):
     """A run directory holding an (untrained) effect model and a transition model tied to it."""
     d = tmp_path_factory.mktemp("exec_run")
     save_checkpoint(d / "best.pt", model=encoder)
-    net = _seeded(lambda: TransitionNet(TransitionConfig.from_preset("quick", bits=encoder.cfg.bits)), 1)
+    net = _seeded(lambda: TransitionNet(TransitionConfig.from_preset("quick", code_bits=encoder.cfg.bits)), 1)
     save_transition(d / TRANSITION_FILE, net, {"effect_model_sha256": sha256_file(d / "best.pt")[:16]})
     return d
 

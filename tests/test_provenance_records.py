@@ -75,7 +75,7 @@ def test_transition_metrics_record_config_seed_versions_and_hashes(run):
     train_transition(run / "run", run / "data", cfg, seed=11)
     saved = json.loads((run / "run" / METRICS_FILE).read_text())
     assert saved["seed"] == 11
-    assert TransitionConfig.from_json(saved["transition_config"]) == TransitionConfig.from_preset("quick", epochs=1, bits=8)
+    assert TransitionConfig.from_json(saved["transition_config"]) == TransitionConfig.from_preset("quick", epochs=1, code_bits=8)
     assert saved["versions"] == json.loads(json.dumps(versions()))
     assert saved["effect_model_sha256"] == _file_hash(run / "run" / "best.pt")
     assert saved["data_fingerprint"] == _data_hash(run / "data")

@@ -20,7 +20,7 @@ from symlearn.symbolic.transition_data import (TransitionData, build_transition_
 from symlearn.symbolic.transition_metrics import ROLLOUT_STEPS, rollout_chains
 from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet, masked_bce
 from symlearn.symbolic.transition_training import METRICS_FILE
-from symlearn.world import ObjectType
+from symlearn.world import N_ACTIONS, ObjectType
 
 BITS = 8
 
@@ -28,7 +28,7 @@ BITS = 8
 def _net(seed: int = 0, **over) -> TransitionNet:
     with torch.random.fork_rng(devices=[]):
         torch.manual_seed(seed)
-        return TransitionNet(TransitionConfig.from_preset("quick", bits=BITS, **over)).eval()
+        return TransitionNet(TransitionConfig.from_preset("quick", code_bits=BITS, **over)).eval()
 
 
 @pytest.fixture(scope="module")
@@ -89,6 +89,22 @@ def test_config_validation_and_presets():
     # the default config names its preset (a method of the same name once shadowed the field)
     assert TransitionConfig().preset == "paper" == TransitionConfig.from_preset("paper").preset
     assert TrainConfig().preset == "paper" and json.dumps(TrainConfig().to_json())
+
+
+def test_code_width_is_the_learned_code_plus_the_location_bits_and_old_files_read_back():
+    cfg = TransitionConfig.from_preset("quick", location_bits=9)  # valid before any effect model is known
+    assert (cfg.code_bits, cfg.location_bits, cfg.bits) == (8, 9, 17)
+    assert TransitionNet(cfg).pre[0].in_features == 17 + N_ACTIONS
+    saved = cfg.to_json()
+    assert saved["bits"] == 17 and TransitionConfig.from_json(saved) == cfg
+    old = {k: v for k, v in saved.items() if k != "code_bits"}  # a file from when the config held the total only
+    assert TransitionConfig.from_json(old) == cfg
+    with pytest.raises(ValueError, match="not code_bits 8 \\+ location_bits 9"):
+        TransitionConfig.from_json({**saved, "bits": 16})
+    with pytest.raises(ValueError, match="more than 20"):
+        TransitionConfig(code_bits=16, location_bits=9)
+    with pytest.raises(ValueError, match="code_bits"):
+        TransitionConfig(code_bits=0)
 
 
 def test_copy_prior_makes_no_change_the_default():
@@ -344,7 +360,7 @@ def test_fit_transition_keeps_the_best_epoch_of_a_custom_training_epoch():
     rng = np.random.default_rng(0)
     z = rng.integers(0, 2, (24, 2, BITS)).astype(np.float32)
     data = TransitionData(z, rng.integers(0, 36, 24), z.copy(), np.ones((24, 2), bool), np.arange(24), np.zeros(24, np.int64))
-    cfg = TransitionConfig.from_preset("quick", bits=BITS, epochs=4)
+    cfg = TransitionConfig.from_preset("quick", code_bits=BITS, epochs=4)
     calls = []
 
     def jolt(net, opt, gen, epoch):  # random steps: the validation loss goes up and down
@@ -463,7 +479,7 @@ def test_a_mixture_names_both_outcomes_whole_where_independent_bits_cannot(tmp_p
 
     data, start, a, b = _two_outcome_data()
     codes = lambda x: tuple(int(c) for c in (x * (1 << np.arange(BITS - 1, -1, -1))).sum(-1))  # noqa: E731
-    nets = {m: fit_transition(TransitionConfig.from_preset("quick", bits=BITS, epochs=60, modes=m), data, data, seed=0)
+    nets = {m: fit_transition(TransitionConfig.from_preset("quick", code_bits=BITS, epochs=60, modes=m), data, data, seed=0)
             for m in (1, 2)}
     mix = LearnedTransition(nets[2][0])
     states, nll = mix.mode_outcomes(np.array([codes(start)]), np.array([0]))

@@ -44,13 +44,12 @@ def timeout_seconds(text: str) -> float:
 
 
 def cmd_train_transition(args: argparse.Namespace) -> int:
-    from symlearn.symbolic.transition_model import MAX_TRANSITION_BITS, TransitionConfig
+    from symlearn.symbolic.transition_model import TransitionConfig
     from symlearn.symbolic.transition_training import train_transition
 
     over = {k: v for k, v in (("epochs", args.epochs), ("copy_prior", args.copy_prior),
-                              ("attention_rounds", args.attention_rounds), ("modes", args.modes)) if v is not None}
-    if args.location_bits:  # train_transition sets the width from the effect model; this one only admits the bits
-        over.update(location_bits=args.location_bits, bits=MAX_TRANSITION_BITS)
+                              ("attention_rounds", args.attention_rounds), ("modes", args.modes),
+                              ("location_bits", args.location_bits)) if v is not None}
     cfg = TransitionConfig.from_preset(args.preset, **over)
     set_threads(args.threads)
     located = f", {cfg.location_bits} location bits" if cfg.location_bits else ""

@@ -29,6 +29,7 @@ from symlearn.world import N_ACTIONS
 
 # An 8-bit learned code and 9 location bits make 17; the rule searches hold (objects, 2**bits) tables, 8 MB at 20.
 MAX_TRANSITION_BITS = 20
+MAX_CODE_BITS = 16  # the effect model's limit (learning.models.ModelConfig)
 MAX_MODES = 16
 
 
@@ -37,7 +38,7 @@ class TransitionConfig:
     """Architecture and training of m(z); `paper` follows the paper's layer counts, `quick` is small."""
 
     preset: str = "paper"
-    bits: int = 8  # code length: the effect model's, plus location_bits
+    code_bits: int = 8  # the effect model's code length; train_transition takes it from the effect model
     hidden: int = 128  # width of every dense layer and of the attention
     n_heads: int = 4  # attention heads (hidden must be divisible by it)
     epochs: int = 200  # the network is tiny: 200 epochs of 10,000 samples take about a minute on CPU
@@ -53,8 +54,8 @@ class TransitionConfig:
     def __post_init__(self) -> None:
         if self.hidden % self.n_heads:
             raise ValueError(f"hidden {self.hidden} is not divisible by n_heads {self.n_heads}")
-        if not 1 <= self.bits <= MAX_TRANSITION_BITS:
-            raise ValueError(f"bits={self.bits} must lie in 1..{MAX_TRANSITION_BITS}")
+        if not (isinstance(self.code_bits, int) and 1 <= self.code_bits <= MAX_CODE_BITS):
+            raise ValueError(f"code_bits={self.code_bits!r} must be an integer in 1..{MAX_CODE_BITS}")
         if self.epochs < 1 or self.batch_size < 1 or self.encode_batch_size < 1:
             raise ValueError("epochs, batch_size and encode_batch_size must be positive")
         if not self.lr > 0:
@@ -63,9 +64,16 @@ class TransitionConfig:
             raise ValueError(f"modes={self.modes!r} must be an integer in 1..{MAX_MODES}")
         if not (isinstance(self.attention_rounds, int) and self.attention_rounds >= 1):
             raise ValueError(f"attention_rounds={self.attention_rounds!r} must be an integer >= 1")
-        if self.location_bits not in (0, *LOCATION_BITS) or self.location_bits >= self.bits:
-            raise ValueError(f"location_bits={self.location_bits!r} must be 0 or one of {LOCATION_BITS}, "
-                             f"and fewer than bits={self.bits}")
+        if self.location_bits not in (0, *LOCATION_BITS):
+            raise ValueError(f"location_bits={self.location_bits!r} must be 0 or one of {LOCATION_BITS}")
+        if self.bits > MAX_TRANSITION_BITS:
+            raise ValueError(f"code_bits {self.code_bits} + location_bits {self.location_bits} make {self.bits} "
+                             f"bits, more than {MAX_TRANSITION_BITS}")
+
+    @property
+    def bits(self) -> int:
+        """The width of m(z)'s codes: the learned code, then the location bits."""
+        return self.code_bits + self.location_bits
 
     @staticmethod
     def from_preset(name: str, **overrides) -> "TransitionConfig":
@@ -75,17 +83,27 @@ class TransitionConfig:
         return dataclasses.replace(TRANSITION_PRESETS[name], **overrides)
 
     def to_json(self) -> dict:
-        """The config as plain JSON, as stored in the checkpoint and the metrics."""
-        return dataclasses.asdict(self)
+        """The config as plain JSON, as stored in the checkpoint and the metrics, with the total width `bits`."""
+        return {**dataclasses.asdict(self), "bits": self.bits}
 
     @staticmethod
     def from_json(d: dict) -> "TransitionConfig":
-        """The config back from to_json's form; unknown fields are refused."""
+        """The config back from to_json's form; unknown fields and a `bits` that is not the sum are refused.
+
+        A file from before code_bits holds only the total `bits`; its code_bits is that less the location bits.
+        """
+        d = dict(d)
         names = {f.name for f in dataclasses.fields(TransitionConfig)}
-        unknown = set(d) - names
+        unknown = set(d) - names - {"bits"}
         if unknown:
             raise ValueError(f"unknown transition config fields {sorted(unknown)}")
-        return TransitionConfig(**d)  # a file from before copy_prior (attention_rounds, location_bits, modes): default
+        total = d.pop("bits", None)
+        if "code_bits" not in d and total is not None:
+            d["code_bits"] = int(total) - int(d.get("location_bits", 0))
+        cfg = TransitionConfig(**d)  # a file from before copy_prior (attention_rounds, location_bits, modes): default
+        if total is not None and total != cfg.bits:
+            raise ValueError(f"bits={total!r} is not code_bits {cfg.code_bits} + location_bits {cfg.location_bits}")
+        return cfg
 
 
 TRANSITION_PRESETS = {

@@ -44,7 +44,7 @@ def train_transition(run_dir: Path, data_dir: Path, cfg: TransitionConfig, seed:
     extra_data = distinct_extra_data(data_dir, extra_data)
     t_start = time.perf_counter()
     encoder, ck = load_effect_model(run_dir, device=analysis_device())
-    cfg = dataclasses.replace(cfg, bits=ck.config.bits + cfg.location_bits)
+    cfg = dataclasses.replace(cfg, code_bits=ck.config.bits)  # the codes m(z) learns are this effect model's
     fingerprint = data_fingerprint(data_dir)
     extra_fp = data_records(extra_data)
     camera = data_camera(data_dir, extra_data) if cfg.location_bits else None
