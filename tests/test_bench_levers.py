@@ -162,3 +162,30 @@ def test_transition_volume_counts_rollouts_per_object_count():
     assert one["all"] == {"n": 6, "scene_accuracy": round(5 / 6, 4)}
     assert two["2"]["scene_accuracy"] == 1.0 and two["4"] == {"n": 2, "scene_accuracy": 0.0}
     assert three["all"] == {"n": 2, "scene_accuracy": 0.5}
+
+
+def test_aliasing_misses_bins_each_aliased_goal_and_names_where_its_objects_stand(tmp_path):
+    am = _load("aliasing_misses")
+    def row(p, loop, ok, cause=None, miss=0.0):
+        return {"problem": p, "planner": "astar", "closed_loop": loop, "success": ok, "failure_cause": cause,
+                "max_distance_m": miss, "n_objects": 2, "goal_off_locations": 1}
+
+    def problem(stick_xy):
+        objects = [{"type": "cube", "position": [0.5, 0.3, 0.45]}, {"type": "stick", "position": [*stick_xy, 0.425]}]
+        return {"goal": {"objects": objects}}
+
+    (tmp_path / "walks").mkdir()
+    (tmp_path / "walks" / "a.json").write_text(json.dumps(problem([0.5, -0.12])))  # 12 cm off location 4 toward -y
+    (tmp_path / "walks" / "b.json").write_text(json.dumps(problem([0.8, 0.2])))  # 2 cm off location 2: on it
+    bench = {"planners": ["astar"], "rows": [
+        row("walks/a", True, False, "symbol_aliasing", 0.021), row("walks/a", False, False, "symbol_aliasing", 0.021),
+        row("walks/b", True, False, "symbol_aliasing", 0.044), row("walks/c", True, False, "departure", 0.3),
+        row("walks/d", True, True)]}
+    out = am.summarize(bench, tmp_path)["astar"]
+    assert (out["n_problems"], out["n_failures"], out["n_aliasing"]) == (4, 3, 2)  # the open-loop row is not counted
+    assert out["aliasing_share"] == pytest.approx(2 / 3, abs=1e-4)
+    assert out["misses_by_bin"] == {"up to 2.5 cm": 1, "2.5-5 cm": 1, "over 5 cm": 0}
+    a, b = out["rows"]
+    assert [g["place"] for g in a["goal"]] == ["on", "-y mid"] and a["goal"][1]["nearest_location"] == 4
+    assert a["goal"][1]["distance_m"] == pytest.approx(0.12, abs=1e-3)
+    assert b["goal"][1] == {"type": "stick", "nearest_location": 2, "place": "on", "distance_m": pytest.approx(0.02, abs=1e-3)}

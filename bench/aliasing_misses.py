@@ -1,0 +1,89 @@
+"""What the symbol-aliasing failures of benchmark runs miss by, and where their goals stand.
+
+A failure counts as aliasing when the final codes meet the goal's codes and the poses do not (2 cm tolerance).
+Per benchmark JSON and planner this lists each closed-loop aliasing failure: how far the farthest object ended
+from its goal, and for each goal object its nearest table location, how far from it, and its place (the 3-bit
+field of `--location-bits 9`: on, -y/+y near/mid/far, x). Misses within the place's band (a stick 14 or 16 cm
+off, both "far") are what a finer code would have to name. Reads JSON only; writes JSON.
+
+    python bench/aliasing_misses.py --benchmarks A.json B.json --problems problems/depth \
+        --out bench/results/aliasing_misses.json
+"""
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+MISS_BINS_M = (0.025, 0.05)  # misses up to 2.5 cm (just over tolerance), 2.5-5 cm, over 5 cm
+
+
+def goal_places(problem: dict) -> list[dict]:
+    """Each goal object's type, nearest location, distance to it and 9-bit place label."""
+    from symlearn.symbolic.locations import OFF_PLACES, location_bits
+    from symlearn.world import LOCATIONS
+
+    objects = problem["goal"]["objects"]
+    xy = np.float32([o["position"][:2] for o in objects])
+    top = np.float32([o["position"][2] for o in objects])  # only the place field is read, not the height
+    bits = location_bits(xy, 9, top).astype(np.int64)
+    out = []
+    for o, b, p in zip(objects, bits, xy):
+        nearest = int(b[0] * 4 + b[1] * 2 + b[2])
+        place = int(b[3] * 4 + b[4] * 2 + b[5])
+        out.append({"type": o["type"], "nearest_location": nearest, "place": OFF_PLACES[place],
+                    "distance_m": round(float(np.linalg.norm(p - np.float32(LOCATIONS[nearest]))), 4)})
+    return out
+
+
+def summarize(bench: dict, problems_root: Path) -> dict:
+    """planner -> failures, aliasing failures, their share, misses by bin and the rows (closed loop)."""
+    out = {}
+    for planner in bench["planners"]:
+        rows = [r for r in bench["rows"] if r["planner"] == planner and r["closed_loop"]]
+        failed = [r for r in rows if not r["success"]]
+        aliased = [r for r in failed if r.get("failure_cause") == "symbol_aliasing"]
+        misses = np.float64([r["max_distance_m"] for r in aliased])
+        edges = np.searchsorted(np.float64(MISS_BINS_M), misses, side="right")
+        detail = []
+        for r in aliased:
+            problem = json.loads((problems_root / f"{r['problem']}.json").read_text())
+            detail.append({"problem": r["problem"], "n_objects": r["n_objects"], "miss_m": r["max_distance_m"],
+                           "goal_off_locations": r["goal_off_locations"], "goal": goal_places(problem)})
+        out[planner] = {"n_problems": len(rows), "n_failures": len(failed), "n_aliasing": len(aliased),
+                        "aliasing_share": round(len(aliased) / len(failed), 4) if failed else None,
+                        "misses_by_bin": {label: int((edges == i).sum()) for i, label in
+                                          enumerate(("up to 2.5 cm", "2.5-5 cm", "over 5 cm"))},
+                        "rows": detail}
+    return out
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--benchmarks", nargs="+", required=True, help="benchmark JSON files (symlearn benchmark --out)")
+    ap.add_argument("--problems", default="problems/depth", help="the folder the rows' problem names are under")
+    ap.add_argument("--out", required=True)
+    args = ap.parse_args()
+    root = Path(args.problems)
+    result = {"problems": str(root), "benchmarks": {}}
+    for path in args.benchmarks:
+        try:
+            bench = json.loads(Path(path).read_text())
+            result["benchmarks"][path] = summarize(bench, root)
+        except (OSError, ValueError, KeyError) as e:
+            raise SystemExit(f"aliasing_misses: cannot read benchmark {path}: {type(e).__name__}: {e}") from None
+    for path, per in result["benchmarks"].items():
+        for planner, s in per.items():
+            print(f"{path}: {planner}: {s['n_aliasing']} of {s['n_failures']} failures aliasing, "
+                  f"misses {s['misses_by_bin']}")
+    out = Path(args.out)
+    tmp = out.with_suffix(out.suffix + ".tmp")
+    tmp.write_text(json.dumps(result, indent=1))
+    tmp.replace(out)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
