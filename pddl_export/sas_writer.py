@@ -120,6 +120,43 @@ class TermKind(str, Enum):
 Option = tuple[TermKind, tuple[int, ...]]
 
 
+def satisfying_cells(intervals: tuple[tuple[int, int], ...], k: int) -> list[tuple[int, ...]]:
+    """Every assignment of k others to categories 0..m (m: none of X_1..X_m) with lo_j <= #j < hi_j, sorted.
+
+    Built object by object, never taking a category that is at its upper bound nor leaving fewer objects than
+    the lower bounds still need: a rule that forbids most of its m codes leaves few choices per object, where
+    trying all (m + 1)^k assignments took minutes for 4-object tasks of 17-bit codes (docs/BENCHMARKS.md).
+    """
+    m = len(intervals)
+    lo = [a for a, _ in intervals]
+    hi = [b for _, b in intervals]
+    counts = [0] * m
+    out: list[tuple[int, ...]] = []
+    cell: list[int] = []
+
+    def extend(left: int, need: int) -> None:
+        if need > left:
+            return
+        if left == 0:
+            if all(c < h for c, h in zip(counts, hi)):  # a bound of hi <= 0 no assignment meets
+                out.append(tuple(cell))
+            return
+        for j in range(m + 1):
+            if j < m and counts[j] + 1 >= hi[j]:
+                continue
+            gained = 1 if j < m and counts[j] < lo[j] else 0
+            if j < m:
+                counts[j] += 1
+            cell.append(j)
+            extend(left - 1, need - gained)
+            cell.pop()
+            if j < m:
+                counts[j] -= 1
+
+    extend(k, sum(lo))
+    return out
+
+
 @functools.lru_cache(maxsize=4096)
 def context_terms(intervals: tuple[tuple[int, int], ...], k: int) -> tuple[tuple[Option, ...], ...]:
     """A small DNF, over k other objects, of "lo_j <= #others with X_j < hi_j for every j".
@@ -133,8 +170,7 @@ def context_terms(intervals: tuple[tuple[int, int], ...], k: int) -> tuple[tuple
     """
     m = len(intervals)
     cats = range(m + 1)  # m = "none of them"
-    cells = {c for c in itertools.product(cats, repeat=k)
-             if all(lo <= c.count(j) < hi for j, (lo, hi) in enumerate(intervals))}
+    cells = set(satisfying_cells(intervals, k))
     everything: tuple[int, ...] = tuple(range(m))
     if m > MAX_SUBSET_CODES:
         return tuple(tuple((TermKind.EQ, (j,)) if j < m else (TermKind.NOT, everything) for j in cell)

@@ -15,7 +15,7 @@ import pytest
 
 from pddl_export.pddl_writer import action_name, conditional_domain, problem_pddl
 from pddl_export.rules import INF, Rule, RuleSet, apply_rules, apply_rules_batch
-from pddl_export.sas_writer import SASEncoder, TermKind, context_terms
+from pddl_export.sas_writer import SASEncoder, TermKind, context_terms, satisfying_cells
 from search.sas_planners import SAS_PLANNERS, search_binary, solve_sas
 from search.result import PlanStatus
 from pddl_export.symbolic import N_ACTIONS, SymbolicGoal
@@ -81,6 +81,22 @@ def test_context_terms_cover_exactly_the_satisfying_cells():
     (term,) = context_terms(((0, 1),), 2)  # "none has X": one term, forbidding X on each other object
     assert [set(range(2)) - set(js) if kind is TermKind.NOT else set(js) for kind, js in term] == [{1}, {1}]
 
+
+
+def test_satisfying_cells_equal_every_assignment_that_meets_the_bounds():
+    """The pruned enumeration gives the brute-force cells, in order, also for empty and impossible bounds."""
+    rng = np.random.default_rng(0)
+    for _ in range(400):
+        m, k = int(rng.integers(0, 6)), int(rng.integers(0, 5))
+        intervals = tuple((int(lo), int(lo + rng.integers(-1, 4))) for lo in rng.integers(0, 3, m))
+        want = sorted(c for c in itertools.product(range(m + 1), repeat=k)
+                      if all(lo <= c.count(j) < hi for j, (lo, hi) in enumerate(intervals)))
+        assert satisfying_cells(intervals, k) == want, (intervals, k)
+    # a rule that forbids 40 codes and asks for one more: each other object is "none" or that code, never a forbidden one
+    forbids = ((0, 1),) * 40 + ((1, INF),)
+    cells = satisfying_cells(forbids, 4)
+    assert len(cells) == 2 ** 4 - 1 and all(set(c) <= {40, 41} and 40 in c for c in cells)
+    assert satisfying_cells(((0, 0),), 2) == [] and satisfying_cells(((3, INF),), 2) == []
 
 @pytest.mark.parametrize("init,goal,want", [((1, 3), (2, None), -1), ((1, 2), (2, None), 1), ((3, 1), (None, 2), -1),
                                             ((1, 1, 2), (2, 2, None), 1), ((1,), (3,), 2)])
