@@ -4,7 +4,10 @@ apply_rules_batch (pddl_export.rules) answers one (state, action) per row; a sea
 action's successor of every frontier state, and over joint states of 4-5 objects it meets
 millions of them. RuleSuccessors answers all actions at once: it groups rules by own code,
 touches only the objects that hold that code, and tests all of a code's rules, whatever their
-action, in one comparison (RuleSet.dense_groups stacked per own code). Tests check it against
+action, in one comparison (RuleSet.dense_groups stacked per own code). What an object does depends only
+on its own code and how many others hold each code its rules count, so each such answer is kept: a search
+meets the same few again and again, and with the rules of 1-5-object scenes (161,021 rules on 17-bit codes)
+the comparison was 95% of rules-outcomes' time (docs/BENCHMARKS.md). Tests check it against
 apply_rules_batch and the row-by-row apply_rules. States pack into one int64 key (pack_states)
 for duplicate detection.
 
@@ -24,6 +27,7 @@ import numpy as np
 from pddl_export.rules import COUNT_CAP, RuleSet
 
 MAX_PACKED_BITS = 62  # a packed state must fit in a non-negative int64
+MEMO_SIZE = 500_000  # (own code, context counts) answers RuleSuccessors keeps; it starts afresh past this
 
 
 def pack_states(states: np.ndarray, bits: int) -> np.ndarray:
@@ -71,6 +75,7 @@ class RuleSuccessors:
             self._groups[c] = (np.array(cols, np.int64), lo, hi,
                                np.concatenate([np.full(len(g[3]), a, np.int64) for a, g in parts]),
                                np.concatenate([g[3] for _, g in parts]))
+        self._memo: dict[tuple[int, bytes], tuple[np.ndarray, np.ndarray]] = {}
 
     @cached_property
     def code_changes(self) -> frozenset[tuple[int, int]]:
@@ -89,11 +94,41 @@ class RuleSuccessors:
             for c in np.unique(part).tolist():  # only the codes present: a small batch holds few
                 if c not in self._groups:
                     continue
-                cols, lo, hi, acol, code_to = self._groups[c]
+                cols = self._groups[c][0]
                 rows, pos = np.nonzero(part == c)
                 others = counts[rows][:, cols] - (self._context[cols] == c)  # (n, C_c) counts among the OTHER objects
                 others = np.minimum(others, COUNT_CAP).astype(np.int16)  # as the int16 bounds (rules._dense_group)
-                fires = np.all((others[:, None, :] >= lo) & (others[:, None, :] < hi), axis=2)  # (n, R)
-                p, r = np.nonzero(fires)
-                out[lo_row + rows[p], acol[r], pos[p]] = code_to[r]
+                contexts, which = np.unique(others, axis=0, return_inverse=True)
+                acts, tos, starts, sizes = self._fired(c, contexts)
+                n_fired = sizes[which.reshape(-1)]  # per (state, object) pair: the rules that fire on it
+                pair = np.repeat(np.arange(len(rows)), n_fired)
+                entry = np.repeat(starts[which.reshape(-1)] - np.cumsum(n_fired) + n_fired, n_fired) + np.arange(len(pair))
+                out[lo_row + rows[pair], acts[entry], pos[pair]] = tos[entry]
         return out
+
+    def _fired(self, c: int, contexts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """For (U, C_c) distinct context counts of own code c: the fired rules' action columns and next codes,
+        concatenated, with each context's start and size in them.
+
+        An object's next code under each action depends only on its own code and these counts, and a search
+        meets the same few again and again (most actions move one or two objects), so each answer is kept:
+        only contexts not seen before go through the (U', R, C_c) comparison with c's rules.
+        """
+        memo = self._memo
+        keys = [(c, row.tobytes()) for row in contexts]
+        found = [memo.get(key) for key in keys]
+        new = [i for i, hit in enumerate(found) if hit is None]
+        if new:
+            _, lo, hi, acol, code_to = self._groups[c]
+            fresh = contexts[new]
+            fires = np.all((fresh[:, None, :] >= lo) & (fresh[:, None, :] < hi), axis=2)  # (U', R)
+            if len(memo) + len(new) > MEMO_SIZE:
+                memo.clear()
+            for i, hit in zip(new, fires):
+                r = np.flatnonzero(hit)
+                found[i] = memo[keys[i]] = (acol[r], code_to[r])
+        sizes = np.array([len(a) for a, _ in found], np.int64)
+        starts = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+        acts = np.concatenate([a for a, _ in found]) if found else np.zeros(0, np.int64)
+        tos = np.concatenate([t for _, t in found]) if found else np.zeros(0, np.int64)
+        return acts, tos, starts, sizes

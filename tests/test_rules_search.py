@@ -50,6 +50,33 @@ def test_compiled_successors_equal_the_reference_semantics(seed):
             assert np.array_equal(succ(states), np.array(rows).reshape(len(states), len(succ.actions), k)), k
 
 
+def test_remembered_contexts_answer_as_fresh_ones_also_after_the_memo_starts_afresh(monkeypatch):
+    import pddl_export.rule_successors as rs_module
+
+    rng = np.random.default_rng(3)
+    rules = random_rules(rng, n=30)
+    states = np.array(list(itertools.product(VOCAB, repeat=3)), np.int64)
+    want = _reference(rules, states, RuleSuccessors(rules).actions)
+    succ = RuleSuccessors(rules)
+    first = succ(states)
+    assert len(succ._memo) > 0 and np.array_equal(first, want)
+    assert np.array_equal(succ(states[::-1]), want[::-1])  # every context now from the memo
+    monkeypatch.setattr(rs_module, "MEMO_SIZE", 3)  # a tiny memo: cleared over and over within one call
+    small = RuleSuccessors(rules)
+    for part in (slice(0, 40), slice(20, 90), slice(None)):  # overlapping batches: some contexts known, some new
+        assert np.array_equal(small(states[part]), want[part])
+    assert len(small._memo) <= 3 + len(states) * 3
+    monkeypatch.setattr(rs_module, "MEMO_SIZE", 1)  # one context known, one new: the memo is cleared between them
+    c = next(c for c, group in small._groups.items() if len(group[0]))  # a code whose rules count others
+    contexts = np.unique(np.random.default_rng(0).integers(0, 3, (40, len(small._groups[c][0]))).astype(np.int16), axis=0)
+    fresh = [RuleSuccessors(rules)._fired(c, contexts[i:i + 1]) for i in range(2)]
+    small._fired(c, contexts[:1])
+    acts, tos, starts, sizes = small._fired(c, contexts[:2])
+    for i, (a, t, _, _) in enumerate(fresh):
+        got = slice(starts[i], starts[i] + sizes[i])
+        assert np.array_equal(acts[got], a) and np.array_equal(tos[got], t)
+
+
 def test_compiled_successors_on_the_pretrained_rules():
     rules, _ = load_rules(PRETRAINED)
     succ = RuleSuccessors(rules)
