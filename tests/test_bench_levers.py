@@ -189,3 +189,22 @@ def test_aliasing_misses_bins_each_aliased_goal_and_names_where_its_objects_stan
     assert [g["place"] for g in a["goal"]] == ["on", "-y mid"] and a["goal"][1]["nearest_location"] == 4
     assert a["goal"][1]["distance_m"] == pytest.approx(0.12, abs=1e-3)
     assert b["goal"][1] == {"type": "stick", "nearest_location": 2, "place": "on", "distance_m": pytest.approx(0.02, abs=1e-3)}
+
+
+def test_the_baselines_of_the_speed_benches_answer_as_the_code_they_time():
+    """bench/rule_successors_memo.py's dense comparison and bench/sas_body.py's brute-force cells are the
+    baselines their speedups are measured against: they must give what the faster code gives."""
+    import itertools
+
+    from pddl_export.rule_successors import RuleSuccessors
+    from pddl_export.sas_writer import satisfying_cells
+    from tests.test_overrides import VOCAB, random_rules
+
+    memo, body = _load("rule_successors_memo"), _load("sas_body")
+    rules = random_rules(np.random.default_rng(1), n=25)
+    succ = RuleSuccessors(rules)
+    states = np.array(list(itertools.product(VOCAB, repeat=3)), np.int64)
+    assert np.array_equal(memo.dense_successors(succ, states), succ(states))
+    assert not np.array_equal(memo.dense_successors(succ, states), np.repeat(states[:, None], len(succ.actions), 1))
+    for intervals, k in [(((0, 1), (1, 3)), 3), (((2, 9),), 2), ((), 2), (((0, 0),), 1)]:
+        assert body.brute_force_cells(intervals, k) == satisfying_cells(intervals, k)
