@@ -66,6 +66,8 @@ def main() -> int:
     ap.add_argument("--problems", default="problems/depth", help="the folder the rows' problem names are under")
     ap.add_argument("--out", required=True)
     args = ap.parse_args()
+    from symlearn.provenance import atomic_write_json, bench_context
+
     root = Path(args.problems)
     result = {"problems": str(root), "benchmarks": {}}
     for path in args.benchmarks:
@@ -78,10 +80,7 @@ def main() -> int:
         for planner, s in per.items():
             print(f"{path}: {planner}: {s['n_aliasing']} of {s['n_failures']} failures aliasing, "
                   f"misses {s['misses_by_bin']}")
-    out = Path(args.out)
-    tmp = out.with_suffix(out.suffix + ".tmp")
-    tmp.write_text(json.dumps(result, indent=1))
-    tmp.replace(out)
+    atomic_write_json(args.out, {**result, **bench_context()})
     return 0
 
 

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import platform
 import time
 from pathlib import Path
 
@@ -80,6 +79,7 @@ def main() -> int:
     ap.add_argument("--out", required=True)
     args = ap.parse_args()
     from pddl_export.rule_successors import RuleSuccessors
+    from symlearn.provenance import atomic_write_json, bench_context
 
     sets, calls, rows = record_calls(Path(args.run), [Path(p) for p in args.problems], args.timeout)
     memo = [RuleSuccessors(s) for s in sets]
@@ -97,12 +97,9 @@ def main() -> int:
            "problems": rows, "n_calls": len(calls), "n_states": int(sum(len(s) for _, s in calls)),
            "baseline_s": round(base_s, 3), "memo_s": round(memo_s, 3),
            "speedup": round(base_s / memo_s, 1) if memo_s else None, "memo_entries": [len(m._memo) for m in memo],
-           "machine": platform.platform(), "date": time.strftime("%Y-%m-%d")}
+           **bench_context()}
     print(json.dumps({k: v for k, v in out.items() if k != "problems"}))
-    path = Path(args.out)
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(json.dumps(out, indent=1))
-    tmp.replace(path)
+    atomic_write_json(args.out, out)
     return 0
 
 

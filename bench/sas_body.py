@@ -60,10 +60,9 @@ def main() -> int:
     ap.add_argument("--baseline-max-objects", type=int, default=4, help="largest count the baseline is timed on")
     ap.add_argument("--out", required=True)
     args = ap.parse_args()
-    import platform
-
     import pddl_export.sas_writer as sw
     from pddl_export.rules_io import load_rules
+    from symlearn.provenance import atomic_write_json, bench_context
 
     rules, model_hash = load_rules(Path(args.run))
     rows = []
@@ -81,12 +80,8 @@ def main() -> int:
         rows.append(row)
         print(json.dumps(row))
     out = {"run": args.run, "model_hash": model_hash, "bits": rules.bits, "vocabulary_size": len(rules.vocabulary),
-           "n_rules": len(rules.rules), "rows": rows, "machine": platform.platform(),
-           "date": time.strftime("%Y-%m-%d")}
-    path = Path(args.out)
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(json.dumps(out, indent=1))
-    tmp.replace(path)
+           "n_rules": len(rules.rules), "rows": rows, **bench_context()}
+    atomic_write_json(args.out, out)
     return 0
 
 
