@@ -248,7 +248,8 @@ def test_up_planner_timeout_is_a_timeout_within_the_limit(planner, rules, tmp_pa
         solve_pddl(*texts, planner=planner, timeout_s=timeout)
     elapsed = time.perf_counter() - t0
     assert res.status is PlanStatus.TIMEOUT, res.message
-    assert elapsed < timeout + 1.5, elapsed
+    # the kill and reaping within seconds: 1.5 s of slack was once exceeded (1.85 s) with one other job on 2 cores
+    assert elapsed < timeout + 3.0, elapsed
     # the call's own clock covers it, up to the process start and reaping around it (longer on a loaded machine)
     assert elapsed - 0.5 < res.extra["total_time_s"] <= elapsed
     assert set(_children_of(os.getpid())) - before == set()
