@@ -22,17 +22,16 @@ MISS_BINS_M = (0.025, 0.05)  # misses up to 2.5 cm (just over tolerance), 2.5-5 
 
 def goal_places(problem: dict) -> list[dict]:
     """Each goal object's type, nearest location, distance to it and 9-bit place label."""
+    from pddl_export.symbolic import codes_from_bits
     from symlearn.symbolic.locations import OFF_PLACES, location_bits
     from symlearn.world import LOCATIONS
 
     objects = problem["goal"]["objects"]
     xy = np.float32([o["position"][:2] for o in objects])
-    top = np.float32([o["position"][2] for o in objects])  # only the place field is read, not the height
-    bits = location_bits(xy, 9, top).astype(np.int64)
+    bits = location_bits(xy, 6)  # nearest location and place: the first 6 of the 9 bits
+    nearest_of, place_of = codes_from_bits(bits[:, :3]).tolist(), codes_from_bits(bits[:, 3:]).tolist()
     out = []
-    for o, b, p in zip(objects, bits, xy):
-        nearest = int(b[0] * 4 + b[1] * 2 + b[2])
-        place = int(b[3] * 4 + b[4] * 2 + b[5])
+    for o, nearest, place, p in zip(objects, nearest_of, place_of, xy):
         out.append({"type": o["type"], "nearest_location": nearest, "place": OFF_PLACES[place],
                     "distance_m": round(float(np.linalg.norm(p - np.float32(LOCATIONS[nearest]))), 4)})
     return out

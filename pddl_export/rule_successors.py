@@ -99,10 +99,11 @@ class RuleSuccessors:
                 others = counts[rows][:, cols] - (self._context[cols] == c)  # (n, C_c) counts among the OTHER objects
                 others = np.minimum(others, COUNT_CAP).astype(np.int16)  # as the int16 bounds (rules._dense_group)
                 contexts, which = np.unique(others, axis=0, return_inverse=True)
+                which = which.reshape(-1)  # per (state, object) pair: its row of contexts
                 acts, tos, starts, sizes = self._fired(c, contexts)
-                n_fired = sizes[which.reshape(-1)]  # per (state, object) pair: the rules that fire on it
+                n_fired = sizes[which]  # per pair: the rules that fire on it
                 pair = np.repeat(np.arange(len(rows)), n_fired)
-                entry = np.repeat(starts[which.reshape(-1)] - np.cumsum(n_fired) + n_fired, n_fired) + np.arange(len(pair))
+                entry = np.repeat(starts[which] - np.cumsum(n_fired) + n_fired, n_fired) + np.arange(len(pair))
                 out[lo_row + rows[pair], acts[entry], pos[pair]] = tos[entry]
         return out
 

@@ -26,6 +26,7 @@ import torch.nn.functional as F
 
 from symlearn.world import N_ACTIONS
 
+MAX_CODE_BITS = 16  # the longest learned code
 
 
 @dataclass(frozen=True)
@@ -52,8 +53,8 @@ class ModelConfig:
             raise ValueError(f"d_model {self.d_model} is not divisible by n_heads {self.n_heads}")
         if self.crop % (2 ** len(self.conv_channels)):
             raise ValueError(f"crop {self.crop} must be divisible by 2^{len(self.conv_channels)}")
-        if not 1 <= self.bits <= 16:
-            raise ValueError(f"bits={self.bits} must lie in 1..16")
+        if not 1 <= self.bits <= MAX_CODE_BITS:
+            raise ValueError(f"bits={self.bits} must lie in 1..{MAX_CODE_BITS}")
 
     @staticmethod
     def from_preset(name: str, **overrides) -> "ModelConfig":

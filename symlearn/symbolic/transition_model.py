@@ -24,12 +24,12 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
+from symlearn.learning.models import MAX_CODE_BITS
 from symlearn.symbolic.locations import LOCATION_BITS
 from symlearn.world import N_ACTIONS
 
 # An 8-bit learned code and 9 location bits make 17; the rule searches hold (objects, 2**bits) tables, 8 MB at 20.
 MAX_TRANSITION_BITS = 20
-MAX_CODE_BITS = 16  # the effect model's limit (learning.models.ModelConfig)
 MAX_MODES = 16
 
 
