@@ -29,10 +29,18 @@ def rules_to_json(rules: RuleSet) -> dict:
                        "fewer_than": [[code_str(c, b), n] for c, n in r.fewer_than]} for r in rules.rules]}
 
 
+class _CodeStrings(dict):
+    """Bit string -> code, each distinct string parsed once."""
+
+    def __missing__(self, s: str) -> int:
+        self[s] = value = int(s, 2)
+        return value
+
+
 def rules_from_json(d: dict) -> RuleSet:
     """Inverse of rules_to_json; refuses malformed files with a one-line error."""
     try:
-        c = lambda s: int(s, 2)  # noqa: E731
+        c = _CodeStrings().__getitem__  # a file names a few hundred codes millions of times
         rules = tuple(Rule(int(r["action"]), c(r["from"]), c(r["to"]), tuple(map(c, r["requires"])),
                            tuple(map(c, r["forbids"])), tuple((c(x), int(n)) for x, n in r["at_least"]),
                            tuple((c(x), int(n)) for x, n in r["fewer_than"])) for r in d["rules"])

@@ -33,7 +33,7 @@ from pddl_export.pddl_writer import (
 from pddl_export.files import atomic_write_text
 from pddl_export.distil import NotEquivariantError, distil_rules
 from pddl_export.fidelity import rule_fidelity
-from pddl_export.rules import COUNT_CAP, AmbiguousRulesError, Rule, RuleSet, _first_overlap, apply_rules, apply_rules_batch
+from pddl_export.rules import COUNT_CAP, INF, AmbiguousRulesError, Rule, RuleSet, _first_overlap, apply_rules, apply_rules_batch
 from pddl_export.symbolic import N_ACTIONS
 
 NEAR, FAR, STICK, RIDER, UNDER, STICK_M, RIDER_M = 1, 2, 3, 4, 5, 6, 7
@@ -499,3 +499,45 @@ def test_enumerate_scenes_queries_only_given_scenes_and_distils_exactly(toy):
     assert rule_fidelity(rs, enum).fraction == 1.0
     with pytest.raises(ValueError, match="objects, expected"):
         enumerate_scenes(net, vocab, [tuple(vocab[:1]) * 4], max_objects=3)
+
+
+def _brute_force_overlap(lo: np.ndarray, hi: np.ndarray) -> tuple[int, int] | None:
+    """First pair (row-major) of boxes whose intervals meet on every column: the definition, pair by pair."""
+    for i in range(len(lo)):
+        for j in range(len(lo)):
+            if i != j and all(max(lo[i, c], lo[j, c]) < min(hi[i, c], hi[j, c]) for c in range(lo.shape[1])):
+                return i, j
+    return None
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_overlap_check_is_the_pairwise_definition_on_random_boxes(seed):
+    """_first_overlap tests disjointness as a product of (column, upper bound) features; it must name the same
+    first overlapping pair as comparing every pair on every column, in any chunk size, including open and
+    COUNT_CAP bounds."""
+    rng = np.random.default_rng(seed)
+    n_none = 0
+    for _ in range(300):
+        n, c = int(rng.integers(1, 10)), int(rng.integers(1, 5))
+        lo = np.zeros((n, c), np.int16)
+        hi = np.full((n, c), COUNT_CAP + 1, np.int16)
+        bounded = rng.random((n, c)) < 0.6
+        low = rng.integers(0, 4, (n, c))
+        high = np.where(rng.random((n, c)) < 0.3, COUNT_CAP + 1, low + rng.integers(1, 3, (n, c)))
+        lo[bounded], hi[bounded] = low[bounded], high[bounded]
+        lo[(rng.random((n, c)) < 0.05) & (hi == COUNT_CAP + 1)] = COUNT_CAP
+        want = _brute_force_overlap(lo, hi)
+        n_none += want is None
+        for cells in (1, 3, 1 << 22):
+            assert _first_overlap(lo, hi, max_cells=cells) == want, (lo.tolist(), hi.tolist(), cells)
+    assert 20 < n_none < 280  # both verdicts occur
+
+
+def test_a_rule_keeps_its_bounds_whatever_a_caller_does_with_them():
+    r = Rule(3, 1, 2, requires=(5,), forbids=(7, 4), at_least=((9, 2),), fewer_than=((5, 3),))
+    b = r.bounds()
+    assert b == {4: (0, 1), 5: (1, 3), 7: (0, 1), 9: (2, INF)} and list(b) == [4, 5, 7, 9]
+    b[4] = (0, INF)
+    assert r.bounds()[4] == (0, 1) and r.matches({5: 1, 9: 2}) and not r.matches({5: 1, 9: 2, 4: 1})
+    with pytest.raises(ValueError, match="contradictory conditions on code 5"):
+        Rule(3, 1, 2, at_least=((5, 3),), fewer_than=((5, 3),))
