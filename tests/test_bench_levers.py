@@ -208,3 +208,24 @@ def test_the_baselines_of_the_speed_benches_answer_as_the_code_they_time():
     assert not np.array_equal(memo.dense_successors(succ, states), np.repeat(states[:, None], len(succ.actions), 1))
     for intervals, k in [(((0, 1), (1, 3)), 3), (((2, 9),), 2), ((), 2), (((0, 0),), 1)]:
         assert body.brute_force_cells(intervals, k) == satisfying_cells(intervals, k)
+
+
+def test_the_rules_load_baseline_builds_and_checks_groups_as_ruleset_does():
+    """bench/rules_load.py times RuleSet's group arrays and exclusivity check against the earlier per-entry
+    arrays and every-pair comparison: on random rules both must give the same arrays, and the same verdicts on
+    exclusive groups and on a group made to overlap."""
+    from pddl_export.rules import _dense_group, _first_overlap
+    from tests.test_overrides import random_rules
+
+    load = _load("rules_load")
+    rules = random_rules(np.random.default_rng(4), n=40)
+    new = load.groups_step(rules, _dense_group, _first_overlap)
+    base = load.groups_step(rules, load.baseline_dense_group, load.baseline_first_overlap)
+    assert load.same_arrays(new[1], base[1]) and new[2] == base[2]
+    assert any(len(rules.rules_for(*k)) > 1 for k in rules.dense_groups) and set(new[2]) == {None}
+    _, lo, hi, _ = max(new[1].values(), key=lambda g: len(g[1]))
+    hi = hi.copy()
+    hi[:] = lo + 1  # each box a single count vector ...
+    hi[1:] = hi[0]
+    lo[1:] = lo[0]  # ... and all of them the same one
+    assert _first_overlap(lo, hi) == load.baseline_first_overlap(lo, hi) == (0, 1)
