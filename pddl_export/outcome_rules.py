@@ -33,7 +33,7 @@ import numpy as np
 from pddl_export.distil import distil_rules
 from pddl_export.enumeration import Enumeration, SceneBlock
 from pddl_export.rules import RuleSet
-from pddl_export.rules_io import PDDL_DIR, rules_from_json, rules_to_json
+from pddl_export.rules_io import PDDL_DIR, paused_gc, rules_from_json, rules_to_json
 from pddl_export.symbolic import OutcomeTransitionFn, bit_flip_costs, code_str, codes_from_bits
 
 OUTCOMES_FILE = "outcomes.json"
@@ -180,10 +180,11 @@ def load_outcomes(run_dir: Path) -> tuple[OutcomeRules, str]:
     if not path.exists():
         raise ValueError(f"no exported outcome rules at {path}; {fix}")
     try:
-        d = json.loads(path.read_text(encoding="utf-8"))
-        if not isinstance(d, dict):
-            raise ValueError(f"a JSON {type(d).__name__}, expected an object")
-        outcomes = outcomes_from_json(d)
+        with paused_gc():
+            d = json.loads(path.read_text(encoding="utf-8"))
+            if not isinstance(d, dict):
+                raise ValueError(f"a JSON {type(d).__name__}, expected an object")
+            outcomes = outcomes_from_json(d)
         model_hash = d.get("model_hash", "")
         if not isinstance(model_hash, str):
             raise ValueError(f"model_hash must be a string, got {model_hash!r}")

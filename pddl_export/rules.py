@@ -75,13 +75,14 @@ class Rule:
             raise ValueError("at_least / fewer_than counts must be >= 2 (use requires / forbids for 1)")
         if len(set(lower)) != len(lower) or len(set(upper)) != len(upper):
             raise ValueError("each code may carry at most one lower and one upper bound")
-        lower_of, upper_of = dict.fromkeys(requires, 1), dict.fromkeys(forbids, 1)
-        lower_of.update(at_least)
-        upper_of.update(fewer_than)
-        for x in lower_of.keys() & upper_of.keys():
-            if lower_of[x] >= upper_of[x]:
-                raise ValueError(f"contradictory conditions on code {x}: need {lower_of[x]} <= count < {upper_of[x]}")
-        bounds = {x: (lower_of.get(x, 0), upper_of.get(x, INF)) for x in sorted(lower_of.keys() | upper_of.keys())}
+        bounds = dict.fromkeys(forbids, (0, 1))  # most conditions forbid a code: filled without a Python loop
+        bounds.update((x, (0, n)) for x, n in fewer_than)
+        for x, lo in [(x, 1) for x in requires] + list(at_least):
+            hi = bounds.get(x, (0, INF))[1]
+            if lo >= hi:
+                raise ValueError(f"contradictory conditions on code {x}: need {lo} <= count < {hi}")
+            bounds[x] = (lo, hi)
+        bounds = dict(sorted(bounds.items()))
         set_("_bounds", bounds)  # computed once: rules of 1-5-object scenes name about 20 context codes each
 
     def bounds(self) -> Bounds:

@@ -7,6 +7,8 @@
 """
 from __future__ import annotations
 
+import contextlib
+import gc
 import json
 from pathlib import Path
 
@@ -27,6 +29,19 @@ def rules_to_json(rules: RuleSet) -> dict:
                        "requires": [code_str(c, b) for c in r.requires], "forbids": [code_str(c, b) for c in r.forbids],
                        "at_least": [[code_str(c, b), n] for c, n in r.at_least],
                        "fewer_than": [[code_str(c, b), n] for c, n in r.fewer_than]} for r in rules.rules]}
+
+
+@contextlib.contextmanager
+def paused_gc():
+    """No cyclic garbage collection inside the block: loading builds millions of acyclic objects, and the
+    collector's passes over them took a third of the time (6.9 against 4.4 s for 327k rules)."""
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
 
 
 class _CodeStrings(dict):
@@ -58,7 +73,8 @@ def load_rules(run_dir: Path) -> tuple[RuleSet, str]:
     if not path.exists():
         raise ValueError(f"no exported rules at {path}; run 'symlearn export-pddl --run {run_dir}' first")
     try:
-        d = json.loads(path.read_text(encoding="utf-8"))
+        with paused_gc():
+            d = json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as e:
         raise ValueError(f"{path}: not valid JSON (line {e.lineno}, column {e.colno}: {e.msg}); "
                          f"re-run 'symlearn export-pddl --run {run_dir}'") from None
@@ -68,7 +84,8 @@ def load_rules(run_dir: Path) -> tuple[RuleSet, str]:
         raise ValueError(f"{path}: not a rules file (a JSON {type(d).__name__}, expected an object with "
                          f"'bits', 'vocabulary', 'max_objects' and 'rules')")
     try:
-        rules = rules_from_json(d)
+        with paused_gc():
+            rules = rules_from_json(d)
     except ValueError as e:
         raise ValueError(f"{path}: {e}") from None
     model_hash = d.get("model_hash", "")

@@ -7,6 +7,7 @@ that no process of the planner survives and no symlearn-* temporary folder is le
 """
 from __future__ import annotations
 
+import gc
 import json
 import os
 import signal
@@ -301,6 +302,7 @@ def test_bad_rules_file_is_named_in_one_line(tmp_path, mutate, message):
         load_rules(tmp_path / "run")
     text = str(info.value)
     assert "\n" not in text and text.startswith(f"{path}: ") and message in text, text
+    assert gc.isenabled()  # loading pauses the garbage collector (rules_io.paused_gc), and a refusal restores it
 
 
 # ------------------------------------------------------------------------------- 4. subprocess calls

@@ -541,3 +541,21 @@ def test_a_rule_keeps_its_bounds_whatever_a_caller_does_with_them():
     assert r.bounds()[4] == (0, 1) and r.matches({5: 1, 9: 2}) and not r.matches({5: 1, 9: 2, 4: 1})
     with pytest.raises(ValueError, match="contradictory conditions on code 5"):
         Rule(3, 1, 2, at_least=((5, 3),), fewer_than=((5, 3),))
+
+
+def test_paused_gc_restores_the_collector_as_it_found_it():
+    import gc
+
+    from pddl_export.rules_io import paused_gc
+
+    with pytest.raises(RuntimeError), paused_gc():
+        assert not gc.isenabled()
+        raise RuntimeError("a failed load")
+    assert gc.isenabled()
+    gc.disable()
+    try:
+        with paused_gc():
+            pass
+        assert not gc.isenabled()  # a caller that had it off keeps it off
+    finally:
+        gc.enable()
