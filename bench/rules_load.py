@@ -49,12 +49,15 @@ def baseline_first_overlap(lo: np.ndarray, hi: np.ndarray, max_cells: int = 1 <<
 
 
 def groups_step(rules, dense_group, first_overlap) -> tuple[float, dict, list]:
-    """Seconds to build every group's arrays and check it, the arrays, and each group's overlap verdict."""
+    """Seconds to build every group's arrays and check it, the arrays, and each group's overlap verdict (both ways
+    on one BLAS thread with the collector paused, as RuleSet loads them)."""
     from threadpoolctl import threadpool_limits
+
+    from pddl_export.rules_io import paused_gc
 
     t = time.perf_counter()
     dense, verdicts = {}, []
-    with threadpool_limits(1, user_api="blas"):
+    with threadpool_limits(1, user_api="blas"), paused_gc():
         for key in sorted(rules.dense_groups):
             group = rules.rules_for(*key)
             dense[key] = dense_group(group)

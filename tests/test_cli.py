@@ -345,3 +345,22 @@ def test_cli_process_exit_codes(tmp_path):
         r = subprocess.run(run + [cmd, "--run", str(tmp_path / "r"), "--data", str(tmp_path / "d"), "--threads", "0"],
                            cwd=ROOT, capture_output=True, text=True, timeout=120)
         assert r.returncode == 2 and "argument --threads: '0' must be a positive integer" in r.stderr, r.stderr
+
+
+def test_plan_and_benchmark_say_when_they_load_big_rule_files(tmp_path, capsys):
+    from symlearn.cli.planning import note_rule_loading
+
+    pddl = tmp_path / "run" / "pddl"
+    pddl.mkdir(parents=True)
+    for name, size in (("rules.json", 40_000_000), ("outcomes.json", 30_000_000)):
+        with open(pddl / name, "wb") as f:
+            f.truncate(size)  # sparse: the size is what is judged
+    note_rule_loading(tmp_path / "run", ["astar", "astar-outcomes"])
+    assert capsys.readouterr().err == ""  # no rule planner: nothing is read
+    note_rule_loading(tmp_path / "run", ["rules-bfs"])
+    assert capsys.readouterr().err == ""  # 40 MB: not worth a line
+    note_rule_loading(tmp_path / "run", ["astar", "rules-outcomes"])
+    err = capsys.readouterr().err
+    assert err.startswith("loading ") and "rules.json and " in err and "outcomes.json (70 MB)" in err
+    with pytest.raises(ValueError, match="rules-magic"):
+        note_rule_loading(tmp_path / "run", ["rules-magic"])
