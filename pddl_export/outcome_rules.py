@@ -33,7 +33,7 @@ import numpy as np
 from pddl_export.distil import distil_rules
 from pddl_export.enumeration import Enumeration, SceneBlock
 from pddl_export.rules import RuleSet
-from pddl_export.rules_io import PDDL_DIR, paused_gc, rules_from_json, rules_to_json
+from pddl_export.rules_io import FREEZE_BYTES, PDDL_DIR, paused_gc, rules_from_json, rules_to_json
 from pddl_export.symbolic import OutcomeTransitionFn, bit_flip_costs, code_str, codes_from_bits
 
 OUTCOMES_FILE = "outcomes.json"
@@ -180,7 +180,7 @@ def load_outcomes(run_dir: Path) -> tuple[OutcomeRules, str]:
     if not path.exists():
         raise ValueError(f"no exported outcome rules at {path}; {fix}")
     try:
-        with paused_gc():
+        with paused_gc(freeze=path.stat().st_size >= FREEZE_BYTES):
             d = json.loads(path.read_text(encoding="utf-8"))
             if not isinstance(d, dict):
                 raise ValueError(f"a JSON {type(d).__name__}, expected an object")

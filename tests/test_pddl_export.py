@@ -559,3 +559,13 @@ def test_paused_gc_restores_the_collector_as_it_found_it():
         assert not gc.isenabled()  # a caller that had it off keeps it off
     finally:
         gc.enable()
+    frozen = gc.get_freeze_count()
+    try:
+        with pytest.raises(RuntimeError), paused_gc(freeze=True):
+            raise RuntimeError("a failed load freezes nothing")
+        assert gc.get_freeze_count() == frozen and gc.isenabled()
+        with paused_gc(freeze=True):
+            built = [[i] for i in range(1000)]  # what a load builds stays out of later collections
+        assert gc.get_freeze_count() >= frozen + len(built) and gc.isenabled()
+    finally:
+        gc.unfreeze()
