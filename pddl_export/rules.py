@@ -153,8 +153,8 @@ def _first_overlap(lo: np.ndarray, hi: np.ndarray, max_cells: int = 1 << 22) -> 
     where comparing every pair on every column took a second (docs/BENCHMARKS.md, "Loading exported rules").
     """
     n = len(lo)
-    j, t = np.nonzero(hi <= COUNT_CAP)  # finite upper bounds: (row, column) pairs
-    keys = np.unique(t.astype(np.int64) * (COUNT_CAP + 2) + hi[j, t])
+    rows, cols = np.nonzero(hi <= COUNT_CAP)  # where the upper bounds are finite
+    keys = np.unique(cols.astype(np.int64) * (COUNT_CAP + 2) + hi[rows, cols])  # distinct (column, t)
     col, thr = keys // (COUNT_CAP + 2), keys % (COUNT_CAP + 2)
     at_least = (lo[:, col] >= thr).astype(np.float32)  # (R, F): lo >= t
     at_most = (hi[:, col] <= thr).astype(np.float32)  # (R, F): hi <= t
