@@ -6,8 +6,13 @@ from its goal, and for each goal object its nearest table location, how far from
 field of `--location-bits 9`: on, -y/+y near/mid/far, x). Misses within the place's band (a stick 14 or 16 cm
 off, both "far") are what a finer code would have to name. Reads JSON only; writes JSON.
 
+With `--replay-run RUN` (the run the benchmarks planned with) each aliasing failure is planned and executed again
+in the simulator, closed loop, with the benchmark's planner, time limit and replans, and each judged object's end
+is compared with its goal: dx, dy and dz in cm, so a miss along x inside a y band (which no place field names) is
+told from one along y. A replay is one more run, not the recorded one: its own outcome is reported beside it.
+
     python bench/aliasing_misses.py --benchmarks A.json B.json --problems problems/depth \
-        --out bench/results/aliasing_misses.json
+        --out bench/results/aliasing_misses.json [--replay-run RUN]
 """
 from __future__ import annotations
 
@@ -37,6 +42,52 @@ def goal_places(problem: dict) -> list[dict]:
     return out
 
 
+def object_offsets(final: np.ndarray, goal: np.ndarray, judged: list[bool]) -> list[dict | None]:
+    """Per object: its end minus its goal position in x, y and z (cm), the miss (as the benchmark's distance) and
+    the axis that carries most of it; None for an object the goal does not judge."""
+    out = []
+    for delta, ok in zip((np.asarray(final, np.float64) - np.asarray(goal, np.float64)) * 100, judged):
+        out.append({"dx_cm": round(float(delta[0]), 2), "dy_cm": round(float(delta[1]), 2),
+                    "dz_cm": round(float(delta[2]), 2), "miss_cm": round(float(np.linalg.norm(delta)), 2),
+                    "axis": "xyz"[int(np.argmax(np.abs(delta)))]} if ok else None)
+    return out
+
+
+def replay(run: Path, bench: dict, planner: str, names: list[str], problems_root: Path) -> dict:
+    """problem -> the replay's success, symbolic match, cause and each object's offsets (closed loop, as `bench`)."""
+    import torch
+
+    from symlearn.planning.execution import ExecutionConfig, run_problem
+    from symlearn.planning.planners import make_planners
+    from symlearn.planning.problem import load_problem
+    from symlearn.sim.simulator import TabletopSimulator
+    from symlearn.symbolic.learned_transition import planning_models
+
+    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
+    from symlearn.provenance import sha256_file
+
+    have = sha256_file(run / TRANSITION_FILE)[:16]
+    if have != bench.get("transition_sha256"):
+        raise SystemExit(f"aliasing_misses: {run / TRANSITION_FILE} ({have}) is not the transition model the "
+                         f"benchmark planned with ({bench.get('transition_sha256')}); replay with that run")
+    torch.set_num_threads(1)
+    fn = make_planners([planner], run, risk_weight=float(bench.get("risk_weight", 1.0)))[planner]
+    encoder, transition = planning_models(run)
+    config = ExecutionConfig(closed_loop=True, timeout_s=float(bench["timeout_s"]),
+                             max_replans=int(bench["max_replans"]))
+    out = {}
+    with TabletopSimulator() as sim:
+        for name in names:
+            problem = load_problem(problems_root / f"{name}.json")
+            row = run_problem(sim, encoder, transition, problem, planner, fn, config)
+            final = np.float64([o.position for o in sim.get_scene().objects])
+            goal = np.float64([o.position for o in problem.goal.objects])
+            judged = [i not in problem.free for i in range(len(goal))]
+            out[name] = {"success": row.success, "symbolic_match": row.symbolic_match, "cause": row.failure_cause,
+                         "max_distance_m": row.max_distance_m, "objects": object_offsets(final, goal, judged)}
+    return out
+
+
 def summarize(bench: dict, problems_root: Path) -> dict:
     """planner -> failures, aliasing failures, their share, misses by bin and the rows (closed loop)."""
     out = {}
@@ -63,18 +114,25 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--benchmarks", nargs="+", required=True, help="benchmark JSON files (symlearn benchmark --out)")
     ap.add_argument("--problems", default="problems/depth", help="the folder the rows' problem names are under")
+    ap.add_argument("--replay-run", help="run directory the benchmarks planned with: replay each aliasing failure")
     ap.add_argument("--out", required=True)
     args = ap.parse_args()
     from symlearn.provenance import atomic_write_json, bench_context
 
     root = Path(args.problems)
-    result = {"problems": str(root), "benchmarks": {}}
+    result = {"problems": str(root), "benchmarks": {}, "replay_run": args.replay_run}
     for path in args.benchmarks:
         try:
             bench = json.loads(Path(path).read_text())
             result["benchmarks"][path] = summarize(bench, root)
         except (OSError, ValueError, KeyError) as e:
             raise SystemExit(f"aliasing_misses: cannot read benchmark {path}: {type(e).__name__}: {e}") from None
+        if args.replay_run:
+            for planner, summary in result["benchmarks"][path].items():
+                again = replay(Path(args.replay_run), bench, planner, [r["problem"] for r in summary["rows"]], root)
+                for r in summary["rows"]:
+                    r["replay"] = again[r["problem"]]
+                    print(f"{path}: {planner}: {r['problem']} replayed: {r['replay']}")
     for path, per in result["benchmarks"].items():
         for planner, s in per.items():
             print(f"{path}: {planner}: {s['n_aliasing']} of {s['n_failures']} failures aliasing, "

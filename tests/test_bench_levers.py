@@ -229,3 +229,36 @@ def test_the_rules_load_baseline_builds_and_checks_groups_as_ruleset_does():
     hi[1:] = hi[0]
     lo[1:] = lo[0]  # ... and all of them the same one
     assert _first_overlap(lo, hi) == load.baseline_first_overlap(lo, hi) == (0, 1)
+
+
+def test_aliasing_offsets_say_which_axis_carries_the_miss():
+    am = _load("aliasing_misses")
+    final = np.float64([[0.508, 0.120, 0.50], [0.80, 0.18, 0.425], [0.5, 0.0, 0.45]])
+    goal = np.float64([[0.528, 0.121, 0.50], [0.807, 0.139, 0.425], [0.1, 0.1, 0.45]])
+    a, b, free = am.object_offsets(final, goal, [True, True, False])
+    assert a == {"dx_cm": -2.0, "dy_cm": -0.1, "dz_cm": 0.0, "miss_cm": pytest.approx(2.0, abs=0.01), "axis": "x"}
+    assert b["axis"] == "y" and b["dy_cm"] == pytest.approx(4.1) and b["miss_cm"] == pytest.approx(4.16, abs=0.01)
+    assert free is None
+
+
+def test_aliasing_replay_runs_the_problem_again_and_refuses_another_model(tiny_run_copy, tmp_path):
+    """The replay plans and executes each problem again (closed loop, the benchmark's settings); its per-object
+    misses must give the executor's own largest distance, and a benchmark of another transition model is refused."""
+    from symlearn.planning.problem_generation import generate_problems
+    from symlearn.provenance import sha256_file
+
+    am = _load("aliasing_misses")
+    root = tmp_path / "problems"
+    paths = generate_problems(root / "walks", 2, objects=(2, 2), length=(1, 2), seed=3)
+    names = [f"walks/{p.stem}" for p in paths]
+    bench = {"timeout_s": 5.0, "max_replans": 1, "risk_weight": 1.0,
+             "transition_sha256": sha256_file(tiny_run_copy / "transition.pt")[:16]}
+    out = am.replay(tiny_run_copy, bench, "astar", names, root)
+    assert set(out) == set(names)
+    for name, r in out.items():
+        assert isinstance(r["success"], bool) and len(r["objects"]) == 2
+        if r["max_distance_m"] is not None:  # something was executed
+            assert max(o["miss_cm"] for o in r["objects"]) == pytest.approx(100 * r["max_distance_m"], abs=0.02)
+            assert r["success"] == (r["max_distance_m"] <= 0.02)
+    with pytest.raises(SystemExit, match="is not the transition model the benchmark planned with"):
+        am.replay(tiny_run_copy, {**bench, "transition_sha256": "0" * 16}, "astar", names, root)
