@@ -140,7 +140,7 @@ def _dense_group(group: Sequence[Rule]) -> DenseGroup:
     hi = np.full((len(group), len(cols)), COUNT_CAP + 1, np.int16)
     lo[rows, where] = los_a
     hi[rows, where] = np.minimum(his_a, COUNT_CAP + 1)
-    return cols.astype(np.int64), lo, hi, np.array([r.code_to for r in group], np.int64)
+    return cols, lo, hi, np.array([r.code_to for r in group], np.int64)
 
 
 def _first_overlap(lo: np.ndarray, hi: np.ndarray, max_cells: int = 1 << 22) -> tuple[int, int] | None:
