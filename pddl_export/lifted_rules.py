@@ -1,0 +1,305 @@
+"""Lifted rules: what one pick-and-release does to the pieces it touches, distilled from transitions.
+
+Physics here is local. An action (pick p, release r) takes the top piece at p (`o`), with whatever stands on
+a far-row stick's ends (its riders), off what it stood on (`u`), and puts it on the top piece at r (`v`); every
+other piece stays as it was. So a rule need not say which codes all other objects hold (the per-action rules
+of `pddl_export.rules` do): it names the pieces in those roles, describes each (type, kept learned bits,
+level, whether it stands at the action's location or covers it with a stick end) and says what each becomes.
+
+A rule's `key` keeps the structure of the move (`STRUCTURE`: the move's class, the types and presence of the
+roles, the riders' sides) and only the descriptions its outcome depends on: fields are added in `REFINEMENTS`
+order and the coarsest key under which every observed description agrees on one outcome is kept (a greedy
+decision list). Rules of one move are thus mutually consistent: wherever two match, they give one outcome.
+
+The class of a move is "cube" for a cube (lifted over both locations), "near" for a stick moved within the near
+row (nothing covers a neighbour there), and the concrete (p, r) pair otherwise: a far-row stick's ends cover its
+row neighbours, and which ones overlap before and after depends on the pair.
+
+`LiftedRules.step` applies them to a state's codes (the Python form of the PDDL that `lifted_writer` writes):
+a move no rule covers leaves the state as it is, as the PDDL offers no action for it.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from collections import Counter, defaultdict
+from dataclasses import dataclass, field
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from pddl_export.lifted_scene import FAR_ROW, NEAR_ROW, CodeLayout, Piece, SceneGraph, neighbours, read_scene, \
+    top_of
+
+LIFTED_KIND = "symlearn-lifted-rules"
+LIFTED_VERSION = 1
+MAX_LIFTED_BYTES = 64 << 20  # a lifted rules file is kilobytes; refuse anything near this
+STRUCTURE = ("cls", "o.stick", "o.level", "u.level", "v.level", "riders.sides", "riders.level")
+REFINEMENTS = (("o.kind",), ("riders.kind",))
+WHERE = ("to", "from", "stay", "shift")  # where a piece ends, relative to the action; an int is a location
+
+
+@dataclass(frozen=True)
+class Move:
+    """The pieces an action touches in one state (indices into its pieces)."""
+
+    pick: int
+    release: int
+    o: int
+    u: int | None
+    v: int | None
+    riders: tuple[int, ...]  # pieces on the ends of a far-row stick o, by side
+
+
+def move_class(o: Piece, pick: int, release: int):
+    """'cube', 'near' (a stick within the near row) or the (pick, release) pair of any other stick move."""
+    if not o.stick:
+        return "cube"
+    if pick in NEAR_ROW and release in NEAR_ROW:
+        return "near"
+    return (pick, release)
+
+
+def participants(graph: SceneGraph, pick: int, release: int) -> Move | str:
+    """The move an action makes in a scene, or why no lifted rule can describe it (a short reason)."""
+    if pick == release:
+        return "same location"
+    pieces = graph.pieces
+    o = graph.tops[pick]
+    if o is None:
+        return "nothing to pick"
+    if pieces[o].loc != pick or not pieces[o].on_location:
+        return "a stick end or an off-location piece"
+    riders = tuple(sorted((j for j, s in enumerate(graph.support) if s == o and pieces[j].loc != pick),
+                          key=lambda j: pieces[j].loc))
+    if any(s in riders for s in graph.support):
+        return "a tower on a stick end"
+    if any(graph.tops[pieces[j].loc] != j for j in riders):
+        return "a rider under another piece"
+    skip = frozenset((o, *riders))
+    v = top_of(pieces, release, skip)
+    if v is not None and release in pieces[o].covers():
+        return "a piece under the stick's end"
+    if pieces[o].stick and release in FAR_ROW:
+        if any(top_of(pieces, n, skip) is not None for n in neighbours(release)):
+            return "a stick laid over standing pieces"
+    return Move(pick, release, o, graph.support[o], v, riders)
+
+
+def signature(graph: SceneGraph, m: Move) -> dict:
+    """Every described field of a move (STRUCTURE and REFINEMENTS name them): what a lifted action can test."""
+    ps = graph.pieces
+    o = ps[m.o]
+    return {"cls": move_class(o, m.pick, m.release), "o.stick": o.stick, "o.kind": o.kind, "o.level": o.level,
+            "u.level": 0 if m.u is None else ps[m.u].level, "v.level": 0 if m.v is None else ps[m.v].level,
+            "riders.sides": tuple(ps[j].loc - m.pick for j in m.riders),
+            "riders.kind": tuple(ps[j].kind for j in m.riders),
+            "riders.level": tuple(ps[j].level for j in m.riders)}
+
+
+def key_of(sig: dict, depth: int) -> tuple:
+    """The key of a signature at a refinement depth: STRUCTURE, then the first `depth` REFINEMENTS."""
+    names = STRUCTURE + tuple(f for group in REFINEMENTS[:depth] for f in group)
+    return tuple((n, sig[n]) for n in names)
+
+
+Outcome = tuple  # per moved piece (o, riders...): (where, place, level, kind)
+
+
+def outcome_of(graph: SceneGraph, after: Sequence[Piece], m: Move) -> Outcome:
+    """What each piece of a move became, relative to the action where it can be."""
+    def rel(i: int | None):
+        if i is None:
+            return None
+        before, now = graph.pieces[i], after[i]
+        if now.loc == before.loc:
+            where = "stay"
+        elif now.loc == m.release:
+            where = "to"
+        elif now.loc == m.pick:
+            where = "from"
+        elif now.loc == before.loc + m.release - m.pick:
+            where = "shift"
+        else:
+            where = int(now.loc)
+        return (where, now.place, now.level, now.kind)
+    return tuple(rel(i) for i in (m.o, *m.riders))
+
+
+def _place(before: Piece, change, m: Move) -> Piece:
+    where, place, level, kind = change
+    loc = {"to": m.release, "from": m.pick, "stay": before.loc,
+           "shift": before.loc + m.release - m.pick}.get(where, where)
+    return Piece(kind=kind, stick=before.stick, loc=int(loc), place=place, level=level)
+
+
+def writable(outcome: Outcome) -> bool:
+    """Whether an outcome is a move a lifted action can state: the picked piece goes to the release location
+    (on it or off it)."""
+    return outcome[0][0] == "to"
+
+
+@dataclass(frozen=True)
+class Rule:
+    """One lifted rule: its refinement depth, its key (field, value) pairs, and the outcome of its move."""
+
+    depth: int
+    key: tuple
+    outcome: Outcome
+    support: int  # observed moves it was distilled from (all of its key's)
+
+    def fields(self) -> dict:
+        return dict(self.key)
+
+
+@dataclass(frozen=True)
+class LiftedRules:
+    """The distilled rules of a code layout, a type reader, and where they came from."""
+
+    layout: CodeLayout
+    stick_of: dict = field(hash=False)  # (learned code, level) -> is it a stick (majority in the data)
+    rules: tuple[Rule, ...] = ()
+    model_hash: str = ""
+    stats: dict = field(default_factory=dict, hash=False)
+
+    def __post_init__(self) -> None:
+        index = {}
+        for r in self.rules:
+            index[(r.depth, r.key)] = r
+        object.__setattr__(self, "_index", index)
+
+    def is_stick(self, code: int) -> bool:
+        """The type a located code reads as: the data's majority for its learned code and level (else level 1)."""
+        learned, level = self.layout.learned(code), int(code) & 7
+        got = self.stick_of.get((learned, level))
+        if got is None:
+            got = self.stick_of.get((learned, -1), level % 2 == 1)
+        return bool(got)
+
+    def pieces(self, codes: Iterable[int]) -> tuple[Piece, ...]:
+        return tuple(self.layout.piece(c, self.is_stick(c)) for c in codes)
+
+    def rule_for(self, sig: dict) -> Rule | None:
+        """The coarsest rule whose key the signature has, or None."""
+        for depth in range(len(REFINEMENTS) + 1):
+            r = self._index.get((depth, key_of(sig, depth)))
+            if r is not None:
+                return r
+        return None
+
+    def step_pieces(self, pieces: Sequence[Piece], action: int) -> tuple[tuple[Piece, ...], Rule | None]:
+        """The pieces after an action (pick * 6 + release), and the rule that fired (None: nothing changes)."""
+        pick, release = divmod(int(action), 6)
+        graph = read_scene(pieces)
+        m = participants(graph, pick, release)
+        if isinstance(m, str):
+            return tuple(pieces), None
+        rule = self.rule_for(signature(graph, m))
+        if rule is None:
+            return tuple(pieces), None
+        out = list(pieces)
+        for i, change in zip((m.o, *m.riders), rule.outcome):
+            if i is not None and change is not None:
+                out[i] = _place(pieces[i], change, m)
+        return tuple(out), rule
+
+    def to_json(self) -> dict:
+        return {"kind": LIFTED_KIND, "version": LIFTED_VERSION, "model_hash": self.model_hash,
+                "code_bits": self.layout.code_bits, "kept": list(self.layout.kept),
+                "stick_of": [[int(a), int(b), bool(s)] for (a, b), s in sorted(self.stick_of.items())],
+                "rules": [{"depth": r.depth, "key": [[k, v] for k, v in r.key],
+                           "outcome": [None if c is None else list(c) for c in r.outcome],
+                           "support": r.support} for r in self.rules],
+                "stats": self.stats}
+
+
+def stick_reader(codes: np.ndarray, mask: np.ndarray, is_stick: np.ndarray, layout: CodeLayout) -> dict:
+    """(learned code, level) -> majority type over the observed objects; (learned code, -1) over all levels."""
+    codes = np.asarray(codes)[np.asarray(mask, bool)]
+    sticks = np.asarray(is_stick)[np.asarray(mask, bool)].astype(bool)
+    votes: dict = defaultdict(Counter)
+    for c, s in zip(codes.tolist(), sticks.tolist()):
+        learned, level = layout.learned(c), c & 7
+        votes[(learned, level)][s] += 1
+        votes[(learned, -1)][s] += 1
+    return {k: c.most_common(1)[0][0] for k, c in votes.items()}
+
+
+def observed_moves(rules_like: LiftedRules, before: np.ndarray, after: np.ndarray, actions: np.ndarray,
+                   mask: np.ndarray) -> tuple[list[tuple[dict, Outcome]], Counter]:
+    """Every modelled move in (N, K) code arrays with its signature and outcome; a tally of the reasons others fail."""
+    moves, why = [], Counter()
+    for n in range(len(actions)):
+        k = int(np.asarray(mask[n]).sum())
+        pb = rules_like.pieces(before[n, :k].tolist())
+        pa = rules_like.pieces(after[n, :k].tolist())
+        graph = read_scene(pb)
+        pick, release = divmod(int(actions[n]), 6)
+        m = participants(graph, pick, release)
+        if isinstance(m, str):
+            why[m] += 1
+            continue
+        moves.append((signature(graph, m), outcome_of(graph, pa, m)))
+    return moves, why
+
+
+def distil_lifted(layout: CodeLayout, stick_of: dict, moves: Sequence[tuple[dict, Outcome]], min_count: int = 3,
+                  model_hash: str = "") -> LiftedRules:
+    """Rules from observed (signature, outcome) moves: each full description's majority outcome (seen at least
+    min_count times), kept at the coarsest key under which all descriptions agree."""
+    full = len(REFINEMENTS)
+    tally: dict = defaultdict(Counter)
+    for sig, out in moves:
+        tally[key_of(sig, full)][out] += 1
+    majority = {k: c.most_common(1)[0] for k, c in tally.items()}
+    majority = {k: (out, n) for k, (out, n) in majority.items() if n >= min_count}
+    sigs = {k: dict(k) for k in majority}
+    groups: dict = defaultdict(set)
+    support: Counter = Counter()
+    for k, sig in sigs.items():
+        for d in range(full + 1):
+            groups[(d, key_of(sig, d))].add(majority[k][0])
+            support[(d, key_of(sig, d))] += sum(tally[k].values())
+    rules, unwritable = {}, 0
+    for k, sig in sigs.items():
+        for d in range(full + 1):
+            g = (d, key_of(sig, d))
+            if len(groups[g]) == 1:
+                if writable(majority[k][0]):
+                    rules[g] = Rule(d, g[1], majority[k][0], support[g])
+                else:
+                    unwritable += 1
+                break
+    stats = {"moves": len(moves), "descriptions": len(tally), "kept_descriptions": len(majority),
+             "rules": len(rules), "descriptions_without_move": unwritable,
+             "agreement": _agreement(tally, majority)}
+    return LiftedRules(layout, stick_of, tuple(sorted(rules.values(), key=lambda r: (repr(r.key), r.depth))),
+                       model_hash, stats)
+
+
+def _agreement(tally: dict, majority: dict) -> float:
+    """Share of observed moves of kept descriptions whose outcome is their description's majority."""
+    total = sum(sum(tally[k].values()) for k in majority)
+    return round(sum(n for _, n in majority.values()) / total, 4) if total else 0.0
+
+
+def load_lifted(path) -> LiftedRules:
+    """LiftedRules back from to_json's form (RUN/pddl/lifted.json)."""
+    path = Path(path)
+    if not path.is_file() or path.stat().st_size > MAX_LIFTED_BYTES:
+        raise ValueError(f"{path} is not a lifted rules file of at most {MAX_LIFTED_BYTES} bytes")
+    try:
+        d = json.loads(path.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as e:
+        raise ValueError(f"{path} is not valid JSON: {e}") from None
+    if not isinstance(d, dict) or d.get("kind") != LIFTED_KIND or d.get("version") != LIFTED_VERSION:
+        raise ValueError(f"{path} is not a lifted rules file ({LIFTED_KIND} version {LIFTED_VERSION})")
+    try:
+        layout = CodeLayout(int(d["code_bits"]), tuple(int(b) for b in d["kept"]))
+        stick_of = {(int(a), int(b)): bool(s) for a, b, s in d["stick_of"]}
+        rules = tuple(Rule(int(r["depth"]), tuple((k, tuple(v) if isinstance(v, list) else v) for k, v in r["key"]),
+                           tuple(None if c is None else tuple(c) for c in r["outcome"]), int(r["support"]))
+                      for r in d["rules"])
+    except (KeyError, TypeError, ValueError) as e:
+        raise ValueError(f"{path}: malformed lifted rules ({e})") from None
+    return LiftedRules(layout, stick_of, rules, str(d.get("model_hash", "")), dict(d.get("stats", {})))

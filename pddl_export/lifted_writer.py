@@ -1,0 +1,265 @@
+"""The lifted PDDL domain of distilled rules, its problems, and plans read back as robot actions.
+
+One domain for any number of objects: typed blocks (`cube`, `stick`), the six table locations and eight levels as
+constants, and the relations a person would write for this table: `(at ?b ?l)`, `(level ?b ?h)`, `(on ?b ?s)`
+(a support is a block or the table), `(top ?l ?s)` (what an object released at ?l lands on) and `(off ?b)` (the
+block stands off its location; nothing picks it). The learned bits a rule tests are unary predicates
+(`bit-I`, I the learned bit's index; docs/DOMAIN.md says what each means in the shipped run). Each rule of
+`pddl_export.lifted_rules` is one action schema: STRIPS with typing, equality and negative preconditions, no
+conditional effects, no quantifiers, no axioms, so that every Fast Downward heuristic, pyperplan and pddlgym
+take it. `top` holds one support per location and `level` one level per block, so Fast Downward's translator
+finds both as mutex groups.
+
+A cube's rule and a stick's moved within the near row are lifted over both locations (`?from`, `?to`); a stick
+moved in or out of the far row covers its row neighbours with its ends, and which of those overlap depends on
+the pair, so its rules name the two locations (`pick-release-stick-l1-l2-...`).
+
+    >>> text = domain_pddl(rules)                                           # doctest: +SKIP
+    >>> problem_pddl(rules, start_codes, goal, "p01", text_name(rules))     # doctest: +SKIP
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+from pddl_export.lifted_rules import LiftedRules, Rule
+from pddl_export.lifted_scene import FAR_ROW, NEAR_ROW, N_LOCATIONS, neighbours, read_scene
+from pddl_export.symbolic import SymbolicGoal
+
+LEVELS = 8
+
+
+def loc_name(loc: int) -> str:
+    return f"l{int(loc)}"
+
+
+def level_name(h: int) -> str:
+    return f"h{int(h)}"
+
+
+def domain_name(rules: LiftedRules) -> str:
+    """The domain's name: carries the transition model's hash, so two runs' domains are told apart."""
+    return f"symlearn-{rules.model_hash or 'nohash'}"
+
+
+@dataclass(frozen=True)
+class Schema:
+    """One action schema: its name, the robot action it stands for, and its PDDL text."""
+
+    name: str
+    pick: int | None  # None: lifted (?from is the first parameter after the blocks)
+    release: int | None
+    text: str
+
+
+def _bit_literals(rules: LiftedRules, term: str, kind: int, present: bool = True) -> list[str]:
+    """Literals fixing a piece's kept learned bits to `kind` (packed in layout.kept order)."""
+    kept = rules.layout.kept
+    out = []
+    for pos, bit in enumerate(kept):
+        value = (kind >> (len(kept) - 1 - pos)) & 1
+        atom = f"(bit-{bit} {term})"
+        out.append(atom if value else f"(not {atom})")
+    return out if present else []
+
+
+def _bit_effects(rules: LiftedRules, term: str, new_kind: int, old_kind: int | None) -> list[str]:
+    """Effects setting the kept bits to new_kind (only those that differ where the old value is known)."""
+    kept = rules.layout.kept
+    out = []
+    for pos, bit in enumerate(kept):
+        shift = len(kept) - 1 - pos
+        value = (new_kind >> shift) & 1
+        if old_kind is not None and ((old_kind >> shift) & 1) == value:
+            continue
+        atom = f"(bit-{bit} {term})"
+        out.append(atom if value else f"(not {atom})")
+    return out
+
+
+def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
+    """The action schema of one rule (see the module docstring for the vocabulary)."""
+    f = rule.fields()
+    cls = f["cls"]
+    concrete = isinstance(cls, tuple)
+    pick, release = (cls if concrete else (None, None))
+    frm, to = (loc_name(pick), loc_name(release)) if concrete else ("?from", "?to")
+    ho, hu, hv = level_name(f["o.level"]), level_name(f["u.level"]), level_name(f["v.level"])
+    params: list[tuple[str, str]] = [("?o", "stick" if f["o.stick"] else "cube")]
+    if not concrete:
+        params += [("?from", "location"), ("?to", "location")]
+    pre: list[str] = [f"(at ?o {frm})", f"(level ?o {ho})", f"(height {frm} {ho})", f"(rests ?o {hu})"]
+    if not concrete:
+        pre.append("(not (= ?from ?to))")
+        if cls == "near":
+            pre += ["(near ?from)", "(near ?to)"]
+    if f.get("o.kind") is not None:
+        pre += _bit_literals(rules, "?o", f["o.kind"])
+    o_out, *r_out = rule.outcome
+    lands_on = o_out[1] == 0  # o ends on the release location (else off it)
+    new_o = level_name(o_out[2])
+
+    # before: the heights of every location o (or a rider) covers; after: those it covers at the release
+    before = {frm: ho}
+    under = {frm: hu}
+    riders = []
+    if concrete:
+        sides = f["riders.sides"]
+        for n in neighbours(pick):
+            side = n - pick
+            if side in sides:
+                i = sides.index(side)
+                term, hr = f"?r{i}", level_name(f["riders.level"][i])
+                params.append((term, "block"))
+                pre += [f"(at {term} {loc_name(n)})", f"(level {term} {hr})", f"(rests {term} {ho})"]
+                if f.get("riders.kind") is not None:
+                    pre += _bit_literals(rules, term, f["riders.kind"][i])
+                riders.append((i, n, term, hr))
+                before[loc_name(n)] = hr
+            else:
+                before[loc_name(n)] = ho
+            under[loc_name(n)] = level_name(0)
+    for loc, h in before.items():
+        pre.append(f"(height {loc} {h})")
+    after = {}
+    eff: list[str] = [f"(not (at ?o {frm}))", f"(at ?o {to})"]
+    if lands_on:
+        after[to] = new_o
+        for n in (neighbours(release) if concrete else ()):
+            after[loc_name(n)] = new_o
+        eff += [f"(not (rests ?o {hu}))", f"(rests ?o {hv})"]
+    else:
+        eff += [f"(not (rests ?o {hu}))", "(off ?o)"]
+    if new_o != ho:
+        eff += [f"(not (level ?o {ho}))", f"(level ?o {new_o})"]
+    eff += _bit_effects(rules, "?o", o_out[3], f.get("o.kind"))
+    for i, n, term, hr in riders:
+        change = r_out[i]
+        shifted = n + release - pick
+        new_r = level_name(change[2])
+        if change[0] == "shift" and change[1] == 0 and lands_on and shifted in neighbours(release):
+            after[loc_name(shifted)] = new_r
+            eff += [f"(not (at {term} {loc_name(n)}))", f"(at {term} {loc_name(shifted)})"]
+            if new_o != ho:
+                eff += [f"(not (rests {term} {ho}))", f"(rests {term} {new_o})"]
+        else:  # the rider falls off the stick: off its location from now on
+            where = change[0]
+            new_loc = {"stay": n, "shift": shifted}.get(where, where if isinstance(where, int) else n)
+            eff += [f"(not (rests {term} {ho}))", f"(off {term})"]
+            if new_loc != n and 0 <= new_loc < N_LOCATIONS:
+                eff += [f"(not (at {term} {loc_name(n)}))", f"(at {term} {loc_name(new_loc)})"]
+        if new_r != hr:
+            eff += [f"(not (level {term} {hr}))", f"(level {term} {new_r})"]
+        eff += _bit_effects(rules, term, change[3], f["riders.kind"][i] if f.get("riders.kind") else None)
+    # the release location and its neighbours must hold what the rule says before (empty beside a far stick)
+    if to not in before:
+        pre.append(f"(height {to} {hv})")
+    for n in (neighbours(release) if concrete else ()):
+        if loc_name(n) not in before:
+            pre.append(f"(height {loc_name(n)} {level_name(0)})")
+    for loc in list(before) + [x for x in after if x not in before]:
+        old = before.get(loc, hv if loc == to else level_name(0))
+        new = after.get(loc, under.get(loc, old))
+        if old != new:
+            eff += [f"(not (height {loc} {old}))", f"(height {loc} {new})"]
+
+    kind = "stick" if f["o.stick"] else "cube"
+    where = f"-{frm}-{to}" if concrete else ""
+    name = f"pick-release-{kind}{where}-{index}"
+    text = _schema_text(name, params, pre, eff, _comment(rule, f))
+    return Schema(name, pick, release, text)
+
+
+def _comment(rule: Rule, f: dict) -> str:
+    o = rule.outcome[0]
+    return (f"; rule of {rule.support} observed moves; {'a stick' if f['o.stick'] else 'a cube'} "
+            f"{'lands on its release location' if o[1] == 0 else 'ends off its release location'} at level {o[2]}")
+
+
+def _schema_text(name: str, params, pre, eff, comment: str) -> str:
+    ps = " ".join(f"{p} - {t}" for p, t in params)
+    pre_s = "\n      ".join(pre)
+    eff_s = "\n      ".join(eff)
+    return (f"  {comment}\n  (:action {name}\n    :parameters ({ps})\n    :precondition (and\n      {pre_s})\n"
+            f"    :effect (and\n      {eff_s}))\n")
+
+
+def schemas(rules: LiftedRules) -> tuple[Schema, ...]:
+    return tuple(rule_schema(rules, r, i) for i, r in enumerate(rules.rules))
+
+
+def domain_pddl(rules: LiftedRules) -> str:
+    """The lifted domain's text."""
+    bits = " ".join(f"(bit-{b} ?b - block)" for b in rules.layout.kept)
+    locs = " ".join(loc_name(i) for i in range(N_LOCATIONS))
+    lvls = " ".join(level_name(h) for h in range(LEVELS))
+    body = "".join(s.text for s in schemas(rules))
+    return (f"; A lifted domain distilled from the transition model {rules.model_hash or '(no hash)'} by symlearn.\n"
+            f"; Blocks stand at locations l0-l5 (far row l0-l2, near row l3-l5) on a support, at a level (5 cm layers).\n"
+            f"(define (domain {domain_name(rules)})\n"
+            "  (:requirements :strips :typing :negative-preconditions :equality)\n"
+            "  (:types block location layer - object cube stick - block)\n"
+            f"  (:constants {locs} - location {lvls} - layer)\n"
+            "  (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer) (rests ?b - block ?h - layer)\n"
+            "               (height ?l - location ?h - layer) (off ?b - block) (near ?l - location)"
+            + (f"\n               {bits}" if bits else "") + ")\n"
+            + body + ")\n")
+
+
+def object_name(i: int) -> str:
+    return f"o{i}"
+
+
+def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicGoal, name: str) -> str:
+    """A problem of the lifted domain: the start scene read from its codes, the goal's located fields."""
+    if len(goal.codes) != len(start_codes):
+        raise ValueError(f"the goal has {len(goal.codes)} objects, the start {len(start_codes)}")
+    pieces = rules.pieces(start_codes)
+    graph = read_scene(pieces)
+    objs = " ".join(f"{object_name(i)} - {'stick' if p.stick else 'cube'}" for i, p in enumerate(pieces))
+    init = [f"(near {loc_name(x)})" for x in NEAR_ROW]
+    for i, p in enumerate(pieces):
+        o = object_name(i)
+        if p.loc < N_LOCATIONS:
+            init.append(f"(at {o} {loc_name(p.loc)})")
+        init.append(f"(level {o} {level_name(p.level)})")
+        init += [a for a in _bit_literals(rules, o, p.kind) if not a.startswith("(not")]
+        if not p.on_location:
+            init.append(f"(off {o})")
+        else:
+            sup = graph.support[i]
+            init.append(f"(rests {o} {level_name(0 if sup is None else pieces[sup].level)})")
+    for loc, t in enumerate(graph.tops):
+        init.append(f"(height {loc_name(loc)} {level_name(0 if t is None else pieces[t].level)})")
+    goals = []
+    for i, code in enumerate(goal.codes):
+        if code is None:
+            continue
+        g = rules.layout.piece(code, pieces[i].stick)
+        o = object_name(i)
+        if g.loc < N_LOCATIONS:
+            goals.append(f"(at {o} {loc_name(g.loc)})")
+        goals.append(f"(level {o} {level_name(g.level)})")
+        if not g.on_location:
+            goals.append(f"(off {o})")
+    init_s = "\n    ".join(init)
+    goal_s = "\n    ".join(goals)
+    return (f"(define (problem {name})\n  (:domain {domain_name(rules)})\n  (:objects {objs})\n"
+            f"  (:init\n    {init_s})\n  (:goal (and\n    {goal_s})))\n")
+
+
+def plan_actions(rules: LiftedRules, steps: Sequence[str]) -> list[int]:
+    """Plan steps ('(pick-release-cube-3 o1 l0 l4 ...)') -> robot action ids (pick * 6 + release)."""
+    by_name = {s.name: s for s in schemas(rules)}
+    out = []
+    for step in steps:
+        words = step.strip().strip("()").split()
+        if not words or words[0].lower() not in by_name:
+            raise ValueError(f"plan step {step!r} names no action of the lifted domain")
+        s = by_name[words[0].lower()]
+        if s.pick is not None:
+            out.append(s.pick * N_LOCATIONS + s.release)
+        else:
+            frm, to = words[2].lower(), words[3].lower()
+            out.append(int(frm[1:]) * N_LOCATIONS + int(to[1:]))
+    return out

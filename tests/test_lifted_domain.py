@@ -1,0 +1,210 @@
+"""The lifted domain: located codes read as pieces, rules distilled from moves, and the PDDL that states them.
+
+The world here is the simulator's own symbolic model (symlearn.planning.stacking) written as located codes the way
+the encoder and location bits give them: eight learned bits of which five repeat the location (as the trained
+encoders' do, from the crops' image x and y), one says cube, one says "on the table", then location, place and
+level. Rules distilled from its moves must reproduce held-out moves exactly, and the PDDL must do what the rules do.
+"""
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from pddl_export.lifted_rules import LiftedRules, distil_lifted, load_lifted, observed_moves, participants, \
+    stick_reader
+from pddl_export.lifted_scene import CodeLayout, Piece, kept_bits, read_scene
+from pddl_export.lifted_writer import domain_pddl, object_name, plan_actions, problem_pddl
+from pddl_export.symbolic import SymbolicGoal
+from symlearn.planning.stacking import act, drop_all
+from symlearn.world import ObjectType
+
+LOC_PATTERN = (0b10101, 0b01101, 0b11011, 0b00110, 0b10010, 0b01001)  # five learned bits that track the location
+POSITION_BITS = (1, 3, 4, 5, 7)
+
+
+def _level(state, types, i) -> int:
+    g = state[i]
+    size = 1 if types[i] == ObjectType.STICK else 2
+    return size if g.on is None else _level(state, types, g.on) + size
+
+
+def located_code(state, types, i) -> int:
+    """Object i's 17-bit located code: learned bits (cube, on-table, location pattern), location, place 0, level."""
+    g = state[i]
+    learned = [0] * 8
+    learned[0] = int(types[i] == ObjectType.CUBE)
+    learned[6] = int(g.on is None)
+    for b, v in zip(POSITION_BITS, format(LOC_PATTERN[g.location], "05b")):
+        learned[b] = int(v)
+    code = int("".join(map(str, learned)), 2)
+    return (code << 9) | (g.location << 6) | (0 << 3) | _level(state, types, i)
+
+
+def world_moves(n: int, seed: int, objects=(1, 4)):
+    """(before codes, action, after codes, types) of random legal moves of the symbolic world."""
+    rng = np.random.default_rng(seed)
+    out = []
+    while len(out) < n:
+        k = int(rng.integers(objects[0], objects[1] + 1))
+        types = [ObjectType.STICK if i == 0 and rng.random() < 0.5 else ObjectType.CUBE for i in range(k)]
+        spec = [(t, int(rng.integers(0, 6))) for t in types]
+        try:
+            state = drop_all(spec)
+            for _ in range(int(rng.integers(0, 3))):  # a few moves first, for stacks and riders
+                state = act(state, types, int(rng.integers(0, 6)), int(rng.integers(0, 6)))
+            p, r = int(rng.integers(0, 6)), int(rng.integers(0, 6))
+            nxt = act(state, types, p, r)
+        except ValueError:
+            continue
+        if p == r:
+            continue
+        out.append(([located_code(state, types, i) for i in range(k)], p * 6 + r,
+                    [located_code(nxt, types, i) for i in range(k)], [t == ObjectType.STICK for t in types]))
+    return out
+
+
+def _arrays(moves):
+    k = max(len(m[0]) for m in moves)
+    before = np.full((len(moves), k), -1, np.int64)
+    after = before.copy()
+    stick = np.zeros((len(moves), k), bool)
+    for n, (b, a, nxt, st) in enumerate(moves):
+        before[n, :len(b)], after[n, :len(b)], stick[n, :len(b)] = b, nxt, st
+    return before, np.array([m[1] for m in moves]), after, before >= 0, stick
+
+
+def _distil(moves_list) -> LiftedRules:
+    before, actions, after, mask, stick = _arrays(moves_list)
+    objs = before[mask]
+    learned = (objs[:, None] >> (9 + np.arange(7, -1, -1))) & 1
+    layout = CodeLayout(8, kept_bits(learned, (objs >> 6) & 7))
+    stick_of = stick_reader(before, mask, stick, layout)
+    moves, _ = observed_moves(LiftedRules(layout, stick_of), before, after, actions, mask)
+    return distil_lifted(layout, stick_of, moves, min_count=1, model_hash="0123456789abcdef")
+
+
+@pytest.fixture(scope="module")
+def world_rules() -> LiftedRules:
+    return _distil(world_moves(1500, seed=0))
+
+
+@pytest.fixture(scope="module")
+def pair_rules() -> LiftedRules:
+    """Rules of two-object scenes only: a domain small enough for unified-planning's reader in seconds."""
+    return _distil(world_moves(400, seed=3, objects=(2, 2)))
+
+
+def test_the_bits_that_track_the_location_are_dropped(world_rules):
+    assert world_rules.layout.kept == (0, 6)  # cube and on-table; bit 2 never varies
+
+
+def test_a_far_stick_covers_its_neighbours_and_carries_its_rider():
+    layout = CodeLayout(8, (0, 6))
+    stick = Piece(kind=0b01, stick=True, loc=1, place=0, level=1)
+    rider = Piece(kind=0b10, stick=False, loc=0, place=0, level=3)
+    under = Piece(kind=0b11, stick=False, loc=4, place=0, level=2)
+    graph = read_scene((stick, rider, under))
+    assert graph.tops == (1, 0, 0, None, 2, None)
+    assert graph.support == (None, 0, None)
+    move = participants(graph, 1, 4)
+    assert (move.o, move.u, move.v, move.riders) == (0, None, 2, (1,))
+    assert participants(graph, 2, 4) == "a stick end or an off-location piece"
+    assert participants(graph, 3, 4) == "nothing to pick"
+    assert layout.piece(located_code(drop_all([(ObjectType.CUBE, 3)]), [ObjectType.CUBE], 0), False).level == 2
+
+
+def test_rules_reproduce_held_out_moves_of_the_world(world_rules):
+    test = world_moves(400, seed=1)
+    described = exact = 0
+    for before, action, after, _ in test:
+        pieces = world_rules.pieces(before)
+        got, rule = world_rules.step_pieces(pieces, action)
+        if rule is None:
+            continue
+        described += 1
+        exact += [(p.loc, p.place, p.level, p.kind) for p in got] == \
+                 [(p.loc, p.place, p.level, p.kind) for p in world_rules.pieces(after)]
+    assert described >= 0.9 * len(test)
+    assert exact == described
+
+
+def test_rules_round_trip_through_json(world_rules, tmp_path):
+    import json
+    path = tmp_path / "lifted.json"
+    path.write_text(json.dumps(world_rules.to_json()))
+    back = load_lifted(path)
+    assert back.rules == world_rules.rules and back.layout == world_rules.layout
+    assert back.stick_of == world_rules.stick_of
+    path.write_text('{"kind": "symlearn-lifted-rules", "version": 1, "rules": 3}')
+    with pytest.raises(ValueError, match="malformed lifted rules"):
+        load_lifted(path)
+
+
+def test_the_domain_is_small_plain_strips(world_rules):
+    text = domain_pddl(world_rules)
+    assert len(text.encode()) < 100_000
+    assert "(define (domain symlearn-0123456789abcdef)" in text
+    for word in ("when", "forall", "exists", ":derived", "either"):
+        assert word not in text
+
+
+def test_pddl_successors_are_the_rules(pair_rules):
+    """Every applicable ground action of the PDDL leads where the rules lead, for every action of sampled states."""
+    from unified_planning.io import PDDLReader
+    from unified_planning.shortcuts import SequentialSimulator, get_environment
+    get_environment().credits_stream = None
+    domain = domain_pddl(pair_rules)
+    states = [m[0] for m in world_moves(3, seed=2, objects=(2, 2))]
+    checked = 0
+    for start in states:
+        goal = SymbolicGoal(tuple(start))
+        problem = PDDLReader().parse_problem_string(domain, problem_pddl(pair_rules, start, goal, "p"))
+        pieces = pair_rules.pieces(start)
+        with SequentialSimulator(problem) as sim:
+            state = sim.get_initial_state()
+            by_action = {}
+            for action, params in sim.get_applicable_actions(state):
+                step = f"({action.name} {' '.join(str(p) for p in params)})"
+                by_action.setdefault(plan_actions(pair_rules, [step])[0], []).append(sim.apply(state, action, params))
+        for a in range(36):
+            want, rule = pair_rules.step_pieces(pieces, a)
+            assert (rule is not None) == (a in by_action), f"action {a} from {start}"
+            for nxt in by_action.get(a, []):
+                checked += 1
+                for i, p in enumerate(want):
+                    o = problem.object(object_name(i))
+                    at = [loc for loc in range(6) if nxt.get_value(problem.fluent("at")(o, problem.object(f"l{loc}"))).bool_constant_value()]
+                    lvl = [h for h in range(8) if nxt.get_value(problem.fluent("level")(o, problem.object(f"h{h}"))).bool_constant_value()]
+                    assert at == [p.loc] and lvl == [p.level], f"object {i} after action {a} from {start}"
+    assert checked >= 3
+
+
+def test_fast_downward_plans_a_tower_the_rules_build(world_rules, tmp_path):
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import up_fast_downward
+    driver = Path(up_fast_downward.__file__).parent / "downward" / "fast-downward.py"
+    types = [ObjectType.CUBE] * 3
+    start_state = drop_all([(t, loc) for t, loc in zip(types, (3, 4, 5))])
+    goal_state = start_state
+    for p, r in ((4, 0), (5, 0)):
+        goal_state = act(goal_state, types, p, r)
+    start = [located_code(start_state, types, i) for i in range(3)]
+    goal = [None, located_code(goal_state, types, 1), located_code(goal_state, types, 2)]
+    (tmp_path / "domain.pddl").write_text(domain_pddl(world_rules))
+    (tmp_path / "p01.pddl").write_text(problem_pddl(world_rules, start, SymbolicGoal(tuple(goal)), "p01"))
+    run = subprocess.run([sys.executable, str(driver), "--plan-file", "plan", "domain.pddl", "p01.pddl",
+                          "--search", "astar(lmcut())"], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stdout[-2000:]
+    steps = [s for s in (tmp_path / "plan").read_text().splitlines() if not s.startswith(";")]
+    plan = plan_actions(world_rules, steps)
+    assert len(plan) == 2  # optimal: both cubes onto location 0
+    pieces = world_rules.pieces(start)
+    for a in plan:
+        pieces, rule = world_rules.step_pieces(pieces, a)
+        assert rule is not None
+    assert [(p.loc, p.level) for p in pieces[1:]] == [(0, 2), (0, 4)]
