@@ -161,6 +161,9 @@ class LiftedRules:
     rules: tuple[Rule, ...] = ()
     model_hash: str = ""
     stats: dict = field(default_factory=dict, hash=False)
+    # (stick, kind, loc, place, level) -> the learned code observed most often with them: what a moved piece's
+    # whole code is predicted to be (its position-tracking bits follow its new location)
+    codebook: dict = field(default_factory=dict, hash=False)
 
     def __post_init__(self) -> None:
         index = {}
@@ -203,6 +206,25 @@ class LiftedRules:
                 out[i] = _place(pieces[i], change, m)
         return tuple(out), rule
 
+    def code_of(self, piece: Piece, old_code: int) -> int:
+        """A piece's whole located code: its fields, after the learned code the data shows most often with them
+        (else the old learned code with the kept bits set to the piece's kind)."""
+        learned = self.codebook.get((piece.stick, piece.kind, piece.loc, piece.place, piece.level))
+        if learned is None:
+            learned = self.layout.learned(old_code)
+            kept = self.layout.kept
+            for pos, bit in enumerate(kept):
+                mask = 1 << (self.layout.code_bits - 1 - bit)
+                value = (piece.kind >> (len(kept) - 1 - pos)) & 1
+                learned = (learned | mask) if value else (learned & ~mask)
+        return (int(learned) << 9) | (piece.loc << 6) | (piece.place << 3) | piece.level
+
+    def step_codes(self, codes: Sequence[int], action: int) -> tuple[tuple[int, ...], Rule | None]:
+        """The located codes after an action: unmoved objects keep theirs, moved ones get code_of their pieces."""
+        pieces = self.pieces(codes)
+        after, rule = self.step_pieces(pieces, action)
+        return tuple(int(c) if a == p else self.code_of(a, c) for c, p, a in zip(codes, pieces, after)), rule
+
     def to_json(self) -> dict:
         return {"kind": LIFTED_KIND, "version": LIFTED_VERSION, "model_hash": self.model_hash,
                 "code_bits": self.layout.code_bits, "kept": list(self.layout.kept),
@@ -210,6 +232,7 @@ class LiftedRules:
                 "rules": [{"depth": r.depth, "key": [[k, v] for k, v in r.key],
                            "outcome": [None if c is None else list(c) for c in r.outcome],
                            "support": r.support} for r in self.rules],
+                "codebook": [[bool(k[0]), *map(int, k[1:]), int(v)] for k, v in sorted(self.codebook.items())],
                 "stats": self.stats}
 
 
@@ -297,9 +320,33 @@ def load_lifted(path) -> LiftedRules:
     try:
         layout = CodeLayout(int(d["code_bits"]), tuple(int(b) for b in d["kept"]))
         stick_of = {(int(a), int(b)): bool(s) for a, b, s in d["stick_of"]}
+        codebook = {(bool(e[0]), int(e[1]), int(e[2]), int(e[3]), int(e[4])): int(e[5]) for e in d.get("codebook", [])}
         rules = tuple(Rule(int(r["depth"]), tuple((k, tuple(v) if isinstance(v, list) else v) for k, v in r["key"]),
                            tuple(None if c is None else tuple(c) for c in r["outcome"]), int(r["support"]))
                       for r in d["rules"])
     except (KeyError, TypeError, ValueError) as e:
         raise ValueError(f"{path}: malformed lifted rules ({e})") from None
-    return LiftedRules(layout, stick_of, rules, str(d.get("model_hash", "")), dict(d.get("stats", {})))
+    return LiftedRules(layout, stick_of, rules, str(d.get("model_hash", "")), dict(d.get("stats", {})), codebook)
+
+
+def build_codebook(rules_like: LiftedRules, codes: np.ndarray, mask: np.ndarray) -> dict:
+    """(stick, kind, loc, place, level) -> the learned code most often observed with them, over (N, K) codes."""
+    votes: dict = defaultdict(Counter)
+    for c in np.asarray(codes)[np.asarray(mask, bool)].tolist():
+        p = rules_like.layout.piece(c, rules_like.is_stick(c))
+        votes[(p.stick, p.kind, p.loc, p.place, p.level)][rules_like.layout.learned(c)] += 1
+    return {k: v.most_common(1)[0][0] for k, v in votes.items()}
+
+
+class LiftedTransition:
+    """The lifted rules as a transition function over located codes (pddl_export.symbolic.TransitionFn)."""
+
+    def __init__(self, rules: LiftedRules) -> None:
+        self.rules, self.bits = rules, rules.layout.bits
+
+    def __call__(self, codes: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        codes = np.asarray(codes, np.int64)
+        out = codes.copy()
+        for i, (row, a) in enumerate(zip(codes.tolist(), np.asarray(actions).tolist())):
+            out[i] = self.rules.step_codes(row, int(a))[0]
+        return out

@@ -127,8 +127,32 @@ def cmd_symbols(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_export_lifted(args: argparse.Namespace) -> int:
+    from symlearn.planning.lifted_export import LIFTED_DIR, LIFTED_FILE, LiftedConfig, export_lifted
+
+    given = {"min_count": args.min_count}
+    cfg = LiftedConfig(**{k: v for k, v in given.items() if v is not None})
+    set_threads(args.threads)
+    out = Path(args.out) if args.out else None
+    rep = export_lifted(Path(args.run), Path(args.data), tuple(Path(d) for d in args.extra_data), cfg, out)
+    where = out or Path(args.run) / "pddl"
+    print(f"kept learned bits {rep['kept_bits']} (bits {rep['position_bits']} track the location); "
+          f"{rep['moves']} moves of m(z) on observed scenes -> {rep['rules']} lifted rules "
+          f"({rep['domain_bytes']} bytes of PDDL)")
+    for data, checks in rep["checks_test_split"].items():
+        for group, c in checks.items():
+            print(f"  {data} test split, {group} objects ({c['cases']} steps): fidelity to m(z) "
+                  f"{c['fidelity_to_net']:.3f}; accuracy against what was observed: rules {c['accuracy_rules']:.3f}, "
+                  f"m(z) {c['accuracy_net']:.3f}")
+    print(f"wrote {where / LIFTED_DIR / 'domain.pddl'} and {where / LIFTED_FILE}")
+    return 0
+
+
 def cmd_export_pddl(args: argparse.Namespace) -> int:
     from symlearn.planning.export import ExportConfig, export_pddl
+
+    if args.lifted:
+        return cmd_export_lifted(args)
 
     given = {"max_objects": args.max_objects, "min_count": args.min_count, "closure": args.closure,
              "pddl_fidelity_cases": args.pddl_fidelity_cases, "scenes": args.scenes, "seed": args.seed,
@@ -257,6 +281,9 @@ def add_export_pddl_command(sub) -> None:
                    help="outcomes.json (rules-outcomes): keep an object's second likeliest next code where it is "
                         "at least this fraction as likely as the likeliest (default 0.05)")
     x.add_argument("--seed", type=int, help="seed of the sampled PDDL fidelity cases (default 0)")
+    x.add_argument("--lifted", action="store_true",
+                   help="write the lifted domain instead (RUN/pddl/lifted/domain.pddl, lifted.json): typed "
+                        "STRIPS schemas distilled from m(z) on observed scenes; needs --location-bits 9")
     x.add_argument("--threads", type=positive_int, help=THREADS_HELP)
     x.set_defaults(func=cmd_export_pddl)
 

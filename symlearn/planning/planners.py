@@ -38,6 +38,7 @@ import numpy as np
 
 from pddl_export.files import atomic_write_text, sha256_file
 from pddl_export.pddl_writer import conditional_domain, problem_pddl, strips_pddl
+from pddl_export.lifted_rules import LiftedRules, load_lifted
 from pddl_export.outcome_rules import MIN_OUTCOME_RATIO, OutcomeRules, load_outcomes
 from pddl_export.overrides import override_rules
 from pddl_export.rules import RuleSet, apply_rules_batch
@@ -66,6 +67,7 @@ class PlannerContext:
     write_dir: Path | None = None  # save every problem/task a planner writes here (None: keep nothing)
     risk_weight: float = 1.0  # astar-likely/-outcomes: an action costs 1 + risk_weight * (-log P(its predicted next state))
     outcomes: OutcomeRules | None = None  # RUN/pddl/outcomes.json, needed by rules-outcomes
+    lifted: LiftedRules | None = None  # RUN/pddl/lifted.json, needed by the planners on the lifted domain
 
     def __post_init__(self) -> None:
         if not (isinstance(self.risk_weight, (int, float)) and math.isfinite(self.risk_weight)
@@ -77,8 +79,9 @@ class PlannerContext:
                 risk_weight: float = 1.0) -> "PlannerContext":
         """A context for the named planners of a run: loads RUN/pddl/rules.json (and outcomes.json) only when needed."""
         specs = [planner_spec(n) for n in names]  # refuse unknown names before reading anything
+        lifted = load_run_lifted(Path(run_dir)) if any(s.needs_lifted for s in specs) else None
         if not any(s.needs_rules for s in specs):
-            return PlannerContext(write_dir=write_dir, risk_weight=risk_weight)
+            return PlannerContext(write_dir=write_dir, risk_weight=risk_weight, lifted=lifted)
         rules, model_hash = load_rules(Path(run_dir))
         check_rules_current(Path(run_dir), model_hash)
         outcomes = None
@@ -88,10 +91,23 @@ class PlannerContext:
                 raise ValueError(f"{Path(run_dir) / PDDL_DIR} holds rules.json and outcomes.json of different "
                                  f"transition models; re-run 'symlearn export-pddl --run {run_dir}'")
         return PlannerContext(rules=rules, model_hash=model_hash, write_dir=write_dir, risk_weight=risk_weight,
-                              outcomes=outcomes)
+                              outcomes=outcomes, lifted=lifted)
 
 
-def check_rules_current(run_dir: Path, model_hash: str) -> None:
+def load_run_lifted(run_dir: Path) -> LiftedRules:
+    """RUN/pddl/lifted.json, refused if missing or exported from another transition.pt than the run's."""
+    from symlearn.planning.lifted_export import LIFTED_FILE
+
+    path = Path(run_dir) / PDDL_DIR / LIFTED_FILE
+    if not path.is_file():
+        raise ValueError(f"no lifted domain at {path}; run 'symlearn export-pddl --run {run_dir} --lifted' "
+                         f"(it needs an m(z) on 9 location bits)")
+    lifted = load_lifted(path)
+    check_rules_current(Path(run_dir), lifted.model_hash, path)
+    return lifted
+
+
+def check_rules_current(run_dir: Path, model_hash: str, rules_path: Path | None = None) -> None:
     """Refuse rules exported from another transition.pt than the run's (the sha256 prefix export-pddl records)."""
     from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
 
@@ -100,7 +116,7 @@ def check_rules_current(run_dir: Path, model_hash: str) -> None:
         raise ValueError(f"no transition model at {path}; run 'symlearn train-transition' first")
     current = sha256_file(path)[:16]
     if not model_hash or model_hash != current:
-        raise ValueError(f"{Path(run_dir) / PDDL_DIR / RULES_FILE} was exported from another transition.pt "
+        raise ValueError(f"{rules_path or Path(run_dir) / PDDL_DIR / RULES_FILE} was exported from another transition.pt "
                          f"(model_hash {model_hash or 'missing'}, {path.name} is {current}); "
                          f"re-run 'symlearn export-pddl --run {run_dir}'")
 
@@ -113,6 +129,7 @@ class PlannerSpec:
     description: str
     needs_rules: bool  # plans on the exported rules (RUN/pddl/rules.json) rather than the network alone
     build: Callable[[PlannerContext], PlannerFn]
+    needs_lifted: bool = False  # plans on the lifted domain (RUN/pddl/lifted.json)
 
 
 # ------------------------------------------------------------------------------- learned-net A*
@@ -350,6 +367,24 @@ def _build_rules_planner(name: str, context: PlannerContext) -> PlannerFn:
     return make_pddl_planner(context.rules, context.model_hash, name, context.write_dir)
 
 
+# ------------------------------------------------------------------------------- stock planners, lifted domain
+
+# registry name -> (search.stock_planners configuration, description)
+LIFTED_PLANNERS = {
+    "fast-downward-lifted": ("fd-lama-first", "stock Fast Downward (its translator, LAMA's first iteration) on the "
+                             "lifted domain"),
+    "fast-downward-lifted-opt": ("fd-lmcut", "stock Fast Downward, optimal A* with LM-cut, on the lifted domain"),
+}
+
+
+def _build_lifted_planner(name: str, engine: str, context: PlannerContext) -> PlannerFn:
+    if context.lifted is None:
+        raise ValueError(f"planner {name!r} plans on the lifted domain (RUN/pddl/lifted.json); "
+                         f"run 'symlearn export-pddl --lifted' first")
+    from symlearn.planning.lifted_planner import LiftedPlanner
+    return LiftedPlanner(context.lifted, name, engine, context.write_dir)
+
+
 # ------------------------------------------------------------------------------- the registry
 
 
@@ -366,6 +401,8 @@ def _registry() -> Mapping[str, PlannerSpec]:
     specs.append(PlannerSpec(OUTCOME_RULES_PLANNER, "A* over the rules and each object's second likeliest outcome "
                              "(the exported all-outcomes determinization), a deviation costing 1 - w log of its "
                              "odds", True, _build_outcome_rules_planner))
+    specs += [PlannerSpec(n, desc, False, partial(_build_lifted_planner, n, engine), needs_lifted=True)
+              for n, (engine, desc) in LIFTED_PLANNERS.items()]
     return types.MappingProxyType({s.name: s for s in specs})
 
 

@@ -1,0 +1,167 @@
+"""`symlearn export-pddl --lifted`: the lifted domain of a run's m(z), distilled on observed scenes.
+
+m(z) is asked for its likeliest next codes on every training scene of the given data sets (each state as the
+robot saw it, with the action it took); each answer is read as a move of pieces (pddl_export.lifted_rules)
+and the moves are distilled into lifted rules. They are checked on the sets' held-out test splits: against
+m(z)'s own likeliest step (fidelity) and against what the robot observed next (accuracy, beside m(z)'s own),
+whole scenes compared on what the domain states (kept learned bits, location, place, level).
+
+Needs an m(z) on 9 location bits (`train-transition --location-bits 9`): location, place and level are the
+relations of the domain. Writes RUN/pddl/lifted.json (the rules, the layout, the type reader, the checks)
+and RUN/pddl/lifted/domain.pddl.
+"""
+from __future__ import annotations
+
+import time
+from collections import Counter
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pddl_export.files import atomic_write_text, sha256_file
+from pddl_export.lifted_rules import LiftedRules, build_codebook, distil_lifted, observed_moves, stick_reader
+from pddl_export.lifted_scene import FIELD_BITS, CodeLayout, kept_bits
+from pddl_export.lifted_writer import domain_pddl
+from pddl_export.rules_io import PDDL_DIR
+from symlearn.provenance import atomic_write_json, versions
+
+LIFTED_FILE = "lifted.json"
+LIFTED_DIR = "lifted"
+
+
+@dataclass(frozen=True)
+class LiftedConfig:
+    """How the lifted rules are distilled."""
+
+    min_count: int = 3  # a description of a move becomes a rule once m(z) answered it this often
+    min_info: float = 0.25  # a learned bit with this much mutual information (bits) with the location tracks it
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.min_count, int) and self.min_count >= 1):
+            raise ValueError(f"min_count={self.min_count!r} must be a positive integer")
+        if not 0 < self.min_info <= 3:
+            raise ValueError(f"min_info={self.min_info!r} must lie in (0, 3]")
+
+
+@dataclass(frozen=True)
+class Split:
+    """One split's codes as m(z) reads them, with actions and the recorded object types."""
+
+    before: np.ndarray  # (N, K) int64, -1 padding
+    after: np.ndarray
+    action: np.ndarray  # (N,)
+    mask: np.ndarray  # (N, K) bool
+    stick: np.ndarray  # (N, K) bool: the recorded type (to name what a learned code is)
+
+
+def _split(reader, data_dir: Path, split: str) -> Split:
+    from symlearn.data.dataset import load_split
+    from symlearn.symbolic.symbols import encode_codes
+
+    data = load_split(data_dir, split)
+    mask = data.mask
+    return Split(encode_codes(reader, data.pre_depth, data.pre_origin, mask),
+                 encode_codes(reader, data.post_depth, data.post_origin, mask),
+                 data.action.astype(np.int64), mask, data.obj_type == 1)
+
+
+def network_steps(transition, codes: np.ndarray, actions: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """m(z)'s likeliest next codes for every row of (N, K) codes with -1 padding (rows grouped by object count)."""
+    out = np.full(codes.shape, -1, np.int64)
+    counts = mask.sum(1)
+    for k in np.unique(counts):
+        rows = np.flatnonzero(counts == k)
+        if k == 0:
+            continue
+        out[rows, :k] = transition(codes[rows, :k].astype(np.int64), actions[rows].astype(np.int64))
+    return out
+
+
+def _fields(rules: LiftedRules, pieces) -> list[tuple]:
+    return [(p.kind, p.loc, p.place, p.level) for p in pieces]
+
+
+def check_lifted(rules: LiftedRules, split: Split, net_next: np.ndarray) -> dict:
+    """Whole-scene agreement on a split, by object count: the rules against m(z), each against the observation."""
+    tally: dict = {}
+    for n in range(len(split.action)):
+        k = int(split.mask[n].sum())
+        before = rules.pieces(split.before[n, :k].tolist())
+        mine, fired = rules.step_pieces(before, int(split.action[n]))
+        net = _fields(rules, rules.pieces(net_next[n, :k].tolist()))
+        seen = _fields(rules, rules.pieces(split.after[n, :k].tolist()))
+        mine = _fields(rules, mine)
+        for group in ("all", "1-3" if k <= 3 else "4-5"):
+            t = tally.setdefault(group, Counter())
+            t["cases"] += 1
+            t["rules_vs_net"] += mine == net
+            t["rules_vs_observed"] += mine == seen
+            t["net_vs_observed"] += net == seen
+            t["rule_fired"] += fired is not None
+    return {g: {"cases": t["cases"], "fidelity_to_net": round(t["rules_vs_net"] / t["cases"], 4),
+                "accuracy_rules": round(t["rules_vs_observed"] / t["cases"], 4),
+                "accuracy_net": round(t["net_vs_observed"] / t["cases"], 4),
+                "rule_fired": round(t["rule_fired"] / t["cases"], 4)} for g, t in tally.items()}
+
+
+def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = (), cfg: LiftedConfig = LiftedConfig(),
+                  out_dir: Path | None = None) -> dict:
+    """Distil, write and check the lifted domain of a run; returns its report (also in lifted.json)."""
+    from symlearn.data.dataset import data_fingerprint, data_records, distinct_extra_data
+    from symlearn.symbolic.learned_transition import planning_models
+    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
+
+    run_dir = Path(run_dir)
+    out = Path(out_dir) if out_dir else run_dir / PDDL_DIR
+    reader, transition = planning_models(run_dir)
+    if reader.location_bits != FIELD_BITS:
+        raise ValueError(f"{run_dir / TRANSITION_FILE}: a lifted domain needs m(z) on {FIELD_BITS} location bits "
+                         f"(train-transition --location-bits {FIELD_BITS}); this one has {reader.location_bits}")
+    model_hash = sha256_file(run_dir / TRANSITION_FILE)[:16]
+    extra_data = distinct_extra_data(data_dir, extra_data)
+    t0 = time.perf_counter()
+    sets = [Path(d) for d in (data_dir, *extra_data)]
+    train = [_split(reader, d, "train") for d in sets]
+    code_bits = reader.bits - FIELD_BITS
+    objects = np.concatenate([s.before[s.mask] for s in train])
+    learned = (objects[:, None] >> (FIELD_BITS + np.arange(code_bits - 1, -1, -1))) & 1
+    locations = (objects >> 6) & 7
+    layout = CodeLayout(code_bits, kept_bits(learned, locations, cfg.min_info))
+    width = max(s.mask.shape[1] for s in train)
+    stick_of = stick_reader(np.concatenate([_pad(s.before, width) for s in train]),
+                            np.concatenate([_pad(s.mask, width) for s in train]),
+                            np.concatenate([_pad(s.stick, width) for s in train]), layout)
+    probe = LiftedRules(layout, stick_of)
+    moves, why = [], Counter()
+    for s in train:
+        m, w = observed_moves(probe, s.before, network_steps(transition, s.before, s.action, s.mask), s.action, s.mask)
+        moves += m
+        why.update(w)
+    rules = distil_lifted(layout, stick_of, moves, cfg.min_count, model_hash)
+    t_distil = time.perf_counter() - t0
+    checks = {}
+    for d in sets:
+        test = _split(reader, d, "test")
+        checks[str(d)] = check_lifted(rules, test, network_steps(transition, test.before, test.action, test.mask))
+    domain = domain_pddl(rules)
+    report = {"run": str(run_dir), "model_hash": model_hash, "config": asdict(cfg), "data": str(data_dir),
+              "data_fingerprint": data_fingerprint(data_dir), "extra_data": data_records(extra_data),
+              "kept_bits": list(layout.kept), "position_bits": [b for b in range(code_bits) if b not in layout.kept],
+              "moves_not_described": dict(why), "checks_test_split": checks, "domain_bytes": len(domain.encode()),
+              "n_schemas": len(rules.rules), "seconds": round(time.perf_counter() - t0, 1),
+              "distil_seconds": round(t_distil, 1), "versions": versions()}
+    codebook = build_codebook(probe, np.concatenate([_pad(s.before, width) for s in train]
+                                                    + [_pad(s.after, width) for s in train]),
+                              np.concatenate([_pad(s.mask, width) for s in train] * 2))
+    rules = LiftedRules(layout, stick_of, rules.rules, model_hash, {**rules.stats, **report}, codebook)
+    (out / LIFTED_DIR).mkdir(parents=True, exist_ok=True)
+    atomic_write_text(out / LIFTED_DIR / "domain.pddl", domain)
+    atomic_write_json(out / LIFTED_FILE, rules.to_json())
+    return rules.stats
+
+
+def _pad(a: np.ndarray, k: int) -> np.ndarray:
+    """Object slots padded to k (with -1 for codes, False for masks and types)."""
+    fill = -1 if a.dtype.kind in "iu" else False
+    return np.pad(a, ((0, 0), (0, k - a.shape[1])), constant_values=fill)
