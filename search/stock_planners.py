@@ -146,6 +146,7 @@ def _reason(out: str, err: str) -> str:
     lines = [ln.strip() for ln in lines if ln.strip() and not re.match(r"^\d{4}-\d\d-\d\d .* (INFO|DEBUG) ", ln)]
     if any(ln.startswith("Traceback") for ln in lines):
         return lines[-1]  # a Python exception: its last line says what
+    lines = [ln for ln in lines if not ln.startswith("Warning")] or lines  # e.g. a type named like a predicate
     if lines:
         return " ".join(lines[:3])
     kept = [ln.strip() for ln in out.splitlines() if ln.strip() and not _NOISE.match(ln.strip())]
