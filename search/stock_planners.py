@@ -137,8 +137,18 @@ def _input_error(path: Path, what: str) -> str | None:
     return None
 
 
-def _reason(out: str, err: str) -> str:
-    """The planner's own one-line account of a failure: its error output, else the last lines of its log."""
+def _reason(out: str, err: str, translator: bool = False) -> str:
+    """The planner's own one-line account of a failure.
+
+    For Fast Downward's translator, the error lines of its log (it prints them on standard output,
+    its warnings on standard error); else, and where the log has none, the error output: a Python
+    exception's last line, or its first lines.
+    """
+    if translator:
+        section = out.split("Running translator.", 1)[-1].split("translate exit code", 1)[0]
+        kept = [ln.strip() for ln in section.splitlines() if ln.strip() and not _NOISE.match(ln.strip())]
+        if kept:
+            return " ".join(kept[-2:])
     lines = []
     for ln in err.splitlines():
         m = _BYTES_REPR.match(ln.strip())  # the driver prints a component's captured stderr as a bytes literal
@@ -146,11 +156,7 @@ def _reason(out: str, err: str) -> str:
     lines = [ln.strip() for ln in lines if ln.strip() and not re.match(r"^\d{4}-\d\d-\d\d .* (INFO|DEBUG) ", ln)]
     if any(ln.startswith("Traceback") for ln in lines):
         return lines[-1]  # a Python exception: its last line says what
-    lines = [ln for ln in lines if not ln.startswith("Warning")] or lines  # e.g. a type named like a predicate
-    if lines:
-        return " ".join(lines[:3])
-    kept = [ln.strip() for ln in out.splitlines() if ln.strip() and not _NOISE.match(ln.strip())]
-    return " ".join(kept[-2:])
+    return " ".join([ln for ln in lines if not ln.startswith("Warning")][:3] or lines[:2])
 
 
 def _read_plan(folder: Path, name: str) -> tuple[list[str], float | None] | str | None:
@@ -246,7 +252,7 @@ def _finish(planner: str, spec: StockPlanner, code: int | None, out: str, err: s
         if code is not None and code < 0:
             why = f"was killed by signal {-code}"
         if status is PlanStatus.ERROR:
-            reason = _reason(out, err)
+            reason = _reason(out, err, translator=fd and code in (30, 31))
             why = f"{planner}: {why}" + (f": {reason}" if reason else "")
         return failed(planner, status, t0, why, **extra)
     steps, cost = read
