@@ -4,7 +4,9 @@ The task is a hand-written lifted toy of the table, written here: 3 blocks on 3 
 (block, location, tier: a height), one `pick-release ?o ?from ?to ?hf ?hf1 ?ht ?ht1` schema that moves the top block
 of ?from onto ?to, with a negative precondition (`(not (at ?o ?to))`: ?from and ?to differ). Plans are
 checked with pyval (pddl-pyvalidator, a validator on unified-planning's parser, not Fast Downward's),
-and optimal lengths against a breadth-first search over stacks written in this file.
+and optimal lengths against a breadth-first search over stacks written in this file. Every variable carries
+its own type (`?a - t ?b - t`, not `?a ?b - t`), which pddlgym's parser needs; no type shares a predicate's
+name (`level`), which unified-planning's parser, and so pyval, refuses.
 """
 from __future__ import annotations
 
@@ -24,9 +26,9 @@ DOMAIN = """(define (domain toy-table)
   (:requirements :strips :typing :negative-preconditions{costreq})
   (:types block location tier)
   (:predicates (at ?o - block ?l - location) (level ?o - block ?h - tier) (height ?l - location ?h - tier)
-               (succ ?h ?h2 - tier){pred})
+               (succ ?h - tier ?h2 - tier){pred})
   {functions}(:action pick-release
-    :parameters (?o - block ?from ?to - location ?hf ?hf1 ?ht ?ht1 - tier)
+    :parameters (?o - block ?from - location ?to - location ?hf - tier ?hf1 - tier ?ht - tier ?ht1 - tier)
     :precondition (and (at ?o ?from) {differ} (level ?o ?hf) (succ ?hf ?hf1) (height ?from ?hf1)
                        (height ?to ?ht) (succ ?ht ?ht1))
     :effect (and (not (at ?o ?from)) (at ?o ?to) (not (level ?o ?hf)) (level ?o ?ht)
@@ -36,8 +38,8 @@ NEG_DOMAIN = DOMAIN.format(costreq="", pred="", functions="", differ="(not (at ?
 COST_DOMAIN = DOMAIN.format(costreq=" :action-costs", pred="", functions="(:functions (total-cost) - number)\n  ",
                             differ="(not (at ?o ?to))", cost=" (increase (total-cost) 2)")
 # pyperplan takes no negative preconditions: "?from and ?to differ" as a static predicate instead
-POS_DOMAIN = DOMAIN.format(costreq="", pred=" (differ ?a ?b - location)", functions="", differ="(differ ?from ?to)",
-                           cost="").replace(" :negative-preconditions", "")
+POS_DOMAIN = DOMAIN.format(costreq="", pred=" (differ ?a - location ?b - location)", functions="",
+                           differ="(differ ?from ?to)", cost="").replace(" :negative-preconditions", "")
 DIFFER = " ".join(f"(differ l{i} l{j})" for i in range(3) for j in range(3) if i != j)
 
 # the tower b1 (bottom), b2, b3 at l0, rebuilt in reverse at l0: 7 moves (tower_optimum)
