@@ -278,10 +278,9 @@ def _solve_in(tmp: Path, domain: Path, problem: Path, planner: str, timeout_s: f
               action_id: Callable[[str], int] | None, memory_mb: int) -> PlanResult:
     """Run the planner on the two files with tmp as its working folder (inside planner_guard and temp_dir)."""
     spec = STOCK_PLANNERS[planner]
-    if spec.tool == "pyperplan":  # it writes PROBLEM.soln beside the problem: work on copies inside tmp
-        domain, problem = (shutil.copyfile(domain, tmp / "domain.pddl") if domain.parent != tmp else domain,
-                           shutil.copyfile(problem, tmp / "problem.pddl") if problem.parent != tmp else problem)
-        domain, problem = Path(domain), Path(problem)
+    if spec.tool == "pyperplan" and problem.parent != tmp:  # it writes PROBLEM.soln beside the problem:
+        domain = Path(shutil.copyfile(domain, tmp / "domain.pddl"))  # it works on copies in the run's folder
+        problem = Path(shutil.copyfile(problem, tmp / "problem.pddl"))
     args = _command(spec, domain, problem, tmp, memory_mb)
     if isinstance(args, str):
         return failed(planner, PlanStatus.ERROR, t0, args)
