@@ -78,6 +78,10 @@ class PlanResult:
     extra: Mapping[str, ExtraValue] = field(default_factory=dict, hash=False)  # small metrics
     # further plans of a top-k planner, best first, each (plan, predicted_states); the main plan not among them
     alternatives: tuple[tuple[tuple[int, ...], tuple[tuple[int, ...], ...]], ...] = field(default=(), hash=False)
+    # the ground plan as a PDDL planner wrote it, e.g. "(pick-release b1 l0 l3)", one str per step; () for planners
+    # that plan on action ids. A stock planner on a domain whose steps are not mapped to action ids returns a
+    # SOLVED result with steps and an empty plan (search.stock_planners)
+    steps: tuple[str, ...] = field(default=(), hash=False)
 
     def __post_init__(self) -> None:
         set_ = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
@@ -128,6 +132,15 @@ class PlanResult:
                 raise ValueError("an alternative's predicted states must hold start + one state per action")
             alts.append((a_plan, a_states))
         set_("alternatives", tuple(alts))
+        steps = tuple(self.steps)
+        if steps:
+            if self.status is not PlanStatus.SOLVED:
+                raise ValueError("steps are only allowed with status solved")
+            if any(not isinstance(x, str) or not x or "\n" in x for x in steps):
+                raise ValueError("steps must be non-empty one-line str")
+            if plan and len(plan) != len(steps):
+                raise ValueError(f"steps must match the plan's actions one to one: {len(plan)}, got {len(steps)}")
+        set_("steps", steps)
 
     @property
     def found(self) -> bool:
@@ -135,8 +148,8 @@ class PlanResult:
         return self.status is PlanStatus.SOLVED
 
     def to_json(self) -> dict[str, Any]:
-        """Plain JSON-ready dict (lists, str status) that from_json reads back."""
-        return {
+        """Plain JSON-ready dict (lists, str status) that from_json reads back ("steps" only when there are some)."""
+        out = {
             "planner": self.planner,
             "status": self.status.value,
             "plan": list(self.plan),
@@ -147,6 +160,9 @@ class PlanResult:
             "extra": dict(self.extra),
             "alternatives": [[list(p), [list(x) for x in st]] for p, st in self.alternatives],
         }
+        if self.steps:
+            out["steps"] = list(self.steps)
+        return out
 
     @classmethod
     def from_json(cls, d: Mapping[str, Any]) -> PlanResult:
@@ -161,6 +177,7 @@ class PlanResult:
             message=d.get("message", ""),
             extra=dict(d.get("extra", {})),
             alternatives=tuple((tuple(p), tuple(tuple(x) for x in st)) for p, st in d.get("alternatives", ())),
+            steps=tuple(d.get("steps", ())),
         )
 
     def __reduce__(self):
