@@ -34,7 +34,8 @@ from pddl_export.lifted_scene import FAR_ROW, NEAR_ROW, CodeLayout, Piece, Scene
 LIFTED_KIND = "symlearn-lifted-rules"
 LIFTED_VERSION = 1
 MAX_LIFTED_BYTES = 64 << 20  # a lifted rules file is kilobytes; refuse anything near this
-STRUCTURE = ("cls", "o.stick", "o.level", "u.level", "v.level", "riders.sides", "riders.level")
+STRUCTURE = ("cls", "o.stick", "o.level", "u.level", "v.level", "riders.sides", "riders.level", "beneath",
+             "landing")
 REFINEMENTS = (("o.kind",), ("riders.kind",))
 WHERE = ("to", "from", "stay", "shift")  # where a piece ends, relative to the action; an int is a location
 
@@ -46,9 +47,11 @@ class Move:
     pick: int
     release: int
     o: int
-    u: int | None
+    under: int  # the level left at the pick location once o (and its riders) are lifted
     v: int | None
     riders: tuple[int, ...]  # pieces on the ends of a far-row stick o, by side
+    beneath: tuple[int, ...] = ()  # a far-row stick o: the level under each of its ends (its pick's neighbours)
+    landing: tuple[int, ...] = ()  # a stick released in the far row: the level at each neighbour it will cover
 
 
 def move_class(o: Piece, pick: int, release: int):
@@ -78,12 +81,14 @@ def participants(graph: SceneGraph, pick: int, release: int) -> Move | str:
         return "a rider under another piece"
     skip = frozenset((o, *riders))
     v = top_of(pieces, release, skip)
-    if v is not None and release in pieces[o].covers():
-        return "a piece under the stick's end"
-    if pieces[o].stick and release in FAR_ROW:
-        if any(top_of(pieces, n, skip) is not None for n in neighbours(release)):
-            return "a stick laid over standing pieces"
-    return Move(pick, release, o, graph.support[o], v, riders)
+
+    def level_at(loc: int) -> int:
+        t = top_of(pieces, loc, skip)
+        return 0 if t is None else pieces[t].level
+    stick = pieces[o].stick
+    beneath = tuple(level_at(n) for n in neighbours(pick)) if stick else ()
+    landing = tuple(level_at(n) for n in neighbours(release)) if stick else ()
+    return Move(pick, release, o, level_at(pick), v, riders, beneath, landing)
 
 
 def signature(graph: SceneGraph, m: Move) -> dict:
@@ -91,10 +96,10 @@ def signature(graph: SceneGraph, m: Move) -> dict:
     ps = graph.pieces
     o = ps[m.o]
     return {"cls": move_class(o, m.pick, m.release), "o.stick": o.stick, "o.kind": o.kind, "o.level": o.level,
-            "u.level": 0 if m.u is None else ps[m.u].level, "v.level": 0 if m.v is None else ps[m.v].level,
+            "u.level": m.under, "v.level": 0 if m.v is None else ps[m.v].level,
             "riders.sides": tuple(ps[j].loc - m.pick for j in m.riders),
             "riders.kind": tuple(ps[j].kind for j in m.riders),
-            "riders.level": tuple(ps[j].level for j in m.riders)}
+            "riders.level": tuple(ps[j].level for j in m.riders), "beneath": m.beneath, "landing": m.landing}
 
 
 def key_of(sig: dict, depth: int) -> tuple:
@@ -324,6 +329,10 @@ def load_lifted(path) -> LiftedRules:
         rules = tuple(Rule(int(r["depth"]), tuple((k, tuple(v) if isinstance(v, list) else v) for k, v in r["key"]),
                            tuple(None if c is None else tuple(c) for c in r["outcome"]), int(r["support"]))
                       for r in d["rules"])
+        for r in rules:
+            names = tuple(k for k, _ in r.key)
+            if names[:len(STRUCTURE)] != STRUCTURE or not 0 <= r.depth <= len(REFINEMENTS):
+                raise ValueError(f"a rule's key names {names[:len(STRUCTURE)]}, expected {STRUCTURE}")
     except (KeyError, TypeError, ValueError) as e:
         raise ValueError(f"{path}: malformed lifted rules ({e})") from None
     return LiftedRules(layout, stick_of, rules, str(d.get("model_hash", "")), dict(d.get("stats", {})), codebook)

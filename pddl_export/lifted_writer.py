@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from typing import Sequence
 
 from pddl_export.lifted_rules import LiftedRules, Rule
-from pddl_export.lifted_scene import FAR_ROW, NEAR_ROW, N_LOCATIONS, neighbours, read_scene
+from pddl_export.lifted_scene import FAR_ROW, NEAR_ROW, N_LOCATIONS, neighbours, read_scene, top_of
 from pddl_export.symbolic import SymbolicGoal
 
 LEVELS = 8
@@ -88,7 +88,8 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
     params: list[tuple[str, str]] = [("?o", "stick" if f["o.stick"] else "cube")]
     if not concrete:
         params += [("?from", "location"), ("?to", "location")]
-    pre: list[str] = [f"(at ?o {frm})", f"(level ?o {ho})", f"(height {frm} {ho})", f"(rests ?o {hu})"]
+    pre: list[str] = [f"(at ?o {frm})", f"(level ?o {ho})", f"(rests ?o {hu})"]
+    eff: list[str] = []
     if not concrete:
         pre.append("(not (= ?from ?to))")
         if cls == "near":
@@ -99,13 +100,13 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
     lands_on = o_out[1] == 0  # o ends on the release location (else off it)
     new_o = level_name(o_out[2])
 
-    # before: the heights of every location o (or a rider) covers; after: those it covers at the release
+    # before: the heights of the locations o (or a rider) covers; `under`: what is left there once o is lifted
     before = {frm: ho}
     under = {frm: hu}
     riders = []
     if concrete:
         sides = f["riders.sides"]
-        for n in neighbours(pick):
+        for n, hb in zip(neighbours(pick), f["beneath"]):
             side = n - pick
             if side in sides:
                 i = sides.index(side)
@@ -118,18 +119,35 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
                 before[loc_name(n)] = hr
             else:
                 before[loc_name(n)] = ho
-            under[loc_name(n)] = level_name(0)
+            under[loc_name(n)] = level_name(hb)
+            pre.append(f"(beneath {loc_name(n)} {level_name(hb)})")
+            eff.append(f"(not (beneath {loc_name(n)} {level_name(hb)}))")
     for loc, h in before.items():
         pre.append(f"(height {loc} {h})")
+    # what the release location and (for a far-row stick) its neighbours hold once o is lifted
+    if to in before:
+        if under[to] != hv:
+            raise ValueError(f"rule {index}: the release location's level {hv} is not what lies under the stick")
+    else:
+        pre.append(f"(height {to} {hv})")
+    landing = dict(zip((loc_name(n) for n in neighbours(release)), map(level_name, f["landing"]))) \
+        if concrete and lands_on else {}
+    for loc, h in landing.items():
+        if loc in before:
+            if under[loc] != h:
+                raise ValueError(f"rule {index}: a neighbour's level {h} is not what lies under the stick")
+        else:
+            pre.append(f"(height {loc} {h})")
     after = {}
-    eff: list[str] = [f"(not (at ?o {frm}))", f"(at ?o {to})"]
+    eff += [f"(not (at ?o {frm}))", f"(at ?o {to})", f"(not (rests ?o {hu}))"]
     if lands_on:
         after[to] = new_o
-        for n in (neighbours(release) if concrete else ()):
-            after[loc_name(n)] = new_o
-        eff += [f"(not (rests ?o {hu}))", f"(rests ?o {hv})"]
+        for loc, h in landing.items():
+            after[loc] = new_o
+            eff.append(f"(beneath {loc} {h})")
+        eff.append(f"(rests ?o {hv})")
     else:
-        eff += [f"(not (rests ?o {hu}))", "(off ?o)"]
+        eff.append("(off ?o)")
     if new_o != ho:
         eff += [f"(not (level ?o {ho}))", f"(level ?o {new_o})"]
     eff += _bit_effects(rules, "?o", o_out[3], f.get("o.kind"))
@@ -151,23 +169,34 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
         if new_r != hr:
             eff += [f"(not (level {term} {hr}))", f"(level {term} {new_r})"]
         eff += _bit_effects(rules, term, change[3], f["riders.kind"][i] if f.get("riders.kind") else None)
-    # the release location and its neighbours must hold what the rule says before (empty beside a far stick)
-    if to not in before:
-        pre.append(f"(height {to} {hv})")
-    for n in (neighbours(release) if concrete else ()):
-        if loc_name(n) not in before:
-            pre.append(f"(height {loc_name(n)} {level_name(0)})")
     for loc in list(before) + [x for x in after if x not in before]:
-        old = before.get(loc, hv if loc == to else level_name(0))
+        old = before.get(loc, hv if loc == to else landing.get(loc))
         new = after.get(loc, under.get(loc, old))
         if old != new:
             eff += [f"(not (height {loc} {old}))", f"(height {loc} {new})"]
+    # beneath facts a landing re-adds where it also lifted them cancel out; keep the effects consistent
+    eff = _net_effects(eff)
 
     kind = "stick" if f["o.stick"] else "cube"
     where = f"-{frm}-{to}" if concrete else ""
     name = f"pick-release-{kind}{where}-{index}"
     text = _schema_text(name, params, pre, eff, _comment(rule, f))
     return Schema(name, pick, release, text)
+
+
+def _net_effects(eff: list[str]) -> list[str]:
+    """Drop a delete and an add of the same atom (the atom keeps its value), keeping the first order otherwise."""
+    adds = {e for e in eff if not e.startswith("(not ")}
+    dels = {e[5:-1] for e in eff if e.startswith("(not ")}
+    both = adds & dels
+    out, seen = [], set()
+    for e in eff:
+        atom = e[5:-1] if e.startswith("(not ") else e
+        if atom in both or e in seen:
+            continue
+        seen.add(e)
+        out.append(e)
+    return out
 
 
 def _comment(rule: Rule, f: dict) -> str:
@@ -201,7 +230,8 @@ def domain_pddl(rules: LiftedRules) -> str:
             "  (:types block location layer - object cube stick - block)\n"
             f"  (:constants {locs} - location {lvls} - layer)\n"
             "  (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer) (rests ?b - block ?h - layer)\n"
-            "               (height ?l - location ?h - layer) (off ?b - block) (near ?l - location)"
+            "               (height ?l - location ?h - layer) (beneath ?l - location ?h - layer) (off ?b - block)\n"
+            "               (near ?l - location)"
             + (f"\n               {bits}" if bits else "") + ")\n"
             + body + ")\n")
 
@@ -226,11 +256,15 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
         init += [a for a in _bit_literals(rules, o, p.kind) if not a.startswith("(not")]
         if not p.on_location:
             init.append(f"(off {o})")
-        else:
-            sup = graph.support[i]
-            init.append(f"(rests {o} {level_name(0 if sup is None else pieces[sup].level)})")
+        else:  # the level under it at its own location
+            below = top_of(pieces, p.loc, frozenset(j for j, q in enumerate(pieces) if q.level >= p.level))
+            init.append(f"(rests {o} {level_name(0 if below is None else pieces[below].level)})")
     for loc, t in enumerate(graph.tops):
         init.append(f"(height {loc_name(loc)} {level_name(0 if t is None else pieces[t].level)})")
+        for i, p in enumerate(pieces):  # a far-row stick's end over loc: the level under it
+            if p.stick and p.on_location and p.loc != loc and loc in p.covers():
+                below = top_of(pieces, loc, frozenset(j for j, q in enumerate(pieces) if q.level >= p.level))
+                init.append(f"(beneath {loc_name(loc)} {level_name(0 if below is None else pieces[below].level)})")
     goals = []
     for i, code in enumerate(goal.codes):
         if code is None:
