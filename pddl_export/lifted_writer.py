@@ -58,8 +58,7 @@ def _bit_literals(rules: LiftedRules, term: str, kind: int, present: bool = True
     out = []
     for pos, bit in enumerate(kept):
         value = (kind >> (len(kept) - 1 - pos)) & 1
-        atom = f"(bit-{bit} {term})"
-        out.append(atom if value else f"(not {atom})")
+        out.append(f"(bit-{bit} {term})" if value else f"(no-bit-{bit} {term})")
     return out if present else []
 
 
@@ -72,8 +71,8 @@ def _bit_effects(rules: LiftedRules, term: str, new_kind: int, old_kind: int | N
         value = (new_kind >> shift) & 1
         if old_kind is not None and ((old_kind >> shift) & 1) == value:
             continue
-        atom = f"(bit-{bit} {term})"
-        out.append(atom if value else f"(not {atom})")
+        on, off = f"(bit-{bit} {term})", f"(no-bit-{bit} {term})"
+        out += [on, f"(not {off})"] if value else [off, f"(not {on})"]
     return out
 
 
@@ -91,7 +90,7 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
     pre: list[str] = [f"(at ?o {frm})", f"(level ?o {ho})", f"(rests ?o {hu})"]
     eff: list[str] = []
     if not concrete:
-        pre.append("(not (= ?from ?to))")
+        pre.append("(differ ?from ?to)")
         if cls == "near":
             pre += ["(near ?from)", "(near ?to)"]
     if f.get("o.kind") is not None:
@@ -219,19 +218,19 @@ def schemas(rules: LiftedRules) -> tuple[Schema, ...]:
 
 def domain_pddl(rules: LiftedRules) -> str:
     """The lifted domain's text."""
-    bits = " ".join(f"(bit-{b} ?b - block)" for b in rules.layout.kept)
+    bits = " ".join(f"(bit-{b} ?b - block) (no-bit-{b} ?b - block)" for b in rules.layout.kept)
     locs = " ".join(loc_name(i) for i in range(N_LOCATIONS))
     lvls = " ".join(level_name(h) for h in range(LEVELS))
     body = "".join(s.text for s in schemas(rules))
     return (f"; A lifted domain distilled from the transition model {rules.model_hash or '(no hash)'} by symlearn.\n"
             f"; Blocks stand at locations l0-l5 (far row l0-l2, near row l3-l5) on a support, at a level (5 cm layers).\n"
             f"(define (domain {domain_name(rules)})\n"
-            "  (:requirements :strips :typing :negative-preconditions :equality)\n"
+            "  (:requirements :strips :typing)\n"
             "  (:types block location layer - object cube stick - block)\n"
             f"  (:constants {locs} - location {lvls} - layer)\n"
             "  (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer) (rests ?b - block ?h - layer)\n"
             "               (height ?l - location ?h - layer) (beneath ?l - location ?h - layer) (off ?b - block)\n"
-            "               (near ?l - location)"
+            "               (near ?l - location) (differ ?a - location ?b - location)"
             + (f"\n               {bits}" if bits else "") + ")\n"
             + body + ")\n")
 
@@ -248,12 +247,13 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
     graph = read_scene(pieces)
     objs = " ".join(f"{object_name(i)} - {'stick' if p.stick else 'cube'}" for i, p in enumerate(pieces))
     init = [f"(near {loc_name(x)})" for x in NEAR_ROW]
+    init += [f"(differ {loc_name(a)} {loc_name(b)})" for a in range(N_LOCATIONS) for b in range(N_LOCATIONS) if a != b]
     for i, p in enumerate(pieces):
         o = object_name(i)
         if p.loc < N_LOCATIONS:
             init.append(f"(at {o} {loc_name(p.loc)})")
         init.append(f"(level {o} {level_name(p.level)})")
-        init += [a for a in _bit_literals(rules, o, p.kind) if not a.startswith("(not")]
+        init += _bit_literals(rules, o, p.kind)
         if not p.on_location:
             init.append(f"(off {o})")
         else:  # the level under it at its own location
