@@ -128,8 +128,13 @@ def cmd_symbols(args: argparse.Namespace) -> int:
 
 
 def cmd_export_lifted(args: argparse.Namespace) -> int:
-    from symlearn.planning.lifted_export import LIFTED_DIR, LIFTED_FILE, LiftedConfig, export_lifted
+    from symlearn.planning.lifted_export import (LIFTED_DIR, LIFTED_FILE, MAX_DATA_OBJECTS, LiftedConfig,
+                                                 export_lifted, write_problem_folder)
 
+    from symlearn.planning.problem import load_problems
+
+    for d in args.problems or []:
+        load_problems(Path(d))  # a missing, empty or malformed problem set is refused before any work
     given = {"min_count": args.min_count}
     cfg = LiftedConfig(**{k: v for k, v in given.items() if v is not None})
     set_threads(args.threads)
@@ -145,6 +150,13 @@ def cmd_export_lifted(args: argparse.Namespace) -> int:
                   f"{c['fidelity_to_net']:.3f}; accuracy against what was observed: rules {c['accuracy_rules']:.3f}, "
                   f"m(z) {c['accuracy_net']:.3f}")
     print(f"wrote {where / LIFTED_DIR / 'domain.pddl'} and {where / LIFTED_FILE}")
+    for d in args.problems or []:
+        index = write_problem_folder(Path(args.run), Path(d))
+        folder = where / LIFTED_DIR / Path(d).name
+        print(f"wrote {folder}: domain.pddl and {len(index['problems'])} problems (p01.pddl ...), index.json")
+        if index["zero_shot"]:
+            print(f"warning: {len(index['zero_shot'])} problems of {d} have more than {MAX_DATA_OBJECTS} objects, "
+                  f"more than any scene the rules were distilled from", file=sys.stderr)
     return 0
 
 
@@ -153,6 +165,8 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
 
     if args.lifted:
         return cmd_export_lifted(args)
+    if args.problems:
+        raise ValueError("--problems writes problem folders of the lifted domain: it needs --lifted")
 
     given = {"max_objects": args.max_objects, "min_count": args.min_count, "closure": args.closure,
              "pddl_fidelity_cases": args.pddl_fidelity_cases, "scenes": args.scenes, "seed": args.seed,
@@ -284,6 +298,9 @@ def add_export_pddl_command(sub) -> None:
     x.add_argument("--lifted", action="store_true",
                    help="write the lifted domain instead (RUN/pddl/lifted/domain.pddl, lifted.json): typed "
                         "STRIPS schemas distilled from m(z) on observed scenes; needs --location-bits 9")
+    x.add_argument("--problems", nargs="+", metavar="DIR",
+                   help="with --lifted: also write each problem set as a standalone folder "
+                        "(RUN/pddl/lifted/SET/domain.pddl, p01.pddl, ..., index.json)")
     x.add_argument("--threads", type=positive_int, help=THREADS_HELP)
     x.set_defaults(func=cmd_export_pddl)
 

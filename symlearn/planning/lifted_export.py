@@ -165,3 +165,50 @@ def _pad(a: np.ndarray, k: int) -> np.ndarray:
     """Object slots padded to k (with -1 for codes, False for masks and types)."""
     fill = -1 if a.dtype.kind in "iu" else False
     return np.pad(a, ((0, 0), (0, k - a.shape[1])), constant_values=fill)
+
+
+MAX_DATA_OBJECTS = 5  # the most objects a scene of the data sets had: problems beyond it are zero-shot
+
+
+def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None = None) -> dict:
+    """A standalone benchmark folder of a problem set: the lifted domain.pddl and one pNN.pddl per problem.
+
+    Each problem's start and goal are the run's codes of its scenes (rendered in the simulator), as the
+    planners see them; index.json maps pNN to the source problem, its object count and shortest plan length
+    where the problem file records it. Loading the folder needs no torch, no pybullet: only a PDDL planner.
+    Returns the index; problems with more objects than the data ever showed are listed under `zero_shot`.
+    """
+    from pddl_export.lifted_rules import load_lifted
+    from pddl_export.lifted_writer import problem_pddl
+    from symlearn.planning.problem import load_problems
+    from symlearn.planning.scenes import scene_codes, symbolic_goal
+    from symlearn.sim.simulator import TabletopSimulator
+    from symlearn.symbolic.learned_transition import planning_models
+
+    run_dir, problems_dir = Path(run_dir), Path(problems_dir)
+    rules = load_lifted(run_dir / PDDL_DIR / LIFTED_FILE)
+    problems = load_problems(problems_dir)  # refuses a missing or empty folder before any work
+    out = Path(out_dir) if out_dir else run_dir / PDDL_DIR / LIFTED_DIR / problems_dir.name
+    reader, _ = planning_models(run_dir)
+    index = {"domain": "domain.pddl", "model_hash": rules.model_hash, "source": str(problems_dir),
+             "problems": {}, "zero_shot": []}
+    texts = {}
+    sim = TabletopSimulator()
+    try:
+        for n, (path, problem) in enumerate(problems):
+            name = f"p{n + 1:02d}"
+            goal = symbolic_goal(sim, reader, problem)
+            start = scene_codes(sim, reader, problem.initial)
+            texts[name] = problem_pddl(rules, [int(c) for c in start], goal, name)
+            index["problems"][name] = {"file": path.name, "objects": problem.k,
+                                       "optimal_length": getattr(problem, "optimal_length", None)}
+            if problem.k > MAX_DATA_OBJECTS:
+                index["zero_shot"].append(name)
+    finally:
+        sim.close()
+    out.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(out / "domain.pddl", domain_pddl(rules))
+    for name, text in texts.items():
+        atomic_write_text(out / f"{name}.pddl", text)
+    atomic_write_json(out / "index.json", index)
+    return index
