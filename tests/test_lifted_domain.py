@@ -211,3 +211,44 @@ def test_stock_planners_plan_a_tower_the_rules_build(world_rules, tmp_path, plan
         pieces, rule = world_rules.step_pieces(pieces, a)
         assert rule is not None
     assert [(p.loc, p.level) for p in pieces[1:]] == [(0, 2), (0, 4)]
+
+
+def test_export_lifted_and_plan_with_stock_fast_downward_on_a_tiny_run(tiny_run_copy, tiny_data, tmp_path):
+    """The whole route on real codes: m(z) on 9 location bits, export-pddl --lifted, the registry's planner."""
+    import json
+
+    import pyval
+
+    from conftest import TINY_TRANSITION_ARGS, cli
+    from symlearn.data.dataset import load_split
+    from symlearn.planning.export import training_codes
+    from symlearn.planning.planners import PlannerContext, make_planner
+    from symlearn.symbolic.learned_transition import planning_models
+
+    run = tiny_run_copy
+    rc, _ = cli("export-pddl", "--run", run, "--data", tiny_data.path, "--lifted")
+    assert rc == 2  # the tiny run's m(z) reads no location bits: refused in one line
+    rc, _ = cli("train-transition", "--run", run, "--data", tiny_data.path, *TINY_TRANSITION_ARGS,
+                "--location-bits", "9", "--quiet")
+    assert rc == 0
+    rc, text = cli("export-pddl", "--run", run, "--data", tiny_data.path, "--lifted", "--min-count", "1")
+    assert rc == 0 and "lifted rules" in text
+    lifted = load_lifted(run / "pddl" / "lifted.json")
+    report = json.loads((run / "pddl" / "lifted.json").read_text())["stats"]
+    assert lifted.rules and report["model_hash"] == lifted.model_hash and "checks_test_split" in report
+    before, after = training_codes(run, tiny_data.path, planning_models(run)[0])
+    actions = load_split(tiny_data.path, "train").action
+    case = next((row[row >= 0].tolist(), int(a)) for row, a in zip(before, actions)
+                if lifted.step_codes(row[row >= 0].tolist(), int(a))[1] is not None)
+    start, action = case
+    want = lifted.step_codes(start, action)[0]
+    planner = make_planner("fast-downward-lifted", PlannerContext.for_run(run, ["fast-downward-lifted"],
+                                                                            write_dir=tmp_path / "tasks"))
+    res = planner(None, np.asarray(start), SymbolicGoal(tuple(want)), 60.0)
+    assert res.found and len(res.plan) <= 1, res.message
+    fields = lambda codes: [(p.loc, p.place, p.level) for p in lifted.pieces(codes)]  # noqa: E731
+    assert fields(res.predicted_states[-1]) == fields(want)
+    (tmp_path / "plan.txt").write_text("".join(f"{s}\n" for s in res.steps))
+    verdict = pyval.PDDLValidator().validate(str(tmp_path / "tasks" / "domain.pddl"),
+                                             str(tmp_path / "tasks" / "problem.pddl"), str(tmp_path / "plan.txt"))
+    assert verdict.status == "VALID"
