@@ -271,6 +271,9 @@ def _settings(run_dir: Path, sets: list[Path], problems: list[SetProblem], plann
                                                     for p in problems))[:16]}
     if any(p in RISK_PLANNERS for p in planners):  # only then does the weight change a result
         out["risk_weight"] = risk_weight
+    if any(planner_spec(n).needs_lifted for n in planners):  # a re-export changes what they plan on
+        from symlearn.planning.lifted_export import LIFTED_FILE
+        out["lifted_sha256"] = sha256_file(run_dir / PDDL_DIR / LIFTED_FILE)[:16]
     return out
 
 
