@@ -34,8 +34,8 @@ from pddl_export.lifted_scene import FAR_ROW, NEAR_ROW, CodeLayout, Piece, Scene
 LIFTED_KIND = "symlearn-lifted-rules"
 LIFTED_VERSION = 1
 MAX_LIFTED_BYTES = 64 << 20  # a lifted rules file is kilobytes; refuse anything near this
-STRUCTURE = ("cls", "o.stick", "o.level", "u.level", "v.level", "riders.sides", "riders.level", "beneath",
-             "landing")
+STRUCTURE = ("cls", "o.stick", "o.place", "o.level", "u.level", "v.level", "riders.sides", "riders.place",
+             "riders.level", "beneath", "landing")
 REFINEMENTS = (("o.kind",), ("riders.kind",))
 WHERE = ("to", "from", "stay", "shift")  # where a piece ends, relative to the action; an int is a location
 
@@ -71,8 +71,8 @@ def participants(graph: SceneGraph, pick: int, release: int) -> Move | str:
     o = graph.tops[pick]
     if o is None:
         return "nothing to pick"
-    if pieces[o].loc != pick or not pieces[o].on_location:
-        return "a stick end or an off-location piece"
+    if pieces[o].loc != pick:
+        return "a stick's end"
     riders = tuple(sorted((j for j, s in enumerate(graph.support) if s == o and pieces[j].loc != pick),
                           key=lambda j: pieces[j].loc))
     if any(s in riders for s in graph.support):
@@ -86,7 +86,7 @@ def participants(graph: SceneGraph, pick: int, release: int) -> Move | str:
         t = top_of(pieces, loc, skip)
         return 0 if t is None else pieces[t].level
     stick = pieces[o].stick
-    beneath = tuple(level_at(n) for n in neighbours(pick)) if stick else ()
+    beneath = tuple(level_at(n) for n in neighbours(pick)) if stick and pieces[o].place == 0 else ()
     landing = tuple(level_at(n) for n in neighbours(release)) if stick else ()
     return Move(pick, release, o, level_at(pick), v, riders, beneath, landing)
 
@@ -96,6 +96,7 @@ def signature(graph: SceneGraph, m: Move) -> dict:
     ps = graph.pieces
     o = ps[m.o]
     return {"cls": move_class(o, m.pick, m.release), "o.stick": o.stick, "o.kind": o.kind, "o.level": o.level,
+            "o.place": o.place, "riders.place": tuple(ps[j].place for j in m.riders),
             "u.level": m.under, "v.level": 0 if m.v is None else ps[m.v].level,
             "riders.sides": tuple(ps[j].loc - m.pick for j in m.riders),
             "riders.kind": tuple(ps[j].kind for j in m.riders),

@@ -93,10 +93,13 @@ class Piece:
         return self.place == 0 and self.loc < N_LOCATIONS
 
     def covers(self) -> tuple[int, ...]:
-        """The locations whose top this piece can be: its own, and a far-row stick's neighbours."""
-        if not self.on_location:
+        """The locations whose top this piece can be: its nearest one (on it or off it), and the row neighbours of
+        a far-row stick lying on its location (its ends)."""
+        if self.loc >= N_LOCATIONS:
             return ()
-        return tuple(sorted((self.loc, *neighbours(self.loc)))) if self.stick else (self.loc,)
+        if self.stick and self.place == 0:
+            return tuple(sorted((self.loc, *neighbours(self.loc))))
+        return (self.loc,)
 
 
 @dataclass(frozen=True)
@@ -105,7 +108,7 @@ class SceneGraph:
 
     pieces: tuple[Piece, ...]
     tops: tuple[int | None, ...]  # per location 0-5
-    support: tuple[int | None, ...]  # per piece; None for the table or a piece off its location
+    support: tuple[int | None, ...]  # per piece; None for the table or an unseen piece
 
 
 def top_of(pieces: Sequence[Piece], loc: int, skip: frozenset = frozenset()) -> int | None:
@@ -138,7 +141,7 @@ def read_scene(pieces: Sequence[Piece]) -> SceneGraph:
     """The scene graph of one state's pieces."""
     pieces = tuple(pieces)
     tops = tuple(top_of(pieces, loc) for loc in range(N_LOCATIONS))
-    support = tuple(support_of(pieces, i) if p.on_location else None for i, p in enumerate(pieces))
+    support = tuple(support_of(pieces, i) if p.loc < N_LOCATIONS else None for i, p in enumerate(pieces))
     return SceneGraph(pieces, tops, support)
 
 

@@ -87,7 +87,8 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
     params: list[tuple[str, str]] = [("?o", "stick" if f["o.stick"] else "cube")]
     if not concrete:
         params += [("?from", "location"), ("?to", "location")]
-    pre: list[str] = [f"(at ?o {frm})", f"(level ?o {ho})", f"(rests ?o {hu})"]
+    pre: list[str] = [f"(at ?o {frm})", f"(level ?o {ho})", f"(rests ?o {hu})",
+                      f"(place ?o {place_name(f['o.place'])})"]
     eff: list[str] = []
     if not concrete:
         pre.append("(differ ?from ?to)")
@@ -96,7 +97,7 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
     if f.get("o.kind") is not None:
         pre += _bit_literals(rules, "?o", f["o.kind"])
     o_out, *r_out = rule.outcome
-    lands_on = o_out[1] == 0  # o ends on the release location (else off it)
+    lands_on = o_out[1] == 0  # o ends on the release location (else off it: a far stick then covers no neighbour)
     new_o = level_name(o_out[2])
 
     # before: the heights of the locations o (or a rider) covers; `under`: what is left there once o is lifted
@@ -111,7 +112,8 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
                 i = sides.index(side)
                 term, hr = f"?r{i}", level_name(f["riders.level"][i])
                 params.append((term, "block"))
-                pre += [f"(at {term} {loc_name(n)})", f"(level {term} {hr})", f"(rests {term} {ho})"]
+                pre += [f"(at {term} {loc_name(n)})", f"(level {term} {hr})", f"(rests {term} {ho})",
+                        f"(place {term} {place_name(f['riders.place'][i])})"]
                 if f.get("riders.kind") is not None:
                     pre += _bit_literals(rules, term, f["riders.kind"][i])
                 riders.append((i, n, term, hr))
@@ -137,16 +139,12 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
                 raise ValueError(f"rule {index}: a neighbour's level {h} is not what lies under the stick")
         else:
             pre.append(f"(height {loc} {h})")
-    after = {}
-    eff += [f"(not (at ?o {frm}))", f"(at ?o {to})", f"(not (rests ?o {hu}))"]
-    if lands_on:
-        after[to] = new_o
-        for loc, h in landing.items():
-            after[loc] = new_o
-            eff.append(f"(beneath {loc} {h})")
-        eff.append(f"(rests ?o {hv})")
-    else:
-        eff.append("(off ?o)")
+    after = {to: new_o}
+    eff += [f"(not (at ?o {frm}))", f"(at ?o {to})", f"(not (rests ?o {hu}))", f"(rests ?o {hv})"]
+    for loc, h in landing.items():
+        after[loc] = new_o
+        eff.append(f"(beneath {loc} {h})")
+    eff += _place_effect("?o", f["o.place"], o_out[1])
     if new_o != ho:
         eff += [f"(not (level ?o {ho}))", f"(level ?o {new_o})"]
     eff += _bit_effects(rules, "?o", o_out[3], f.get("o.kind"))
@@ -154,17 +152,21 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
         change = r_out[i]
         shifted = n + release - pick
         new_r = level_name(change[2])
-        if change[0] == "shift" and change[1] == 0 and lands_on and shifted in neighbours(release):
+        if change[0] == "shift" and lands_on and shifted in neighbours(release):  # rides along
             after[loc_name(shifted)] = new_r
             eff += [f"(not (at {term} {loc_name(n)}))", f"(at {term} {loc_name(shifted)})"]
             if new_o != ho:
                 eff += [f"(not (rests {term} {ho}))", f"(rests {term} {new_o})"]
-        else:  # the rider falls off the stick: off its location from now on
+        else:  # it falls: it stays at its place's location (or the one m(z) says), on the table
             where = change[0]
             new_loc = {"stay": n, "shift": shifted}.get(where, where if isinstance(where, int) else n)
-            eff += [f"(not (rests {term} {ho}))", f"(off {term})"]
-            if new_loc != n and 0 <= new_loc < N_LOCATIONS:
+            if not 0 <= new_loc < N_LOCATIONS:
+                raise ValueError(f"rule {index}: a rider ends at no location ({new_loc})")
+            after[loc_name(new_loc)] = new_r
+            eff += [f"(not (rests {term} {ho}))", f"(rests {term} {level_name(0)})"]
+            if new_loc != n:
                 eff += [f"(not (at {term} {loc_name(n)}))", f"(at {term} {loc_name(new_loc)})"]
+        eff += _place_effect(term, f["riders.place"][i], change[1])
         if new_r != hr:
             eff += [f"(not (level {term} {hr}))", f"(level {term} {new_r})"]
         eff += _bit_effects(rules, term, change[3], f["riders.kind"][i] if f.get("riders.kind") else None)
@@ -181,6 +183,19 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
     name = f"pick-release-{kind}{where}-{index}"
     text = _schema_text(name, params, pre, eff, _comment(rule, f))
     return Schema(name, pick, release, text)
+
+
+PLACES = ("on-spot", "minus-y-near", "minus-y-mid", "minus-y-far", "plus-y-near", "plus-y-mid", "plus-y-far", "off-x")
+
+
+def place_name(p: int) -> str:
+    """The place field's value as a constant: on its location, or which way (y) and how far off it (5-9, 9-15,
+    over 15 cm), or off mainly in x."""
+    return PLACES[int(p)]
+
+
+def _place_effect(term: str, old: int, new: int) -> list[str]:
+    return [] if old == new else [f"(not (place {term} {place_name(old)}))", f"(place {term} {place_name(new)})"]
 
 
 def _net_effects(eff: list[str]) -> list[str]:
@@ -226,10 +241,10 @@ def domain_pddl(rules: LiftedRules) -> str:
             f"; Blocks stand at locations l0-l5 (far row l0-l2, near row l3-l5) on a support, at a level (5 cm layers).\n"
             f"(define (domain {domain_name(rules)})\n"
             "  (:requirements :strips :typing)\n"
-            "  (:types block location layer - object cube stick - block)\n"
-            f"  (:constants {locs} - location {lvls} - layer)\n"
+            "  (:types block location layer position - object cube stick - block)\n"
+            f"  (:constants {locs} - location {lvls} - layer {' '.join(PLACES)} - position)\n"
             "  (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer) (rests ?b - block ?h - layer)\n"
-            "               (height ?l - location ?h - layer) (beneath ?l - location ?h - layer) (off ?b - block)\n"
+            "               (height ?l - location ?h - layer) (beneath ?l - location ?h - layer) (place ?b - block ?p - position)\n"
             "               (near ?l - location) (differ ?a - location ?b - location)"
             + (f"\n               {bits}" if bits else "") + ")\n"
             + body + ")\n")
@@ -254,9 +269,8 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
             init.append(f"(at {o} {loc_name(p.loc)})")
         init.append(f"(level {o} {level_name(p.level)})")
         init += _bit_literals(rules, o, p.kind)
-        if not p.on_location:
-            init.append(f"(off {o})")
-        else:  # the level under it at its own location
+        init.append(f"(place {o} {place_name(p.place)})")
+        if p.loc < N_LOCATIONS:  # the level under it at its own location
             below = top_of(pieces, p.loc, frozenset(j for j, q in enumerate(pieces) if q.level >= p.level))
             init.append(f"(rests {o} {level_name(0 if below is None else pieces[below].level)})")
     for loc, t in enumerate(graph.tops):
@@ -274,8 +288,7 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
         if g.loc < N_LOCATIONS:
             goals.append(f"(at {o} {loc_name(g.loc)})")
         goals.append(f"(level {o} {level_name(g.level)})")
-        if not g.on_location:
-            goals.append(f"(off {o})")
+        goals.append(f"(place {o} {place_name(g.place)})")
     init_s = "\n    ".join(init)
     goal_s = "\n    ".join(goals)
     return (f"(define (problem {name})\n  (:domain {domain_name(rules)})\n  (:objects {objs})\n"

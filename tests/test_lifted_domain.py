@@ -110,7 +110,7 @@ def test_a_far_stick_covers_its_neighbours_and_carries_its_rider():
     assert graph.support == (None, 0, None)
     move = participants(graph, 1, 4)
     assert (move.o, move.under, move.v, move.riders) == (0, 0, 2, (1,))
-    assert participants(graph, 2, 4) == "a stick end or an off-location piece"
+    assert participants(graph, 2, 4) == "a stick's end"
     assert participants(graph, 3, 4) == "nothing to pick"
     assert layout.piece(located_code(drop_all([(ObjectType.CUBE, 3)]), [ObjectType.CUBE], 0), False).level == 2
 
