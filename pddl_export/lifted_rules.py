@@ -20,6 +20,7 @@ a move no rule covers leaves the state as it is, as the PDDL offers no action fo
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 from collections import Counter, defaultdict
@@ -35,8 +36,8 @@ LIFTED_KIND = "symlearn-lifted-rules"
 LIFTED_VERSION = 1
 MAX_LIFTED_BYTES = 64 << 20  # a lifted rules file is kilobytes; refuse anything near this
 STRUCTURE = ("cls", "o.stick", "o.place", "o.level", "u.level", "v.level", "riders.sides", "riders.place",
-             "riders.level", "beneath", "landing")
-REFINEMENTS = (("o.kind",), ("riders.kind",))
+             "riders.level", "beneath", "landing", "u.at", "v.at")
+REFINEMENTS = (("o.kind",), ("v.kind",), ("u.kind",), ("riders.kind",))
 WHERE = ("to", "from", "stay", "shift")  # where a piece ends, relative to the action; an int is a location
 
 
@@ -52,6 +53,8 @@ class Move:
     riders: tuple[int, ...]  # pieces on the ends of a far-row stick o, by side
     beneath: tuple[int, ...] = ()  # a far-row stick o: the level under each of its ends (its pick's neighbours)
     landing: tuple[int, ...] = ()  # a stick released in the far row: the level at each neighbour it will cover
+    below: int | None = None  # the piece left on top at the pick location, where it stands at it
+    v_at: int | None = None  # v, where it stands at the release location (not a stick's end over it)
 
 
 def move_class(o: Piece, pick: int, release: int):
@@ -88,7 +91,10 @@ def participants(graph: SceneGraph, pick: int, release: int) -> Move | str:
     stick = pieces[o].stick
     beneath = tuple(level_at(n) for n in neighbours(pick)) if stick and pieces[o].place == 0 else ()
     landing = tuple(level_at(n) for n in neighbours(release)) if stick else ()
-    return Move(pick, release, o, level_at(pick), v, riders, beneath, landing)
+    below = top_of(pieces, pick, skip)
+    below = below if below is not None and pieces[below].loc == pick else None
+    v_at = v if v is not None and pieces[v].loc == release else None
+    return Move(pick, release, o, level_at(pick), v, riders, beneath, landing, below, v_at)
 
 
 def signature(graph: SceneGraph, m: Move) -> dict:
@@ -100,7 +106,10 @@ def signature(graph: SceneGraph, m: Move) -> dict:
             "u.level": m.under, "v.level": 0 if m.v is None else ps[m.v].level,
             "riders.sides": tuple(ps[j].loc - m.pick for j in m.riders),
             "riders.kind": tuple(ps[j].kind for j in m.riders),
-            "riders.level": tuple(ps[j].level for j in m.riders), "beneath": m.beneath, "landing": m.landing}
+            "riders.level": tuple(ps[j].level for j in m.riders), "beneath": m.beneath, "landing": m.landing,
+            "u.at": m.below is not None, "v.at": m.v_at is not None,
+            "u.kind": None if m.below is None else ps[m.below].kind,
+            "v.kind": None if m.v_at is None else ps[m.v_at].kind}
 
 
 def key_of(sig: dict, depth: int) -> tuple:
@@ -109,7 +118,8 @@ def key_of(sig: dict, depth: int) -> tuple:
     return tuple((n, sig[n]) for n in names)
 
 
-Outcome = tuple  # per moved piece (o, riders...): (where, place, level, kind)
+Outcome = tuple  # (o's change, u's new kind, v's new kind, each rider's change); a change: (where, place, level,
+# kind); a new kind None where the piece is absent or keeps its kind
 
 
 def outcome_of(graph: SceneGraph, after: Sequence[Piece], m: Move) -> Outcome:
@@ -129,7 +139,9 @@ def outcome_of(graph: SceneGraph, after: Sequence[Piece], m: Move) -> Outcome:
         else:
             where = int(now.loc)
         return (where, now.place, now.level, now.kind)
-    return tuple(rel(i) for i in (m.o, *m.riders))
+    def new_kind(i: int | None):
+        return None if i is None or after[i].kind == graph.pieces[i].kind else after[i].kind
+    return (rel(m.o), new_kind(m.below), new_kind(m.v_at), *(rel(i) for i in m.riders))
 
 
 def _place(before: Piece, change, m: Move) -> Piece:
@@ -207,9 +219,12 @@ class LiftedRules:
         if rule is None:
             return tuple(pieces), None
         out = list(pieces)
-        for i, change in zip((m.o, *m.riders), rule.outcome):
-            if i is not None and change is not None:
-                out[i] = _place(pieces[i], change, m)
+        o_change, u_kind, v_kind, *r_changes = rule.outcome
+        for i, change in zip((m.o, *m.riders), (o_change, *r_changes)):
+            out[i] = _place(pieces[i], change, m)
+        for i, kind in ((m.below, u_kind), (m.v_at, v_kind)):
+            if i is not None and kind is not None:
+                out[i] = dataclasses.replace(out[i], kind=int(kind))
         return tuple(out), rule
 
     def code_of(self, piece: Piece, old_code: int) -> int:
@@ -236,7 +251,7 @@ class LiftedRules:
                 "code_bits": self.layout.code_bits, "kept": list(self.layout.kept),
                 "stick_of": [[int(a), int(b), bool(s)] for (a, b), s in sorted(self.stick_of.items())],
                 "rules": [{"depth": r.depth, "key": [[k, v] for k, v in r.key],
-                           "outcome": [None if c is None else list(c) for c in r.outcome],
+                           "outcome": [list(c) if isinstance(c, tuple) else c for c in r.outcome],
                            "support": r.support} for r in self.rules],
                 "codebook": [[bool(k[0]), *map(int, k[1:]), int(v)] for k, v in sorted(self.codebook.items())],
                 "stats": self.stats}
@@ -328,7 +343,7 @@ def load_lifted(path) -> LiftedRules:
         stick_of = {(int(a), int(b)): bool(s) for a, b, s in d["stick_of"]}
         codebook = {(bool(e[0]), int(e[1]), int(e[2]), int(e[3]), int(e[4])): int(e[5]) for e in d.get("codebook", [])}
         rules = tuple(Rule(int(r["depth"]), tuple((k, tuple(v) if isinstance(v, list) else v) for k, v in r["key"]),
-                           tuple(None if c is None else tuple(c) for c in r["outcome"]), int(r["support"]))
+                           tuple(tuple(c) if isinstance(c, list) else c for c in r["outcome"]), int(r["support"]))
                       for r in d["rules"])
         for r in rules:
             names = tuple(k for k, _ in r.key)

@@ -96,7 +96,7 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
             pre += ["(near ?from)", "(near ?to)"]
     if f.get("o.kind") is not None:
         pre += _bit_literals(rules, "?o", f["o.kind"])
-    o_out, *r_out = rule.outcome
+    o_out, u_kind, v_kind, *r_out = rule.outcome
     lands_on = o_out[1] == 0  # o ends on the release location (else off it: a far stick then covers no neighbour)
     new_o = level_name(o_out[2])
 
@@ -170,6 +170,15 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
         if new_r != hr:
             eff += [f"(not (level {term} {hr}))", f"(level {term} {new_r})"]
         eff += _bit_effects(rules, term, change[3], f["riders.kind"][i] if f.get("riders.kind") else None)
+    # the learned bits of what o leaves on top at its pick location, and of what it lands on
+    for term, loc, level, kind, role in (("?u", frm, hu, u_kind, "u"), ("?v", to, hv, v_kind, "v")):
+        if kind is None:
+            continue
+        params.append((term, "block"))
+        pre += [f"(at {term} {loc})", f"(level {term} {level})"]
+        if f.get(f"{role}.kind") is not None:
+            pre += _bit_literals(rules, term, f[f"{role}.kind"])
+        eff += _bit_effects(rules, term, kind, f.get(f"{role}.kind"))
     for loc in list(before) + [x for x in after if x not in before]:
         old = before.get(loc, hv if loc == to else landing.get(loc))
         new = after.get(loc, under.get(loc, old))
