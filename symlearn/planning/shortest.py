@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from symlearn.planning.problem import OPTIMAL_REASONS, Problem
 from symlearn.planning.stacking import LAYERS, LEVEL_M, State, check_state, levels, successors
 from symlearn.planning.goals import MAX_TILT_DEG, ObjectGoal, stick_covers
-from symlearn.world import LOCATIONS, OBJECT_SIZE, TABLE_TOP_Z, ObjectType, Scene
+from symlearn.world import LOCATIONS, OBJECT_SIZE, TABLE_TOP_Z, ObjectState, ObjectType, Scene
 
 POSE_TOLERANCE_M = 0.01  # an object this close (xy and z) to a model pose is in it; the simulator settles within 2 mm
 MAX_YAW_DEG = 10.0  # a stick turned farther from the y axis has its ends elsewhere than the model says
@@ -109,6 +109,13 @@ def scene_state(scene: Scene) -> State:
     except ValueError as e:
         raise NotCovered(str(e)) from None
     return tuple(state)
+
+
+def state_scene(state: State, types) -> Scene:
+    """The scene a state stands for: every object upright over its location, resting on its support's top."""
+    lv = levels(state, types)
+    return Scene(tuple(ObjectState(t, (*LOCATIONS[g.location], TABLE_TOP_Z + lv[i] * LEVEL_M + OBJECT_SIZE[t][2] / 2))
+                       for i, (t, g) in enumerate(zip(types, state))))
 
 
 def goal_places(problem: Problem) -> dict[int, tuple[int, int]]:
