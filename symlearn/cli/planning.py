@@ -214,7 +214,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 def cmd_benchmark(args: argparse.Namespace) -> int:
     from symlearn.planning.benchmark import benchmark, format_goal_placement, format_table
-    from symlearn.planning.benchmark_plots import format_grid, write_plots
+    from symlearn.planning.benchmark_plots import format_grid, format_shortest_grid, write_plots
 
     set_threads(args.threads)
     note_rule_loading(Path(args.run), list(args.planners))
@@ -224,10 +224,13 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
     print(format_table(res))
     print(format_goal_placement(res))
     print()
+    print(format_shortest_grid(res["shortest_grid"]))
+    print()
+    print("secondary view: by reference (generator) plan length")
     print(format_grid(res["grid"]))
     print(f"wrote {args.out}")
     if args.plots:
-        for path in write_plots(res["grid"], Path(args.plots)):
+        for path in write_plots(res["grid"], Path(args.plots), res["shortest_grid"]):
             print(f"wrote {path}")
     return 0
 
@@ -343,7 +346,8 @@ def add_benchmark_command(sub) -> None:
     c.add_argument("--planners", type=planner_list, default=["astar", "astar-ucs"],
                    help="comma-separated planner names")
     c.add_argument("--out", required=True, help="benchmark JSON file")
-    c.add_argument("--plots", help="folder for the success and planning-time plots by objects x reference length")
+    c.add_argument("--plots", help="folder for the plots: success and executed / shortest plan length by objects x "
+                                   "shortest-plan length, success and planning time by objects x reference length")
     c.add_argument("--quiet", action="store_true")
     c.add_argument("--record", help="directory for GIFs of failed plans (<problem>_<planner>.gif)")
     _add_execution_flags(c)
