@@ -203,6 +203,16 @@ def test_annotate_adds_shortest_plans_to_an_older_set_and_resumes(tmp_path):
     assert load_problem(tmp_path / "problem_0000.json").optimal_length == 2
     assert json.loads((tmp_path / "problems.manifest").read_text())["problem_version"] == PROBLEM_VERSION
     before = (tmp_path / "problem_0000.json").stat().st_mtime_ns
+    # a set of the older version is completed only once annotated: its command says how
+    from symlearn.planning.problem_generation import prepare_problem_dir
+    old = tmp_path / "old"
+    old.mkdir()
+    (old / "problem_0000.json").write_text(json.dumps(d))
+    (old / "problems.manifest").write_text(json.dumps({"format": "symlearn-problem-set", "problem_version": 2}))
+    with pytest.raises(ValueError, match="version 2, without shortest plans: 'symlearn problems --annotate --out"):
+        prepare_problem_dir(old, {"format": "symlearn-problem-set", "problem_version": PROBLEM_VERSION})
+    add_shortest_plans(old)
+    prepare_problem_dir(old, {"format": "symlearn-problem-set", "problem_version": PROBLEM_VERSION})
     assert add_shortest_plans(tmp_path)["kept"] == 1
     assert (tmp_path / "problem_0000.json").stat().st_mtime_ns == before
 

@@ -167,6 +167,11 @@ def prepare_problem_dir(out_dir: Path, settings: dict, overwrite: bool = False) 
             raise ValueError(f"{out_dir} already holds files but no problem manifest ({manifest.name}); "
                              f"use --overwrite to replace its problems, or another --out")
         elif old != settings:
+            keys = [k for k in set(settings) | set(old) if old.get(k) != settings.get(k)]
+            if keys == ["problem_version"]:
+                raise ValueError(f"{out_dir} holds problems of version {old.get('problem_version')}, without shortest "
+                                 f"plans: 'symlearn problems --annotate --out {out_dir}' adds them, then this command "
+                                 f"completes the set; or --overwrite")
             diff = ", ".join(f"{k} {old.get(k)} (asked {v})" for k, v in settings.items() if old.get(k) != v)
             raise ValueError(f"{out_dir} already holds problems of other settings ({diff}); "
                              f"use --overwrite to replace them, or another --out")
