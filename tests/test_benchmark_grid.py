@@ -213,3 +213,77 @@ def test_benchmark_over_two_sets_end_to_end(tiny_run_copy, tmp_path):
     assert sum(b["failure_causes"]["astar"]["open"].values()) == sum(not r["success"] for r in b["rows"])
     assert all((plots / f).stat().st_size > 0 for f in PLOT_FILES)
     assert not (tmp_path / "bench.json.rows.jsonl").exists()
+
+
+def _srow(k: int, optimal: int | None, *, success: bool, executed: int | None = None, closed: bool = True,
+          off: int = 0, cause: str | None = None) -> ProblemRun:
+    return dataclasses_replace(_row("astar", k, 8, success=success, closed=closed, cause=cause,
+                                    length=executed or 1),
+                               optimal_length=optimal, executed_length=executed, goal_off_locations=off)
+
+
+def dataclasses_replace(row, **kw):
+    import dataclasses
+
+    return dataclasses.replace(row, **kw)
+
+
+SHORT_ROWS = [
+    _srow(3, 5, success=True, executed=5), _srow(3, 6, success=True, executed=9),  # ratios 1 and 1.5
+    _srow(3, 5, success=False, executed=2, cause="departure"), _srow(3, 6, success=False, cause="no_plan"),
+    _srow(3, 1, success=True, executed=1),
+    _srow(3, None, success=False, off=1, executed=4, cause="departure"),  # off the locations: its own column
+    _srow(3, None, success=True, executed=2),  # undecided: "?"
+    _srow(5, 9, success=True, executed=11), _srow(5, 12, success=False, cause="timeout"),
+    _srow(3, 5, success=False, closed=False, cause="departure", executed=5),
+]
+
+
+def test_shortest_grid_cells_hold_rates_ratios_and_causes():
+    from symlearn.planning.benchmark import shortest_bucket, summary_shortest_grid
+
+    assert [shortest_bucket(r) for r in SHORT_ROWS[:9]] == ["5-6", "5-6", "5-6", "5-6", "1-2", "off", "?", "9-12",
+                                                            "9-12"]
+    grid = summary_shortest_grid(SHORT_ROWS)["astar"]
+    cell = grid["closed"]["3"]["5-6"]
+    assert cell["n"] == 4 and cell["success_rate"] == 0.5 and cell["mean_optimal_length"] == 5.5
+    assert cell["mean_length_ratio"] == 1.25 and cell["failure_causes"] == {"departure": 1, "no_plan": 1}
+    assert grid["closed"]["3"]["off"]["failure_causes"] == {"departure": 1} and grid["closed"]["3"]["off"]["n"] == 1
+    assert grid["closed"]["3"]["?"]["success_rate"] == 1.0 and grid["closed"]["3"]["?"]["mean_length_ratio"] is None
+    assert grid["closed"]["5"]["9-12"]["mean_length_ratio"] == pytest.approx(11 / 9, abs=1e-3)
+    assert grid["open"] == {"3": {"5-6": grid["open"]["3"]["5-6"]}} and grid["open"]["3"]["5-6"]["success_rate"] == 0
+
+
+def test_shortest_grid_text_markdown_plots_and_report(tmp_path):
+    from PIL import Image
+
+    from symlearn.planning.benchmark import summary_shortest_grid
+    from symlearn.planning.benchmark_plots import SHORTEST_PLOT_FILES, format_shortest_grid
+    from symlearn.report.gather import benchmark_section
+
+    shortest = summary_shortest_grid(SHORT_ROWS)
+    text = format_shortest_grid(shortest).splitlines()
+    head = text.index("astar: success open/closed (n) by objects x shortest-plan length")
+    assert text[head + 1].split() == ["objects", "1-2", "3-4", "5-6", "7-8", "9-12", "off", "?"]
+    assert text[head + 2].split() == ["3", "-/1.00", "(1)", "-", "0.00/0.50", "(1)", "-", "-", "-/0.00", "(1)",
+                                      "-/1.00", "(1)"]
+    ratio = text.index("astar: executed / shortest plan length (closed loop, successful problems)")
+    assert text[ratio + 2].split() == ["3", "1.00", "-", "1.25", "-", "-", "-", "-"]
+    assert "  3 objects, 5-6: departure 1, no_plan 1" in text
+    md = markdown_grid({"grid": summary_grid(SHORT_ROWS), "failure_causes": summary_failure_causes(SHORT_ROWS),
+                        "tasks": {}, "shortest_grid": shortest})
+    assert md.index("by shortest-plan length") < md.index("by reference length (secondary view)")
+    assert "| 5 | - | - | - | - | 1.22 | - | - |" in md
+    paths = write_plots(summary_grid(SHORT_ROWS), tmp_path, shortest)
+    assert [p.name for p in paths] == [*SHORTEST_PLOT_FILES, *PLOT_FILES]
+    with Image.open(paths[0]) as im:
+        assert im.size == (round(PANEL_IN[0] * 2 * DPI), round(PANEL_IN[1] * DPI))  # panels for 3 and 5 objects
+    section = benchmark_section({"summary": {"astar": {}}, "shortest_grid": shortest})
+    grid_table = next(t for t in section.tables if t.key == "shortest_grid")
+    assert grid_table.header == ("planner", "objects", "1-2", "3-4", "5-6", "7-8", "9-12", "off", "?")
+    assert grid_table.rows[0] == ("astar", "3", "- / 1.00 (1)", "-", "0.00 / 0.50 (1)", "-", "-", "- / 0.00 (1)",
+                                  "- / 1.00 (1)")
+    detail = next(t for t in section.tables if t.key == "shortest_detail")
+    assert detail.rows[0][:4] == ("astar", "closed", "3", "1.00") and detail.rows[0][5] == "1.25; departure 1, no_plan 1"
+    old = benchmark_section({"summary": {"astar": {}}})
+    assert any("before problems recorded their shortest plans" in line for line in old.text)

@@ -7,6 +7,8 @@ ValueError / RuntimeError with one-line messages, which the main CLI prints.
     symlearn train-transition --run runs/paper --data data/paper --preset paper
     symlearn problems --out problems/p13 --n 50 --objects 1-3 --length 1-4 --seed 0
     symlearn problems --suite structures --out problems/structures --n 22 --objects 1-5 --seed 0
+    symlearn problems --stratify --out problems/dev --n 10 --objects 1-5 --seed 1000
+    symlearn problems --annotate --out problems/p13
     symlearn problems --goal examples/goals/fig6_composite.json --out problems/goals
     symlearn plan --run runs/paper --problem problems/p13/problem_0000.json --planner astar --closed-loop
     symlearn benchmark --run runs/paper --problems problems/p13 --planners astar,astar-ucs --out bench.json
@@ -73,19 +75,66 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
 def cmd_problems(args: argparse.Namespace) -> int:
     from symlearn.planning.problem_generation import generate_problems
 
+    if args.exclude and not args.stratify:
+        raise ValueError("--exclude applies to --stratify sets only")
+    if args.annotate:
+        return _cmd_annotate(args)
     if args.suite or args.goal:
-        if args.stratify or args.on_locations:
-            raise ValueError(f"--{'stratify' if args.stratify else 'on-locations'} applies to random-walk problems only")
+        for flag in ("stratify", "stratify_reference", "on_locations"):
+            if getattr(args, flag):
+                raise ValueError(f"--{flag.replace('_', '-')} applies to random-walk problems only")
         return _cmd_structure_problems(args)
+    if args.stratify:
+        return _cmd_stratified(args)
     args.n, args.objects = args.n or 20, args.objects or (1, 3)
     args.length, args.seed = args.length or (1, 4), 0 if args.seed is None else args.seed
-    per = " per cell" if args.stratify else ""
+    per = " per cell" if args.stratify_reference else ""
     placed = ", goals on the table locations" if args.on_locations else ""
     print(f"problems: {args.n} problems{per}, objects {args.objects[0]}-{args.objects[1]}, length "
           f"{args.length[0]}-{args.length[1]}{placed}, seed {args.seed} -> {args.out}", file=sys.stderr)
     paths = generate_problems(Path(args.out), args.n, objects=args.objects, length=args.length, seed=args.seed,
-                              overwrite=args.overwrite, stratify=args.stratify, on_locations=args.on_locations)
+                              overwrite=args.overwrite, stratify=args.stratify_reference,
+                              on_locations=args.on_locations)
     print(f"wrote {len(paths)} problems to {args.out}")
+    return 0
+
+
+def _cmd_stratified(args: argparse.Namespace) -> int:
+    """`problems --stratify`: --n problems per cell of objects x shortest-plan length, and per off-location cell."""
+    from symlearn.planning.stratified import generate_stratified
+
+    given = [f for f, v in (("--length", args.length), ("--on-locations", args.on_locations or None),
+                            ("--stratify-reference", args.stratify_reference or None)) if v is not None]
+    if given:
+        raise ValueError(f"--stratify draws walks of every length and keeps off-location goals in their own "
+                         f"cells; {', '.join(given)} do not apply")
+    n, objects, seed = args.n or 10, args.objects or (1, 5), 0 if args.seed is None else args.seed
+    exclude = tuple(Path(x) for x in (args.exclude or "").split(",") if x.strip())
+    print(f"problems: {n} problems per cell of objects {objects[0]}-{objects[1]} x shortest-plan length, "
+          f"seed {seed}" + (f", none of {', '.join(map(str, exclude))}" if exclude else "") + f" -> {args.out}",
+          file=sys.stderr)
+    paths, cells = generate_stratified(Path(args.out), n, objects=objects, seed=seed, overwrite=args.overwrite,
+                                       exclude=exclude, progress=lambda line: print(line, file=sys.stderr, flush=True))
+    print("cells (objects, shortest-plan length: problems written/asked):")
+    for c in cells:
+        print("  " + c.line())
+    print(f"wrote {len(paths)} problems to {args.out}")
+    return 0
+
+
+def _cmd_annotate(args: argparse.Namespace) -> int:
+    """`problems --annotate --out DIR`: record the shortest plan in every problem file of DIR that lacks it."""
+    from symlearn.planning.problem_generation import add_shortest_plans
+
+    given = [f for f, v in (("--n", args.n), ("--objects", args.objects), ("--length", args.length),
+                            ("--seed", args.seed), ("--suite", args.suite), ("--goal", args.goal)) if v is not None]
+    given += [f for f, v in (("--stratify", args.stratify), ("--stratify-reference", args.stratify_reference),
+                             ("--on-locations", args.on_locations), ("--overwrite", args.overwrite)) if v]
+    if given:
+        raise ValueError(f"--annotate adds shortest plans to the problems in --out; {', '.join(given)} do not apply")
+    counts = add_shortest_plans(Path(args.out))
+    print(f"{args.out}: {counts['annotated']} problems annotated, {counts['kept']} already were; shortest plans "
+          f"known for {counts['known']}, undecided for {counts['undecided']}")
     return 0
 
 
@@ -165,7 +214,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 def cmd_benchmark(args: argparse.Namespace) -> int:
     from symlearn.planning.benchmark import benchmark, format_goal_placement, format_table
-    from symlearn.planning.benchmark_plots import format_grid, write_plots
+    from symlearn.planning.benchmark_plots import format_grid, format_shortest_grid, write_plots
 
     set_threads(args.threads)
     note_rule_loading(Path(args.run), list(args.planners))
@@ -175,10 +224,13 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
     print(format_table(res))
     print(format_goal_placement(res))
     print()
+    print(format_shortest_grid(res["shortest_grid"]))
+    print()
+    print("secondary view: by reference (generator) plan length")
     print(format_grid(res["grid"]))
     print(f"wrote {args.out}")
     if args.plots:
-        for path in write_plots(res["grid"], Path(args.plots)):
+        for path in write_plots(res["grid"], Path(args.plots), res["shortest_grid"]):
             print(f"wrote {path}")
     return 0
 
@@ -230,8 +282,19 @@ def add_problems_command(sub) -> None:
     p.add_argument("--length", type=int_range, help="generator actions per random-walk problem, e.g. 1-4 (default 1-4)")
     p.add_argument("--seed", type=non_negative_int, help="base seed (default 0)")
     p.add_argument("--stratify", action="store_true",
-                   help="--n random-walk problems per cell of object count x horizon bucket (1-2, 3-4, 5-6, 7-8 "
-                        "actions) within --objects and --length, named by cell (k3_len5-6_0007)")
+                   help="--n problems (default 10) per cell of object count x shortest-plan length (1-2, 3-4, 5-6, "
+                        "7-8, 9-12 actions) within --objects (default 1-5), plus an off-location cell per object "
+                        "count, drawn from random walks, structure tasks and walks aimed at deep states, named by "
+                        "cell (k3_opt5-6_0007, k3_off_0001; docs/PROBLEMS.md)")
+    p.add_argument("--exclude", help="with --stratify: problem sets (A,B) none of whose problems may be drawn "
+                                     "again, e.g. the dev set when making the test set")
+    p.add_argument("--stratify-reference", action="store_true",
+                   help="--n random-walk problems per cell of object count x reference (walk) length bucket (1-2, "
+                        "3-4, 5-6, 7-8 actions) within --objects and --length, named by cell (k3_len5-6_0007): "
+                        "the older depth sets")
+    p.add_argument("--annotate", action="store_true",
+                   help="record the shortest plan (optimal_length) in every problem file of --out that lacks it, "
+                        "e.g. sets made before it existed; nothing else changes")
     p.add_argument("--on-locations", action="store_true",
                    help="random walks only: redraw a walk whose goal leaves an object more than 5 cm from every table "
                         "location (a stick across two places), so every goal is one place-and-level symbols can name")
@@ -283,7 +346,8 @@ def add_benchmark_command(sub) -> None:
     c.add_argument("--planners", type=planner_list, default=["astar", "astar-ucs"],
                    help="comma-separated planner names")
     c.add_argument("--out", required=True, help="benchmark JSON file")
-    c.add_argument("--plots", help="folder for the success and planning-time plots by objects x reference length")
+    c.add_argument("--plots", help="folder for the plots: success and executed / shortest plan length by objects x "
+                                   "shortest-plan length, success and planning time by objects x reference length")
     c.add_argument("--quiet", action="store_true")
     c.add_argument("--record", help="directory for GIFs of failed plans (<problem>_<planner>.gif)")
     _add_execution_flags(c)

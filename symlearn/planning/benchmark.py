@@ -3,8 +3,10 @@
 Planners are named entries of the one registry, symlearn.planning.planners.PLANNERS (the
 learned-net A* variants and the planners on the exported rules); `benchmark` builds the named
 ones for the run and refuses unknown names before any work. Beside the per-planner summary, the
-result holds `grid` (objects x reference-length bucket, open and closed loop), `failure_causes`
-and `tasks` (structure-suite tasks); symlearn.planning.benchmark_plots renders them.
+result holds `shortest_grid` (objects x shortest-plan length of the problems, with off-location goals in
+their own column: success, executed / shortest plan length, failure causes per cell), `grid` (objects x
+reference-length bucket, the older view), `failure_causes` and `tasks` (structure-suite tasks);
+symlearn.planning.benchmark_plots renders them.
 
     >>> res = benchmark(Path("runs/paper"), Path("problems/p13"), ["astar", "astar-ucs"],
     ...                 Path("runs/paper/bench.json"), closed_loop=True, timeout_s=30)  # doctest: +SKIP
@@ -108,6 +110,52 @@ def summary_grid(rows: list[ProblemRun]) -> dict:
                 by_objects[str(k)] = {b: _cell(rs) for b, rs in cells.items() if rs}
             if by_objects:
                 out[planner][loop] = by_objects
+    return out
+
+
+SHORTEST_BUCKETS = ("1-2", "3-4", "5-6", "7-8", "9-12", "off", "?")  # shortest-plan lengths, in plot order
+OFF_LOCATIONS = "off"  # the column of goals with a judged object off the table locations
+
+
+def shortest_bucket(row: ProblemRun) -> str:
+    """A row's shortest-plan column: "1-2" ... "9-12", "off" (a goal off the locations), or "?" (undecided)."""
+    if row.goal_off_locations:
+        return OFF_LOCATIONS
+    n = row.optimal_length
+    if not isinstance(n, int) or n <= 0:
+        return "?"
+    if n > 8:
+        return "9-12"
+    lo = n - (n + 1) % 2
+    return f"{lo}-{lo + 1}"
+
+
+def _shortest_cell(rows: list[ProblemRun]) -> dict:
+    """_cell, plus the mean shortest length, executed / shortest length over the successes, and failure causes."""
+    out = _cell(rows)
+    known = [r for r in rows if r.optimal_length]
+    ratios = [r.executed_length / r.optimal_length for r in known if r.success and r.executed_length is not None]
+    out["mean_optimal_length"] = round(statistics.mean(r.optimal_length for r in known), 3) if known else None
+    out["mean_length_ratio"] = round(statistics.mean(ratios), 3) if ratios else None
+    out["failure_causes"] = failure_causes(rows)
+    return out
+
+
+def summary_shortest_grid(rows: list[ProblemRun]) -> dict:
+    """planner -> "open"/"closed" -> object count -> shortest-plan column (SHORTEST_BUCKETS) -> cell.
+
+    A cell: n, success and found rates, median planning time, mean plan and reference lengths (solved rows),
+    mean shortest length, mean executed / shortest length over its successes, and failure causes (counts).
+    """
+    out: dict = {}
+    for planner in dict.fromkeys(r.planner for r in rows):
+        for loop in LOOPS:
+            mine = [r for r in rows if r.planner == planner and r.closed_loop == (loop == "closed")]
+            for k in sorted({r.n_objects for r in mine}):
+                cells = {b: [r for r in mine if r.n_objects == k and shortest_bucket(r) == b]
+                         for b in SHORTEST_BUCKETS}
+                out.setdefault(planner, {}).setdefault(loop, {})[str(k)] = {
+                    b: _shortest_cell(rs) for b, rs in cells.items() if rs}
     return out
 
 
@@ -388,7 +436,7 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
               "transition_sha256": settings["transition_sha256"],
               "problems_sha256": settings["problems_sha256"],
               "versions": versions(), "wall_time_s": round(time.perf_counter() - t0, 2),
-              "summary": summarize_rows(rows), "grid": summary_grid(rows),
+              "summary": summarize_rows(rows), "shortest_grid": summary_shortest_grid(rows), "grid": summary_grid(rows),
               "failure_causes": summary_failure_causes(rows), "tasks": summary_tasks(rows),
               "goal_placement": summary_goal_placement(rows),
               "rows": [r.to_json() for r in rows]}

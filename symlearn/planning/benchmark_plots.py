@@ -1,4 +1,5 @@
-"""The objects x reference-length grid of a benchmark as text, Markdown and plots.
+"""The objects x shortest-plan-length grid of a benchmark (and the older reference-length one) as text,
+Markdown and plots.
 
 `symlearn benchmark` prints `format_grid` after a run and, with --plots DIR, writes `write_plots`'
 figures; on a saved result JSON the same come from this module's command line, which prints the
@@ -15,8 +16,8 @@ import json
 import math
 from pathlib import Path
 
-from symlearn.planning.benchmark import (LENGTH_BUCKETS, LOOPS, summary_failure_causes, summary_grid,
-                                         summary_tasks)
+from symlearn.planning.benchmark import (LENGTH_BUCKETS, LOOPS, SHORTEST_BUCKETS, summary_failure_causes,
+                                         summary_grid, summary_shortest_grid, summary_tasks)
 from symlearn.planning.execution import ProblemRun
 from symlearn.provenance import atomic_write_bytes
 
@@ -24,16 +25,27 @@ MAIN_BUCKETS = LENGTH_BUCKETS[:4]  # always shown; "9+" and "?" only when some r
 DPI = 100
 PANEL_IN = (4.0, 3.2)  # inches per object-count panel (width, height)
 PLOT_FILES = ("success_by_length.png", "time_by_length.png")
+SHORTEST_PLOT_FILES = ("success_by_shortest.png", "length_ratio_by_shortest.png")
+MAIN_SHORTEST = SHORTEST_BUCKETS[:5]  # always shown; "off" and "?" only when some row falls there
 
 
 def grid_of(result: dict) -> dict:
-    """The result's grid, failure causes and tasks (recomputed from its rows when an older JSON lacks them)."""
-    if "grid" in result and "failure_causes" in result:
-        return {"grid": result["grid"], "failure_causes": result["failure_causes"], "tasks": result.get("tasks", {})}
+    """The result's grids, failure causes and tasks (recomputed from its rows when an older JSON lacks them).
+
+    A result written before shortest plans has no `shortest_grid`; from its rows every problem falls in the
+    "?" column (its rows carry no shortest length), which says the problems must be annotated and re-run.
+    """
+    if "grid" in result and "failure_causes" in result and "shortest_grid" in result:
+        return {"grid": result["grid"], "failure_causes": result["failure_causes"], "tasks": result.get("tasks", {}),
+                "shortest_grid": result["shortest_grid"]}
     rows = [ProblemRun(**r) for r in result.get("rows", [])]
     if not rows:
+        if "grid" in result and "failure_causes" in result:
+            return {"grid": result["grid"], "failure_causes": result["failure_causes"],
+                    "tasks": result.get("tasks", {}), "shortest_grid": {}}
         raise ValueError("the benchmark result holds neither a grid nor rows")
-    return {"grid": summary_grid(rows), "failure_causes": summary_failure_causes(rows), "tasks": summary_tasks(rows)}
+    return {"grid": summary_grid(rows), "failure_causes": summary_failure_causes(rows), "tasks": summary_tasks(rows),
+            "shortest_grid": summary_shortest_grid(rows)}
 
 
 def merge_results(results: list[dict], names: list[str]) -> dict:
@@ -65,11 +77,11 @@ def merge_results(results: list[dict], names: list[str]) -> dict:
     return merged
 
 
-def _axes(by_loop: dict) -> tuple[list[str], list[str]]:
+def _axes(by_loop: dict, buckets=LENGTH_BUCKETS, main=MAIN_BUCKETS) -> tuple[list[str], list[str]]:
     """Object counts (rows) and buckets (columns) of one planner's grid, in order."""
     objects = sorted({k for loop in by_loop.values() for k in loop}, key=int)
     used = {b for loop in by_loop.values() for cells in loop.values() for b in cells}
-    return objects, [b for b in LENGTH_BUCKETS if b in MAIN_BUCKETS or b in used]
+    return objects, [b for b in buckets if b in main or b in used]
 
 
 def _cell_text(by_loop: dict, k: str, bucket: str, sep: str) -> str:
@@ -93,13 +105,69 @@ def format_grid(grid: dict) -> str:
     return "\n\n".join(out)
 
 
-def markdown_grid(summary: dict) -> str:
-    """Markdown for docs/BENCHMARKS.md: a grid table per planner, failure causes, and structure-suite tasks."""
+def _main_loop(by_loop: dict) -> str:
+    """The loop a planner's ratio and causes are shown for: closed where it ran, else open."""
+    return "closed" if "closed" in by_loop else "open"
+
+
+def _ratio_text(by_loop: dict, k: str, bucket: str) -> str:
+    c = by_loop.get(_main_loop(by_loop), {}).get(k, {}).get(bucket)
+    return "-" if not c or c.get("mean_length_ratio") is None else f"{c['mean_length_ratio']:.2f}"
+
+
+def _causes_text(by_loop: dict, k: str, bucket: str) -> str:
+    c = by_loop.get(_main_loop(by_loop), {}).get(k, {}).get(bucket)
+    if not c:
+        return "-"
+    causes = c.get("failure_causes") or {}
+    return ", ".join(f"{name} {n}" for name, n in sorted(causes.items(), key=lambda kv: -kv[1])) or "none"
+
+
+def format_shortest_grid(shortest: dict) -> str:
+    """Per planner: success open/closed (n) by objects x shortest-plan length ("off": goals off the locations,
+    "?": undecided), executed / shortest plan length over the successes, and failure causes per cell."""
+    out = []
+    for planner, by_loop in shortest.items():
+        objects, buckets = _axes(by_loop, SHORTEST_BUCKETS, MAIN_SHORTEST)
+        loop = _main_loop(by_loop)
+        lines = [f"{planner}: success open/closed (n) by objects x shortest-plan length",
+                 f"{'objects':>8}" + "".join(f"{b:>18}" for b in buckets)]
+        lines += [f"{k:>8}" + "".join(f"{_cell_text(by_loop, k, b, '/'):>18}" for b in buckets) for k in objects]
+        lines += [f"{planner}: executed / shortest plan length ({loop} loop, successful problems)",
+                  f"{'objects':>8}" + "".join(f"{b:>18}" for b in buckets)]
+        lines += [f"{k:>8}" + "".join(f"{_ratio_text(by_loop, k, b):>18}" for b in buckets) for k in objects]
+        lines.append(f"{planner}: failure causes ({loop} loop) per cell")
+        lines += [f"  {k} objects, {b}: {_causes_text(by_loop, k, b)}" for k in objects for b in buckets
+                  if by_loop.get(loop, {}).get(k, {}).get(b, {}).get("failure_causes")]
+        out.append("\n".join(lines))
+    return "\n\n".join(out)
+
+
+def markdown_shortest(shortest: dict) -> str:
+    """Markdown of the shortest-plan grid: per planner success open / closed (n), executed / shortest length,
+    and failure causes per cell (closed loop where it ran)."""
     parts = []
+    for planner, by_loop in shortest.items():
+        objects, buckets = _axes(by_loop, SHORTEST_BUCKETS, MAIN_SHORTEST)
+        head = ["| objects | " + " | ".join(buckets) + " |", "|---:|" + "---:|" * len(buckets)]
+        rows = [f"**{planner}**: success open / closed (n) by shortest-plan length", "", *head]
+        rows += [f"| {k} | " + " | ".join(_cell_text(by_loop, k, b, " / ") for b in buckets) + " |" for k in objects]
+        rows += ["", f"executed / shortest plan length ({_main_loop(by_loop)} loop, successes)", "", *head]
+        rows += [f"| {k} | " + " | ".join(_ratio_text(by_loop, k, b) for b in buckets) + " |" for k in objects]
+        rows += ["", f"failure causes ({_main_loop(by_loop)} loop)", "", *head]
+        rows += [f"| {k} | " + " | ".join(_causes_text(by_loop, k, b) for b in buckets) + " |" for k in objects]
+        parts.append("\n".join(rows))
+    return "\n\n".join(parts)
+
+
+def markdown_grid(summary: dict) -> str:
+    """Markdown for docs/BENCHMARKS.md: the shortest-plan grids, then the reference-length grid per planner,
+    failure causes, and structure-suite tasks."""
+    parts = [markdown_shortest(summary["shortest_grid"])] if summary.get("shortest_grid") else []
     for planner, by_loop in summary["grid"].items():
         objects, buckets = _axes(by_loop)
-        rows = [f"**{planner}**: success open / closed (n)", "", "| objects | " + " | ".join(buckets) + " |",
-                "|---:|" + "---:|" * len(buckets)]
+        rows = [f"**{planner}**: success open / closed (n) by reference length (secondary view)", "",
+                "| objects | " + " | ".join(buckets) + " |", "|---:|" + "---:|" * len(buckets)]
         rows += [f"| {k} | " + " | ".join(_cell_text(by_loop, k, b, " / ") for b in buckets) + " |" for k in objects]
         parts.append("\n".join(rows))
     causes = sorted({c for loops in summary["failure_causes"].values() for counts in loops.values() for c in counts})
@@ -123,12 +191,13 @@ def _series(by_loop: dict, loop: str, k: str, buckets: list[str], key: str) -> l
     return [math.nan if cells.get(b, {}).get(key) is None else cells[b][key] for b in buckets]
 
 
-def _figure(grid: dict, key: str, ylabel: str, log: bool, loops: tuple[str, ...]):
+def _figure(grid: dict, key: str, ylabel: str, log: bool, loops: tuple[str, ...], all_buckets=LENGTH_BUCKETS,
+            main=MAIN_BUCKETS, xlabel: str = "reference plan length", ylim=(-0.03, 1.03)):
     """One panel per object count, one colour per planner; open loop solid, closed loop dashed."""
     from matplotlib.figure import Figure
 
     objects = sorted({k for by_loop in grid.values() for loop in by_loop.values() for k in loop}, key=int)
-    buckets = [b for b in LENGTH_BUCKETS if b in MAIN_BUCKETS or any(
+    buckets = [b for b in all_buckets if b in main or any(
         b in cells for by_loop in grid.values() for loop in by_loop.values() for cells in loop.values())]
     fig = Figure(figsize=(PANEL_IN[0] * max(len(objects), 1), PANEL_IN[1]), dpi=DPI, layout="constrained")
     axes = fig.subplots(1, max(len(objects), 1), squeeze=False, sharey=True)[0]
@@ -146,11 +215,11 @@ def _figure(grid: dict, key: str, ylabel: str, log: bool, loops: tuple[str, ...]
         ax.set_title(f"{k} object{'s' if k != '1' else ''}")
         ax.set_xticks(xs, buckets)
         ax.set_xlim(-0.5, len(buckets) - 0.5)
-        ax.set_xlabel("reference plan length")
+        ax.set_xlabel(xlabel)
         if log:
             ax.set_yscale("log")
-        else:
-            ax.set_ylim(-0.03, 1.03)
+        elif ylim is not None:
+            ax.set_ylim(*ylim)
         ax.grid(alpha=0.3)
     axes[0].set_ylabel(ylabel)
     if handles:
@@ -165,17 +234,26 @@ def _save(fig, path: Path) -> Path:
     return path
 
 
-def write_plots(grid: dict, out_dir: Path) -> list[Path]:
-    """Success and median planning time (log scale) against the reference-length bucket, as PNGs in out_dir."""
+def write_plots(grid: dict, out_dir: Path, shortest: dict | None = None) -> list[Path]:
+    """Success and median planning time (log scale) against the reference-length bucket, as PNGs in out_dir;
+    with the shortest-plan grid, success and executed / shortest plan length against the shortest-plan length."""
     if not grid:
         raise ValueError("the benchmark grid is empty: nothing to plot")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    if shortest:
+        xlabel = "shortest plan length (off: goal off the locations)"
+        success = _figure(shortest, "success_rate", "success rate", False, LOOPS, SHORTEST_BUCKETS, MAIN_SHORTEST,
+                          xlabel)
+        ratio = _figure(shortest, "mean_length_ratio", "executed / shortest plan length", False, LOOPS,
+                        SHORTEST_BUCKETS, MAIN_SHORTEST, xlabel, ylim=None)
+        written += [_save(success, out_dir / SHORTEST_PLOT_FILES[0]), _save(ratio, out_dir / SHORTEST_PLOT_FILES[1])]
     success = _figure(grid, "success_rate", "success rate", False, LOOPS)
     # the first planning call: open loop's, or closed loop's where only closed loop ran
     times = {p: {"open": by_loop.get("open") or by_loop.get("closed", {})} for p, by_loop in grid.items()}
     timing = _figure(times, "median_time_s", "median planning time (s)", True, ("open",))
-    return [_save(success, out_dir / PLOT_FILES[0]), _save(timing, out_dir / PLOT_FILES[1])]
+    return written + [_save(success, out_dir / PLOT_FILES[0]), _save(timing, out_dir / PLOT_FILES[1])]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -202,7 +280,7 @@ def main(argv: list[str] | None = None) -> int:
 
         atomic_write_json(args.merged, finite_or_null(result))
         print(f"wrote {args.merged}")
-    for path in write_plots(summary["grid"], args.out):
+    for path in write_plots(summary["grid"], args.out, summary.get("shortest_grid")):
         print(f"wrote {path}")
     print()
     print(markdown_grid(summary))

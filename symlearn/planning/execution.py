@@ -266,6 +266,8 @@ class ProblemRun:
     failure_cause: str | None = None  # the attributed cause of a failure (see failure attribution), None on success
     attribution: dict = field(default_factory=dict)  # per-step failure attribution details
     goal_off_locations: int | None = None  # judged objects the goal puts off the table locations (Problem's)
+    optimal_length: int | None = None  # the problem's shortest plan (Problem.optimal_length), None if undecided
+    executed_length: int | None = None  # actions executed, across replans; None when nothing was executed
 
     def __post_init__(self) -> None:
         if self.failure_stage is not None:
@@ -406,4 +408,5 @@ def run_problem(sim, encoder, transition: TransitionFn, problem: Problem, planne
         replans=0 if ex is None else ex.replans, failure_stage=failure_stage(plan, ex),
         generator_length=problem.generator_length, message=plan.message, n_objects=problem.k,
         timings={k: v for k, v in plan.extra.items() if k.endswith("_s")}, task=problem.task,
-        failure_cause=cause, attribution=why, goal_off_locations=problem.goal_off_locations)
+        failure_cause=cause, attribution=why, goal_off_locations=problem.goal_off_locations,
+        optimal_length=problem.optimal_length, executed_length=None if ex is None else len(ex.executed))

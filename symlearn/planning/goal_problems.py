@@ -4,7 +4,8 @@ The arrangement is built by dropping the fixed objects in support order at their
 (free objects after them, at an empty location), letting them settle, and checking every fixed
 object against where the arrangement puts it (goals.arrangement_errors). A reference plan is run
 from the initial scene; its end scene is the problem's goal and must agree with the arrangement
-within 2 cm on the fixed objects. The simulator is passed in; nothing here imports pybullet.
+within 2 cm on the fixed objects; its shortest plan is recorded (symlearn.planning.shortest). The
+simulator is passed in; nothing here imports pybullet.
 
     >>> with TabletopSimulator() as sim:                                              # doctest: +SKIP
     ...     problem = goal_problem(sim, load_goal(path), name=path.stem, where=f"goal file {path}")
@@ -17,6 +18,7 @@ from symlearn.planning.goals import ARRANGEMENT_TOLERANCE_M, Goal, arrangement_e
 from symlearn.planning.paths import check_safe_name
 from symlearn.planning.problem import Problem
 from symlearn.planning.scenes import max_goal_distance
+from symlearn.planning.shortest import with_shortest
 from symlearn.world import FAR_ROW, N_LOCATIONS, ObjectType, Scene, decode_action
 
 
@@ -78,7 +80,8 @@ def goal_problem(sim, goal: Goal, name: str, where: str) -> Problem:
 
 def _problem(where: str, name: str, goal: Goal, initial: Scene, goal_scene: Scene) -> Problem:
     try:
-        return Problem(name, goal.seed, goal.spec, initial, goal.plan or (), goal_scene, task=goal.task, free=goal.free)
+        return with_shortest(Problem(name, goal.seed, goal.spec, initial, goal.plan or (), goal_scene, task=goal.task,
+                                     free=goal.free))
     except ValueError as e:
         raise ValueError(f"{where}: {e}") from None
 

@@ -23,8 +23,10 @@ from symlearn.provenance import atomic_write_json
 from symlearn.world import LOCATIONS, N_ACTIONS, N_LOCATIONS, TABLE_TOP_Z, ObjectType, Scene, decode_action
 
 PROBLEM_FORMAT = "symlearn-problem"
-PROBLEM_VERSION = 2  # 2 added "task" and "free"; version 1 files (neither) still load
-READABLE_VERSIONS = (1, 2)
+PROBLEM_VERSION = 3  # 2 added "task" and "free", 3 the shortest plan; version 1 and 2 files still load (not computed)
+READABLE_VERSIONS = (1, 2, 3)
+# why a problem has no shortest-plan length (symlearn.planning.shortest explains each)
+OPTIMAL_REASONS = ("goal_off_locations", "pose_not_covered", "search_cap", "unreachable")
 RANDOM_WALK = "random-walk"  # the task of problems drawn by random actions
 GOAL_TOLERANCE_M = 0.02  # success: every object within this distance of its goal position
 ON_LOCATION_M = 0.05  # an object whose xy lies farther than this from every table location is "off the locations"
@@ -49,9 +51,15 @@ class Problem:
     goal: Scene  # poses the generator's actions ended in
     task: str = RANDOM_WALK  # what made it: "random-walk", or a structure suite's task name ("tower-2", ...)
     free: tuple[int, ...] = ()  # objects the goal leaves free: their goal poses and codes are not judged
+    # The shortest plan in the world (symlearn.planning.shortest): its length and one such plan, or no length
+    # and the reason (OPTIMAL_REASONS) the model cannot decide; all three None: not computed (a version 1-2 file).
+    optimal_length: int | None = None
+    optimal_reason: str | None = None
+    optimal_plan: tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
         check_safe_name(self.name, "problem")
+        self._check_optimal()
         if not isinstance(self.task, str) or not self.task:
             raise ValueError(f"problem {self.name}: task must be a non-empty string, got {self.task!r}")
         if not all(_is_int(i) for i in self.free):
@@ -85,9 +93,32 @@ class Problem:
                                  f"do not match the spec {[t.name.lower() for t in types]}")
             check_scene(scene, f"{p}: {what} scene")
 
+    def _check_optimal(self) -> None:
+        p = f"problem {self.name}"
+        n, why, plan = self.optimal_length, self.optimal_reason, self.optimal_plan
+        if why is not None and why not in OPTIMAL_REASONS:
+            raise ValueError(f"{p}: optimal_reason {why!r} is not one of {', '.join(OPTIMAL_REASONS)}")
+        if n is not None:
+            if not (_is_int(n) and n >= 0):
+                raise ValueError(f"{p}: optimal_length must be a non-negative integer or null, got {n!r}")
+            if why is not None:
+                raise ValueError(f"{p}: optimal_length {n} comes with a reason ({why}); one or the other")
+            if not isinstance(plan, (tuple, list)) or not all(_is_int(a) and 0 <= a < N_ACTIONS for a in plan):
+                raise ValueError(f"{p}: optimal_plan must list action ids 0..{N_ACTIONS - 1}, got {plan!r}")
+            if len(plan) != n:
+                raise ValueError(f"{p}: optimal_plan has {len(plan)} actions, optimal_length says {n}")
+            object.__setattr__(self, "optimal_plan", tuple(int(a) for a in plan))
+        elif plan is not None:
+            raise ValueError(f"{p}: optimal_plan given without an optimal_length")
+
     @property
     def k(self) -> int:
         return len(self.spec)
+
+    @property
+    def optimal_known(self) -> bool:
+        """Whether the shortest plan was searched for (a length or a reason), as version 3 files record."""
+        return self.optimal_length is not None or self.optimal_reason is not None
 
     @property
     def generator_length(self) -> int:
@@ -116,7 +147,9 @@ class Problem:
                 "actions_readable": [f"pick {decode_action(a).pick} -> release {decode_action(a).release}"
                                      for a in self.actions],
                 "goal": self.goal.to_json(), "generator_length": self.generator_length,
-                "task": self.task, "free": list(self.free)}
+                "task": self.task, "free": list(self.free), "optimal_length": self.optimal_length,
+                "optimal_reason": self.optimal_reason,
+                "optimal_plan": None if self.optimal_plan is None else list(self.optimal_plan)}
 
     @staticmethod
     def from_json(d: dict, where: str = "problem") -> "Problem":
@@ -134,6 +167,14 @@ class Problem:
             raise ValueError(f"{p}: problem version {d['version']!r}, this symlearn reads versions "
                              f"{', '.join(map(str, READABLE_VERSIONS))}")
         task, free = d.get("task", RANDOM_WALK), d.get("free", [])
+        if d["version"] >= 3:
+            missing = [k for k in ("optimal_length", "optimal_reason", "optimal_plan") if k not in d]
+            if missing:
+                raise ValueError(f"{p}: missing keys {', '.join(missing)} (a version 3 problem records its "
+                                 f"shortest plan, or null)")
+        optimal = (d.get("optimal_length"), d.get("optimal_reason"), d.get("optimal_plan"))
+        if optimal[2] is not None and not isinstance(optimal[2], list):
+            raise ValueError(f"{p}: optimal_plan must be a list of action ids or null")
         if not isinstance(task, str) or not task:
             raise ValueError(f"{p}: task must be a non-empty string, got {task!r}")
         if not isinstance(free, list) or not all(_is_int(i) for i in free):
@@ -162,7 +203,7 @@ class Problem:
             scenes[key] = _scene(d[key], f"{p}: {key} scene")
         try:
             return Problem(d["name"], int(d["seed"]), tuple(parsed), scenes["initial"], tuple(actions), scenes["goal"],
-                           task, tuple(free))
+                           task, tuple(free), *optimal)
         except ValueError as e:
             msg = str(e).removeprefix(f"problem {name}: ")
             raise ValueError(msg if msg.startswith(p) else f"{p}: {msg}") from None

@@ -3,7 +3,8 @@
 A problem is generated in the simulator: a random scene of k objects is built by dropping
 them (exploration.sample_scene_spec), a random sequence of L actions that each move something
 is executed, and the scene it ends in is the goal. The generator's actions are kept as a known
-valid plan (its length is a reference for plan lengths).
+valid plan (its length is a reference for plan lengths); the shortest plan is searched for in the
+symbolic model and recorded too (symlearn.planning.shortest).
 
     >>> paths = generate_problems(Path("problems/p13"), n=20, objects=(1, 3), length=(1, 4), seed=0)  # doctest: +SKIP
 """
@@ -17,7 +18,9 @@ from pathlib import Path
 import numpy as np
 
 from symlearn.planning.paths import path_under
-from symlearn.planning.problem import GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, save_problem
+from symlearn.planning.problem import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems,
+                                       save_problem)
+from symlearn.planning.shortest import with_shortest
 from symlearn.provenance import atomic_write_json
 from symlearn.sim.exploration import MAX_OBJECTS, ExplorationConfig, sample_action, sample_scene_spec
 from symlearn.world import Action, Scene, decode_action
@@ -95,7 +98,7 @@ def generate_problem(sim, rng: np.random.Generator, cfg: ProblemConfig, name: st
         if len(actions) == length:
             problem = Problem(name, seed, tuple(spec), initial, tuple(actions), sim.get_scene())
             if not (cfg.on_locations and problem.goal_off_locations):
-                return problem
+                return with_shortest(problem)
     where = " ending on the table locations" if cfg.on_locations else ""
     raise RuntimeError(f"problem {name}: no valid action sequence{where} after {cfg.max_scene_tries} scenes")
 
@@ -134,7 +137,7 @@ def _own_files(out_dir: Path) -> list[Path]:
         or re.fullmatch(rf"\.({_OWN_PROBLEM}|problems\.manifest)\..*\.tmp", f.name))]
 
 
-_OWN_PROBLEM = r"(problem_\d{4,}|k\d_len\d+-\d+_\d{4,})\.json"
+_OWN_PROBLEM = r"(problem_\d{4,}|k\d_len\d+-\d+_\d{4,}|k\d_opt\d+-\d+_\d{4,}|k\d_off_\d{4,})\.json"
 
 
 def prepare_problem_dir(out_dir: Path, settings: dict, overwrite: bool = False) -> None:
@@ -164,6 +167,11 @@ def prepare_problem_dir(out_dir: Path, settings: dict, overwrite: bool = False) 
             raise ValueError(f"{out_dir} already holds files but no problem manifest ({manifest.name}); "
                              f"use --overwrite to replace its problems, or another --out")
         elif old != settings:
+            keys = [k for k in set(settings) | set(old) if old.get(k) != settings.get(k)]
+            if keys == ["problem_version"]:
+                raise ValueError(f"{out_dir} holds problems of version {old.get('problem_version')}, without shortest "
+                                 f"plans: 'symlearn problems --annotate --out {out_dir}' adds them, then this command "
+                                 f"completes the set; or --overwrite")
             diff = ", ".join(f"{k} {old.get(k)} (asked {v})" for k, v in settings.items() if old.get(k) != v)
             raise ValueError(f"{out_dir} already holds problems of other settings ({diff}); "
                              f"use --overwrite to replace them, or another --out")
@@ -230,3 +238,32 @@ def generate_problems(out_dir: Path, n: int, objects: tuple[int, int] = (1, 3), 
 
 def _is_count(x, least: int = 1) -> bool:
     return isinstance(x, (int, np.integer)) and not isinstance(x, bool) and x >= least
+
+
+def add_shortest_plans(problems_dir: Path) -> dict[str, int]:
+    """Record the shortest plan in every problem of a folder that lacks it (files of versions 1-2), in place.
+
+    Each file is rewritten atomically at the current version, so a killed run resumes where it stopped; files
+    that already record it are left untouched. A set's manifest is moved to the current problem version, so
+    the command that made the set still completes it. Returns counts: annotated, kept, known, undecided.
+    """
+    problems_dir = Path(problems_dir)
+    loaded = load_problems(problems_dir)  # refuses a missing folder or a malformed file before writing anything
+    counts = {"annotated": 0, "kept": 0, "known": 0, "undecided": 0}
+    for path, problem in loaded:
+        if problem.optimal_known:
+            counts["kept"] += 1
+        else:
+            problem = with_shortest(problem)
+            save_problem(path, problem)
+            counts["annotated"] += 1
+        counts["known" if problem.optimal_length is not None else "undecided"] += 1
+    manifest = problems_dir / PROBLEMS_MANIFEST
+    if manifest.is_file():
+        try:
+            settings = json.loads(manifest.read_text())
+        except (json.JSONDecodeError, UnicodeDecodeError):
+            settings = None
+        if isinstance(settings, dict) and settings.get("format") == MANIFEST_FORMAT:
+            atomic_write_json(manifest, {**settings, "problem_version": PROBLEM_VERSION})
+    return counts

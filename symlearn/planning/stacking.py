@@ -5,8 +5,10 @@ or released at a location lands on the top object there, or on the end of a far-
 over it, or on the table; a pick takes the top object at a location, and a stick picked at its
 middle carries everything standing on it (its end riders shift with it along the far row).
 Scripts that leave these rules (a pick at an empty location or at a stick's end, a stick laid over
-standing objects, riders carried off the locations) are refused with a ValueError. The simulator
-has the last word: goal_problems checks every scripted plan there.
+standing objects, riders carried off the locations, anything put on the end of a stick that does not
+lie on the table, which tips it over) are refused with a ValueError. The simulator has the last
+word: goal_problems checks every scripted plan there, and tests/test_shortest.py the shortest
+plans that symlearn.planning.shortest searches over `successors`.
 
     >>> from symlearn.world import ObjectType as T
     >>> s = drop_all([(T.STICK, 4), (T.CUBE, 3)])
@@ -17,7 +19,7 @@ has the last word: goal_problems checks every scripted plan there.
 from __future__ import annotations
 
 from symlearn.planning.goals import ObjectGoal, stick_covers
-from symlearn.world import FAR_ROW, ObjectType
+from symlearn.world import FAR_ROW, N_LOCATIONS, ObjectType
 
 State = tuple  # tuple[ObjectGoal | None, ...]: every placed object's location and support, in identity order
 
@@ -32,6 +34,8 @@ def _top(state: State, types, loc: int, skip=frozenset()) -> tuple[int, bool] | 
         return tops[0], False
     for i, g in enumerate(state):
         if g is not None and i not in skip and types[i] == ObjectType.STICK and stick_covers(g.location, loc):
+            if g.on is not None:  # a stick balanced on a column tips over under an end rider (docs/PROBLEMS.md)
+                raise ValueError(f"location {loc} lies under an end of the stick standing on object {g.on}")
             return i, True
     return None
 
@@ -83,6 +87,8 @@ def act(state: State, types, pick: int, release: int) -> State:
             raise ValueError(f"object {r} riding the stick would leave the locations")
         new[r] = ObjectGoal(loc, g.on, g.end)
     _land(new, types, i, release, skip=frozenset(riders))
+    if new[i].on is not None and any(new[r].end and new[r].on == i for r in riders):
+        raise ValueError(f"the stick released at {release} onto object {new[i].on} would tip its end riders off")
     return tuple(new)
 
 
@@ -108,3 +114,74 @@ def touched(spec, plan) -> set[int]:
             used |= set(plan[step])
             state = act(state, types, *plan[step])
     return used
+
+
+LEVEL_M = 0.05  # heights come in layers of 5 cm: a cube is two layers tall, the stick one
+LAYERS = {ObjectType.CUBE: 2, ObjectType.STICK: 1}
+
+
+def levels(state: State, types) -> tuple[int, ...]:
+    """Each object's bottom, in layers (LEVEL_M) above the table: the sum of the heights under it."""
+    out: list[int | None] = [None] * len(state)
+
+    def level(i: int) -> int:
+        if out[i] is None:
+            on = state[i].on
+            out[i] = 0 if on is None else level(on) + LAYERS[types[on]]
+        return out[i]
+
+    return tuple(level(i) for i in range(len(state)))
+
+
+def check_state(state: State, types) -> None:
+    """Refuse (ValueError) a state the rules above cannot produce or run: two objects on one seat, a support
+    that is absent, at another location or not a stick's end, an object on the table under a far-row stick's
+    end, a rider on the end of a stick that does not lie on the table, a support cycle."""
+    seats: dict[tuple, int] = {}
+    for i, g in enumerate(state):
+        if g is None:
+            raise ValueError(f"object {i} has no place")
+        if g.on is not None:
+            if not 0 <= g.on < len(state) or g.on == i:
+                raise ValueError(f"object {i} stands on object {g.on}, which is absent")
+            below = state[g.on]
+            if g.end and not (types[g.on] == ObjectType.STICK and stick_covers(below.location, g.location)):
+                raise ValueError(f"object {i} at {g.location} is not on an end of object {g.on} at {below.location}")
+            if g.end and below.on is not None:
+                raise ValueError(f"object {i} rides on an end of the stick standing on object {below.on}")
+            if not g.end and below.location != g.location:
+                raise ValueError(f"object {i} at {g.location} stands on object {g.on} at {below.location}")
+        seat = ("table" if g.on is None else g.on, g.location)
+        if seat in seats:
+            raise ValueError(f"objects {seats[seat]} and {i} share one seat at location {g.location}")
+        seats[seat] = i
+    for s, g in enumerate(state):
+        if types[s] == ObjectType.STICK:
+            under = [i for i, h in enumerate(state) if h.on is None and stick_covers(g.location, h.location)]
+            if under:
+                raise ValueError(f"objects {under} on the table lie under an end of the stick at {g.location}")
+    for i in range(len(state)):  # cycles: a chain of supports longer than the scene
+        j, steps = state[i].on, 0
+        while j is not None:
+            j, steps = state[j].on, steps + 1
+            if steps > len(state):
+                raise ValueError(f"object {i} is on a support cycle")
+
+
+def successors(state: State, types):
+    """(action id, next state) of every pick-and-release the model covers from `state`, in action-id order.
+
+    A pick at an empty location or a release where it was picked changes nothing and is left out, as is an
+    action the rules refuse (a stick picked by its end, riders carried off the locations, ...): a search over
+    these steps finds only plans whose every step the model can vouch for.
+    """
+    occupied = {g.location for g in state} | {n for i, g in enumerate(state) if types[i] == ObjectType.STICK
+                                              for n in FAR_ROW if stick_covers(g.location, n)}
+    for pick in sorted(occupied):
+        for release in range(N_LOCATIONS):
+            if release == pick:
+                continue
+            try:
+                yield pick * N_LOCATIONS + release, act(state, types, pick, release)
+            except ValueError:
+                continue

@@ -183,7 +183,51 @@ def benchmark_section(bench: dict | None, why: str = "") -> Section:
                             "(a stick left across two places cannot be named by the symbols)",
                             ("planner", "goals", "problems", "success", "closed-loop success"), placement,
                             key="goal_placement"))
+    shortest = bench.get("shortest_grid")
+    if shortest:
+        tables += _shortest_tables(shortest)
+    elif bench.get("summary"):
+        text.append("no grid by shortest-plan length: the benchmark was written before problems recorded their "
+                    "shortest plans ('symlearn problems --annotate --out DIR', then benchmark again)")
     return Section("benchmark", title, text=text, tables=tables)
+
+
+SHORTEST_COLUMNS = ("1-2", "3-4", "5-6", "7-8", "9-12", "off", "?")  # symlearn.planning.benchmark.SHORTEST_BUCKETS
+
+
+def _shortest_tables(shortest: dict) -> list[Table]:
+    """The benchmark's objects x shortest-plan-length grid: success open / closed (n), then executed / shortest
+    plan length and failure causes per cell (closed loop where it ran), one row per planner and object count."""
+    used = [b for b in SHORTEST_COLUMNS if b in SHORTEST_COLUMNS[:5] or any(
+        b in cells for by_loop in shortest.values() for loop in by_loop.values() for cells in loop.values())]
+    success, detail = [], []
+    for planner, by_loop in shortest.items():
+        main = "closed" if "closed" in by_loop else "open"
+        for k in sorted({k for loop in by_loop.values() for k in loop}, key=int):
+            cells = []
+            for b in used:
+                c = [by_loop.get(loop, {}).get(k, {}).get(b) for loop in ("open", "closed")]
+                n = next((x["n"] for x in c if x), None)
+                cells.append("-" if n is None else " / ".join("-" if x is None or x.get("success_rate") is None
+                                                              else f"{x['success_rate']:.2f}" for x in c) + f" ({n})")
+            success.append((planner, k, *cells))
+            row = []
+            for b in used:
+                c = by_loop.get(main, {}).get(k, {}).get(b)
+                if not c:
+                    row.append("-")
+                    continue
+                ratio = "-" if c.get("mean_length_ratio") is None else f"{c['mean_length_ratio']:.2f}"
+                causes = ", ".join(f"{name} {m}" for name, m in sorted((c.get("failure_causes") or {}).items(),
+                                                                       key=lambda kv: -kv[1]))
+                row.append(ratio + (f"; {causes}" if causes else ""))
+            detail.append((planner, main, k, *row))
+    return [Table("Success open / closed (problems) by objects x shortest-plan length (off: goals off the "
+                  "table locations; ?: shortest plan undecided)", ("planner", "objects", *used), tuple(success),
+                  key="shortest_grid"),
+            Table("Executed / shortest plan length over the successes; failure causes", ("planner", "loop",
+                                                                                         "objects", *used),
+                  tuple(detail), key="shortest_detail")]
 
 
 def plan_section(filmstrip: Path | None, gif: Path | None) -> Section:
