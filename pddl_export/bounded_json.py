@@ -131,26 +131,36 @@ def loads_bounded(text: str | bytes, where: str, max_depth: int = DEFAULT_MAX_DE
     return value
 
 
+def _field_name(chain) -> str:
+    """'a.b[2].c' from the (parent chain, key) links _check_values keeps (built only for a refusal)."""
+    keys = []
+    while chain is not None:
+        chain, key = chain
+        keys.append(key)
+    return "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in reversed(keys)).lstrip(".") or "(top)"
+
+
 def _check_values(value, where: str, max_depth: int) -> None:
-    """Walk a parsed value without recursion: depth, finite floats, 64-bit integers (first offender named)."""
-    stack = [(value, 0, "")]
+    """Walk a parsed value without recursion: nesting depth and 64-bit integers (the first offender named).
+    Floats were checked while parsing; the field path is kept as cheap links and spelled out only on refusal."""
+    stack = [(value, 0, None)]
+    pop, push = stack.pop, stack.append
     while stack:
-        v, depth, at = stack.pop()
+        v, depth, chain = pop()
         if isinstance(v, dict):
-            if depth >= max_depth:
-                raise JsonFileError(f"{where}: nested deeper than {max_depth} levels (at {at or 'the top'})")
-            stack.extend((x, depth + 1, f"{at}.{k}" if at else str(k)) for k, x in v.items()
-                         if isinstance(x, (dict, list, float, int)))
+            items = v.items()
         elif isinstance(v, list):
-            if depth >= max_depth:
-                raise JsonFileError(f"{where}: nested deeper than {max_depth} levels (at {at or 'the top'})")
-            stack.extend((x, depth + 1, f"{at}[{i}]") for i, x in enumerate(v) if isinstance(x, (dict, list, float, int)))
-        elif isinstance(v, float):
-            if not math.isfinite(v):
-                raise JsonFileError(f"{where}: field {at or '(top)'}: {v} is not a finite number")
+            items = enumerate(v)
         elif isinstance(v, int) and not isinstance(v, bool) and not -INT_LIMIT <= v < INT_LIMIT:
-            raise JsonFileError(f"{where}: field {at or '(top)'}: an integer of {len(str(abs(v)))} digits, "
+            raise JsonFileError(f"{where}: field {_field_name(chain)}: an integer of {len(str(abs(v)))} digits, "
                                 f"outside 64 bits")
+        else:
+            continue
+        if depth >= max_depth:
+            raise JsonFileError(f"{where}: nested deeper than {max_depth} levels (at {_field_name(chain)})")
+        for k, x in items:
+            if isinstance(x, (dict, list)) or (type(x) is int and not -INT_LIMIT <= x < INT_LIMIT):
+                push((x, depth + 1, (chain, k)))
 
 
 def read_json_file(path: str | os.PathLike, schema: "Schema | None" = None, *, what: str = "JSON file",
@@ -339,6 +349,22 @@ class List(Schema):
             self.refuse(v, at, where, f"a list of {len(v)} items, expected {self.min_len}..{self.max_len}")
         for i, x in enumerate(v):
             self.item.check(x, f"{at}[{i}]", where)
+
+
+@dataclass(frozen=True)
+class Tuple(Schema):
+    """A list of exactly len(items) values, the i-th fitting items[i]."""
+
+    items: tuple[Schema, ...]
+
+    def describe(self) -> str:
+        return f"a list of {len(self.items)} items ({', '.join(i.describe() for i in self.items)})"
+
+    def check(self, v, at, where):
+        if not isinstance(v, list) or len(v) != len(self.items):
+            self.refuse(v, at, where)
+        for i, (x, s) in enumerate(zip(v, self.items)):
+            s.check(x, f"{at}[{i}]", where)
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from pddl_export.bounded_json import loads_bounded
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig
 from symlearn.provenance import atomic_write_bytes, sha256_file, versions
 
@@ -91,10 +92,11 @@ def _record(blob: dict) -> Checkpoint:
             raise KeyError(f"field {key!r} missing")
         if not isinstance(blob[key], kind):
             raise TypeError(f"field {key!r} is {type(blob[key]).__name__}, expected {kind.__name__}")
-    cfg = ModelConfig.from_json(json.loads(blob["config"]))
+    cfg = ModelConfig.from_json(loads_bounded(blob["config"], "field 'config'"))
     return Checkpoint(cfg, blob["model"], blob["optimizer"] or None, blob["epoch"], blob["best_val"],
-                      json.loads(blob["history"]), blob["rng_states"],
-                      blob["effect_mean"].numpy(), blob["effect_std"].numpy(), json.loads(blob["meta"]))
+                      loads_bounded(blob["history"], "field 'history'"), blob["rng_states"],
+                      blob["effect_mean"].numpy(), blob["effect_std"].numpy(),
+                      loads_bounded(blob["meta"], "field 'meta'"))
 
 
 def _first_line(e: BaseException) -> str:

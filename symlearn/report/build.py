@@ -10,6 +10,7 @@ from pathlib import Path
 
 from symlearn.provenance import atomic_write_bytes, atomic_write_text
 from symlearn.report import gather as g
+from symlearn.report import schemas
 from symlearn.report.figures import plot_png
 from symlearn.report.model import NOT_RUN, Report
 from symlearn.report.render import to_html, to_markdown
@@ -62,7 +63,7 @@ def build_report(run: Path, data: Path | None = None, benchmark: Path | None = N
     sy, sy_why = g.read_json(run / "symbols.json")
     tm, _ = g.read_json(run / "transition_metrics.json")
     bench_path = Path(benchmark) if benchmark is not None else run / "benchmark.json"
-    bench, bench_why = g.read_json(bench_path)
+    bench, bench_why = g.read_json(bench_path, schemas.BENCHMARK)
     if benchmark is None and not bench_path.exists():
         bench_why = ""
     gif = find_recording(run, recording)

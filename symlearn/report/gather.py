@@ -6,9 +6,10 @@ unreadable input becomes a "not run" section naming the file and the command tha
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
+from pddl_export.bounded_json import JsonFileError, Schema, check, read_json_file
+from symlearn.report import schemas
 from symlearn.report.model import Image, Mark, Plot, Report, Section, Table, not_run
 from symlearn.report.render import fmt
 
@@ -20,15 +21,18 @@ SYMBOL_IMAGES = (("symbols.png", "Symbol prototypes (the paper's Fig. 4)"),
                  ("symbol_examples.png", "Examples of one symbol (the paper's Fig. 5)"))
 
 
-def read_json(path: Path) -> tuple[dict | None, str]:
-    """(document, '') or (None, one-line reason): missing, unreadable or not a JSON object."""
+def read_json(path: Path, schema: Schema | None = None) -> tuple[dict | None, str]:
+    """(document, '') or (None, one-line reason): missing, refused by the bounded reader (not a regular file,
+    too large, not JSON, too deep, non-finite numbers) or not fitting `schema` (default: the schema of the
+    run file of that name in symlearn.report.schemas, else any JSON object)."""
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():
         return None, f"{path} not found"
+    schema = schema or schemas.RUN_FILES.get(path.name)
     try:
-        doc = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        return None, f"{path} cannot be read ({type(e).__name__}: {str(e).splitlines()[0][:100]})"
+        doc = read_json_file(path, schema, what="run file")
+    except JsonFileError as e:
+        return None, f"refused: {e}"
     if not isinstance(doc, dict):
         return None, f"{path} is not a JSON object"
     return doc, ""
@@ -214,7 +218,9 @@ def history_from_checkpoint(run: Path) -> list | None:
         from symlearn.learning.checkpoint import CheckpointError, load_checkpoint
 
         try:
-            return load_checkpoint(Path(run) / "best.pt").history
-        except CheckpointError:
+            history = load_checkpoint(Path(run) / "best.pt").history
+            check(history, schemas.HISTORY, f"{Path(run) / 'best.pt'} (history)")
+            return history
+        except (CheckpointError, JsonFileError):
             return None
     return None
