@@ -79,7 +79,7 @@ def read_bounded_bytes(path: str | os.PathLike, max_bytes: int, what: str = "fil
                     else "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else "a socket or other")
             raise JsonFileError(f"{path}: is {kind}, not a regular {what}")
         if st.st_size > max_bytes:
-            raise JsonFileError(f"{path}: {st.st_size} bytes, more than the {max_bytes} a {what} may have")
+            raise JsonFileError(f"{path}: {st.st_size} bytes, more than the {max_bytes} bytes a {what} may have")
         chunks, left = [], max_bytes + 1
         while left > 0:
             chunk = os.read(fd, min(left, 4 * MiB))
@@ -305,12 +305,16 @@ class OneOf(Schema):
         return " or ".join(o.describe() for o in self.options)
 
     def check(self, v, at, where):
+        errors = []
         for o in self.options:
             try:
                 o.check(v, at, where)
                 return
-            except JsonFileError:
-                continue
+            except JsonFileError as e:
+                errors.append(e)
+        others = [o for o in self.options if not isinstance(o, Null)]
+        if v is not None and len(others) == 1:  # `X or null` and not null: X's own refusal names the inner field
+            raise errors[self.options.index(others[0])]
         self.refuse(v, at, where)
 
 

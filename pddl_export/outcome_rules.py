@@ -168,12 +168,20 @@ def outcomes_from_json(d: dict) -> OutcomeRules:
     try:
         rules = rules_from_json(d)
         c = _CodeStrings(rules.bits).__getitem__  # exactly `bits` characters 0 or 1, as in rules.json
-        costs = tuple((_action(r["action"]), c(r["from"]), c(r["to"]), float(r["cost"])) for r in d["costs"])
-        return OutcomeRules(rules, costs, float(d["min_ratio"]))
+        costs = tuple((_action(r["action"]), c(r["from"]), c(r["to"]), _number(r["cost"], "cost"))
+                      for r in d["costs"])
+        return OutcomeRules(rules, costs, _number(d["min_ratio"], "min_ratio"))
     except KeyError as e:
         raise ValueError(f"malformed outcomes file: missing field {e}") from None
     except (TypeError, AttributeError, OverflowError) as e:
         raise ValueError(f"malformed outcomes file: {type(e).__name__}: {str(e).splitlines()[0][:200]}") from None
+
+
+def _number(x, name: str) -> float:
+    """A finite number of the file (not a string or boolean); ValueError naming the field otherwise."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)) or not np.isfinite(x):
+        raise ValueError(f"malformed outcomes file: field {name!r} must be a finite number, got {str(x)[:40]!r}")
+    return float(x)
 
 
 def _action(a) -> int:

@@ -144,12 +144,12 @@ def _series(history: list, keys: tuple[str, ...]) -> dict:
     return out
 
 
-def curves_section(effect_history: list | None, transition_history: list | None) -> Section:
-    """Learning curves of the effect model and the transition network."""
+def curves_section(effect_history: list | None, transition_history: list | None, why: str = "") -> Section:
+    """Learning curves of the effect model and the transition network; `why` names history files refused."""
     title = "Learning curves"
     if not effect_history and not transition_history:
-        return not_run("curves", title, "no training history: RUN/metrics.json (or best.pt) and "
-                                        "RUN/transition_metrics.json missing")
+        return not_run("curves", title, why or "no training history: RUN/metrics.json (or best.pt) and "
+                                               "RUN/transition_metrics.json missing")
     s = Section("curves", title)
     if effect_history:
         s.plots.append(Plot("effect_loss", "Effect model", "epoch", "loss",
@@ -159,7 +159,7 @@ def curves_section(effect_history: list | None, transition_history: list | None)
         if any(v[0] for v in mae.values()):
             s.plots.append(Plot("effect_val_mae", "Effect model: validation MAE", "epoch", "mm", mae))
     else:
-        s.text.append("effect model: not run (no history in RUN/metrics.json or RUN/best.pt)")
+        s.text.append("effect model: not run (no history in RUN/metrics.json or RUN/best.pt)" + (f"; {why}" if why else ""))
     if transition_history:
         s.plots.append(Plot("transition_loss", "Transition network", "epoch", "loss",
                             _series(transition_history, ("train_loss", "val_loss"))))
@@ -190,12 +190,12 @@ def benchmark_section(bench: dict | None, why: str = "") -> Section:
     return Section("benchmark", title, text=text, tables=tables)
 
 
-def plan_section(filmstrip: Path | None, gif: Path | None) -> Section:
-    """One executed plan as a filmstrip (start, then after each action)."""
+def plan_section(filmstrip: Path | None, gif: Path | None, why: str = "") -> Section:
+    """One executed plan as a filmstrip (start, then after each action); `why` a recording could not be read."""
     title = "An executed plan"
     if filmstrip is None:
-        return not_run("plan", title, "no recorded plan: run 'symlearn plan ... --record RUN/plan.gif' or "
-                                      "'symlearn benchmark ... --record RUN/recordings'")
+        return not_run("plan", title, why or "no recorded plan: run 'symlearn plan ... --record RUN/plan.gif' or "
+                                             "'symlearn benchmark ... --record RUN/recordings'")
     return Section("plan", title, text=[f"recorded in {gif}: start, then the scene after each action "
                                         "(arrow: pick -> release)"],
                    images=[Image("plan_filmstrip", f"Filmstrip of {Path(gif).name}", filmstrip)])
