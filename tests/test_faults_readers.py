@@ -183,24 +183,18 @@ def test_goal_deep_or_huge_values_are_refused_naming_the_file(tmp_path, text, wo
     _one_line(info.value, str(path), *words)
 
 
-def test_goal_and_problem_files_that_are_fifos_do_not_hang(tmp_path):
-    """A FIFO named *.json: refused at once. (On a reader that blocks, the thread is released by a writer.)"""
-    from symlearn.planning.goals import load_goal
-    from symlearn.planning.problem import load_problem
-
-    for loader in (load_goal, load_problem):
-        fifo = tmp_path / f"{loader.__name__}.json"
-        os.mkfifo(fifo)
-        out: list = []
-        t = threading.Thread(target=lambda: out.append(_refusal(loader, fifo)), daemon=True)
-        t.start()
-        t.join(10)
-        if t.is_alive():  # release the blocked open before failing
-            fd = os.open(fifo, os.O_WRONLY | os.O_NONBLOCK)
-            os.close(fd)
-            t.join(10)
-            pytest.fail(f"{loader.__name__} blocked on a FIFO")
-        assert out and "FIFO" in out[0] and str(fifo) in out[0], out
+def _refusal_within(loader, path: Path, seconds: float = 10.0) -> str:
+    """loader(path)'s one-line refusal, failing (not hanging) if it blocks: a reader stuck opening a FIFO is
+    released by opening the FIFO for writing."""
+    out: list = []
+    t = threading.Thread(target=lambda: out.append(_refusal(loader, path)), daemon=True)
+    t.start()
+    t.join(seconds)
+    if t.is_alive():
+        os.close(os.open(path, os.O_WRONLY | os.O_NONBLOCK))
+        t.join(seconds)
+        pytest.fail(f"{getattr(loader, '__name__', loader)} blocked on {path}")
+    return out[0]
 
 
 def _refusal(loader, path) -> str:
@@ -209,6 +203,18 @@ def _refusal(loader, path) -> str:
     except ValueError as e:
         return str(e)
     return "accepted"
+
+
+def test_goal_and_problem_files_that_are_fifos_do_not_hang(tmp_path):
+    """A FIFO named *.json: refused at once."""
+    from symlearn.planning.goals import load_goal
+    from symlearn.planning.problem import load_problem
+
+    for loader in (load_goal, load_problem):
+        fifo = tmp_path / f"{loader.__name__}.json"
+        os.mkfifo(fifo)
+        text = _refusal_within(loader, fifo)
+        assert "FIFO" in text and str(fifo) in text and "\n" not in text, text
 
 
 def test_plan_problem_dev_zero_is_refused_at_once(tmp_path):
@@ -399,7 +405,7 @@ def test_report_refuses_a_gif_declaring_huge_frames(tmp_path, capsys, declared, 
     rc, out = cli("report", "--run", run)
     assert rc == 0, out
     note = _report_notes(run)["An executed plan"]
-    assert note.startswith(f"refused: {gif}: ") and all(w in note for w in words), note
+    assert note.startswith(f"{gif} cannot be read: ") and all(w in note for w in words), note
     assert not (run / "report_files" / "plan_filmstrip.png").exists()
 
 
@@ -436,7 +442,7 @@ def test_report_survives_wrong_shaped_run_files(tmp_path, fname, doc, words):
     rc, out = cli("report", "--run", run)
     assert rc == 0, out
     md = (run / "report.md").read_text().replace("\\", "")  # Markdown escapes of brackets
-    assert f"{run / fname}: " in md and all(w in md for w in words), md
+    assert f"{run / fname} cannot be read: " in md and all(w in md for w in words), md
 
 
 @pytest.mark.parametrize("special", ["/dev/zero", "fifo"])
@@ -635,3 +641,16 @@ def test_property_report_never_raises_on_wrong_shaped_run_files(tmp_path):
         assert rc == 0, out
         md = (run / "report.md").read_text()
         assert md.startswith("# symlearn report")
+
+
+@pytest.mark.parametrize("which", ["best.pt", "transition.pt"])
+def test_checkpoint_that_is_a_fifo_or_device_is_refused_at_once(tmp_path, which):
+    from symlearn.learning.checkpoint import load_checkpoint
+    from symlearn.symbolic.transition_checkpoint import load_transition
+
+    load = load_checkpoint if which == "best.pt" else load_transition
+    os.mkfifo(tmp_path / which)
+    os.symlink("/dev/zero", tmp_path / f"zero_{which}")
+    for path in (tmp_path / which, tmp_path / f"zero_{which}"):
+        text = _refusal_within(load, path)
+        assert str(path) in text and "not a regular file" in text and "\n" not in text, text

@@ -64,6 +64,8 @@ def load_checkpoint(path: Path, expect_config: ModelConfig | None = None) -> Che
     path = Path(path)
     if not path.exists():
         raise CheckpointError(f"no checkpoint at {path}; train a model first ('symlearn train')")
+    if not path.is_file():  # a FIFO would block torch.load, a device would be read without end
+        raise CheckpointError(f"{path} is not a regular file")
     try:
         blob = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as e:  # torch raises several types for foreign, empty or truncated files

@@ -65,7 +65,7 @@ def build_report(run: Path, data: Path | None = None, benchmark: Path | None = N
     sy, sy_why = g.read_json(run / "symbols.json")
     tm, tm_why = g.read_json(run / "transition_metrics.json")
     _, metrics_why = g.read_json(run / "metrics.json")
-    curves_why = "; ".join(w for w in (metrics_why, tm_why) if w.startswith("refused"))
+    curves_why = "; ".join(w for w in (metrics_why, tm_why) if "cannot be read" in w)
     bench_path = Path(benchmark) if benchmark is not None else run / "benchmark.json"
     bench, bench_why = g.read_json(bench_path, schemas.BENCHMARK)
     if benchmark is None and not bench_path.exists():
@@ -78,7 +78,7 @@ def build_report(run: Path, data: Path | None = None, benchmark: Path | None = N
         try:
             strip = filmstrip_from_gif(gif, run / FILES_DIR / "plan_filmstrip.png")
         except RecordingError as e:  # beyond the pixel caps, or not a GIF: the section says so in one line
-            gif_why = f"refused: {e}"
+            gif_why = g.cannot_read(gif, e)
     sections = [g.data_section(summary, shares, why or data_why),
                 g.effect_section(ev, _reason(ev_why, "symlearn evaluate")),
                 g.table1_section(t1, _reason(t1_why, "symlearn table1")),

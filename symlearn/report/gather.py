@@ -32,10 +32,15 @@ def read_json(path: Path, schema: Schema | None = None) -> tuple[dict | None, st
     try:
         doc = read_json_file(path, schema, what="run file")
     except JsonFileError as e:
-        return None, f"refused: {e}"
+        return None, cannot_read(path, e)
     if not isinstance(doc, dict):
         return None, f"{path} is not a JSON object"
     return doc, ""
+
+
+def cannot_read(path: Path, e: Exception) -> str:
+    """'PATH cannot be read: REASON' from a reader's one-line refusal ('PATH: REASON')."""
+    return f"{path} cannot be read: {str(e).removeprefix(f'{path}: ')}"
 
 
 def data_section(summary: dict | None, shares: dict | None, why: str = "") -> Section:

@@ -37,6 +37,8 @@ def load_transition(path: Path, expect_config: TransitionConfig | None = None) -
     path = Path(path)
     if not path.exists():
         raise TransitionError(f"no transition model at {path}; run 'symlearn train-transition' first")
+    if not path.is_file():  # a FIFO would block torch.load, a device would be read without end
+        raise TransitionError(f"{path} is not a regular file")
     try:
         blob = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as e:  # torch raises several types for foreign or truncated files
