@@ -675,3 +675,23 @@ def test_checkpoint_that_is_a_fifo_or_device_is_refused_at_once(tmp_path, which)
     for path in (tmp_path / which, tmp_path / f"zero_{which}"):
         text = _refusal_within(load, path)
         assert str(path) in text and "not a regular file" in text and "\n" not in text, text
+
+
+@pytest.mark.parametrize("text, words", [
+    ('{"kind": "symlearn-lifted-rules", "version": true, "rules": []}', ["not a lifted rules file"]),
+    ('{"kind": "symlearn-lifted-rules", "version": 1, "code_bits": Infinity}', ["Infinity is not a JSON number"]),
+    ('{"kind": "symlearn-lifted-rules", "version": 1, "code_bits": 1e400}', ["not a finite number"]),
+    ('{"kind": "symlearn-lifted-rules", "version": 1, "code_bits": ' + "[" * 50 + "]" * 50 + "}",
+     ["nested deeper"]),
+    (None, ["FIFO"]),
+])
+def test_lifted_rules_file_goes_through_the_bounded_reader(tmp_path, text, words):
+    from pddl_export.lifted_rules import load_lifted
+
+    path = tmp_path / "lifted.json"
+    if text is None:
+        os.mkfifo(path)
+    else:
+        path.write_text(text)
+    out = _refusal_within(load_lifted, path)
+    assert out.startswith(f"{path}") and "\n" not in out and all(w in out for w in words), out
