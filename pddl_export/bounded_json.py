@@ -10,7 +10,8 @@ mistaken file meets the same limits everywhere:
   in a file of up to SCAN_BYTES (every kind but a paper-scale rules file), every integer must also lie
   within 64 bits and nothing be nested deeper than `max_depth`. A larger file is parsed with the same
   float checks and Python's own nesting guard, and its kind's parser checks each field it uses
-  (rules_io: code lengths, counts, ranges): walking millions of rules again would take 4x the parse;
+  (rules_io: code lengths, counts, ranges): walking millions of rules again costs ~3x the parse
+  (bench/json_reader.py);
 - the value must fit the file kind's schema (fields, types, ranges, list lengths, string lengths).
 
 A refusal is a `JsonFileError` (a ValueError, which the command line prints on one line with exit
