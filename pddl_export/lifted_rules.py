@@ -21,7 +21,6 @@ a move no rule covers leaves the state as it is, as the PDDL offers no action fo
 from __future__ import annotations
 
 import dataclasses
-import json
 from pathlib import Path
 from collections import Counter, defaultdict
 from dataclasses import dataclass, field
@@ -29,6 +28,7 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
+from pddl_export.bounded_json import read_json_file
 from pddl_export.lifted_scene import FAR_ROW, NEAR_ROW, CodeLayout, Piece, SceneGraph, neighbours, read_scene, \
     top_of
 
@@ -330,13 +330,9 @@ def _agreement(tally: dict, majority: dict) -> float:
 def load_lifted(path) -> LiftedRules:
     """LiftedRules back from to_json's form (RUN/pddl/lifted.json)."""
     path = Path(path)
-    if not path.is_file() or path.stat().st_size > MAX_LIFTED_BYTES:
-        raise ValueError(f"{path} is not a lifted rules file of at most {MAX_LIFTED_BYTES} bytes")
-    try:
-        d = json.loads(path.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as e:
-        raise ValueError(f"{path} is not valid JSON: {e}") from None
-    if not isinstance(d, dict) or d.get("kind") != LIFTED_KIND or d.get("version") != LIFTED_VERSION:
+    d = read_json_file(path, what="lifted rules file", max_bytes=MAX_LIFTED_BYTES)  # bounded; one line naming it
+    version = d.get("version") if isinstance(d, dict) else None
+    if not isinstance(d, dict) or d.get("kind") != LIFTED_KIND or type(version) is not int or version != LIFTED_VERSION:
         raise ValueError(f"{path} is not a lifted rules file ({LIFTED_KIND} version {LIFTED_VERSION})")
     try:
         layout = CodeLayout(int(d["code_bits"]), tuple(int(b) for b in d["kept"]))
@@ -349,8 +345,8 @@ def load_lifted(path) -> LiftedRules:
             names = tuple(k for k, _ in r.key)
             if names[:len(STRUCTURE)] != STRUCTURE or not 0 <= r.depth <= len(REFINEMENTS):
                 raise ValueError(f"a rule's key names {names[:len(STRUCTURE)]}, expected {STRUCTURE}")
-    except (KeyError, TypeError, ValueError) as e:
-        raise ValueError(f"{path}: malformed lifted rules ({e})") from None
+    except (KeyError, TypeError, ValueError, OverflowError) as e:
+        raise ValueError(f"{path}: malformed lifted rules ({str(e).splitlines()[0][:200]})") from None
     return LiftedRules(layout, stick_of, rules, str(d.get("model_hash", "")), dict(d.get("stats", {})), codebook)
 
 

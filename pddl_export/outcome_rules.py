@@ -22,7 +22,6 @@ outcomes, without the network. Stored as RUN/pddl/outcomes.json beside rules.jso
 """
 from __future__ import annotations
 
-import json
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -33,8 +32,10 @@ import numpy as np
 from pddl_export.distil import distil_rules
 from pddl_export.enumeration import Enumeration, SceneBlock
 from pddl_export.rules import RuleSet
-from pddl_export.rules_io import FREEZE_BYTES, PDDL_DIR, paused_gc, rules_from_json, rules_to_json
-from pddl_export.symbolic import OutcomeTransitionFn, bit_flip_costs, code_str, codes_from_bits
+from pddl_export.bounded_json import read_json_file
+from pddl_export.rules_io import (FREEZE_BYTES, PDDL_DIR, RULES_FILE_BYTES, _CodeStrings, paused_gc, rules_from_json,
+                                  rules_to_json)
+from pddl_export.symbolic import N_ACTIONS, OutcomeTransitionFn, bit_flip_costs, code_str, codes_from_bits
 
 OUTCOMES_FILE = "outcomes.json"
 MIN_OUTCOME_RATIO = 0.05  # an alternative is kept where it is at least this fraction as likely as the likeliest
@@ -165,12 +166,29 @@ def outcomes_to_json(outcomes: OutcomeRules) -> dict:
 def outcomes_from_json(d: dict) -> OutcomeRules:
     """Inverse of outcomes_to_json; one-line ValueError on a malformed file."""
     try:
-        costs = tuple((int(r["action"]), int(r["from"], 2), int(r["to"], 2), float(r["cost"])) for r in d["costs"])
-        return OutcomeRules(rules_from_json(d), costs, float(d["min_ratio"]))
+        rules = rules_from_json(d)
+        c = _CodeStrings(rules.bits).__getitem__  # exactly `bits` characters 0 or 1, as in rules.json
+        costs = tuple((_action(r["action"]), c(r["from"]), c(r["to"]), _number(r["cost"], "cost"))
+                      for r in d["costs"])
+        return OutcomeRules(rules, costs, _number(d["min_ratio"], "min_ratio"))
     except KeyError as e:
         raise ValueError(f"malformed outcomes file: missing field {e}") from None
-    except (TypeError, AttributeError) as e:
-        raise ValueError(f"malformed outcomes file: {type(e).__name__}: {e}") from None
+    except (TypeError, AttributeError, OverflowError) as e:
+        raise ValueError(f"malformed outcomes file: {type(e).__name__}: {str(e).splitlines()[0][:200]}") from None
+
+
+def _number(x, name: str) -> float:
+    """A finite number of the file (not a string or boolean); ValueError naming the field otherwise."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)) or not np.isfinite(x):
+        raise ValueError(f"malformed outcomes file: field {name!r} must be a finite number, got {str(x)[:40]!r}")
+    return float(x)
+
+
+def _action(a) -> int:
+    """An action id of a cost entry: an integer 0..N_ACTIONS - 1."""
+    if isinstance(a, bool) or not isinstance(a, int) or not 0 <= a < N_ACTIONS:
+        raise ValueError(f"cost entry action {a!r} is not an action id 0..{N_ACTIONS - 1}")
+    return a
 
 
 def load_outcomes(run_dir: Path) -> tuple[OutcomeRules, str]:
@@ -181,15 +199,13 @@ def load_outcomes(run_dir: Path) -> tuple[OutcomeRules, str]:
         raise ValueError(f"no exported outcome rules at {path}; {fix}")
     try:
         with paused_gc(freeze=path.stat().st_size >= FREEZE_BYTES):
-            d = json.loads(path.read_text(encoding="utf-8"))
+            d = read_json_file(path, what="outcomes file", max_bytes=RULES_FILE_BYTES)
             if not isinstance(d, dict):
                 raise ValueError(f"a JSON {type(d).__name__}, expected an object")
             outcomes = outcomes_from_json(d)
         model_hash = d.get("model_hash", "")
         if not isinstance(model_hash, str):
             raise ValueError(f"model_hash must be a string, got {model_hash!r}")
-    except json.JSONDecodeError as e:
-        raise ValueError(f"{path}: not valid JSON (line {e.lineno}: {e.msg}); {fix}") from None
-    except (OSError, UnicodeDecodeError, ValueError) as e:
-        raise ValueError(f"{path}: {e}") from None
+    except ValueError as e:  # the bounded reader's refusals already name the file
+        raise ValueError(str(e) if str(e).startswith(f"{path}: ") else f"{path}: {e}") from None
     return outcomes, model_hash

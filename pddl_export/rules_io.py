@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import contextlib
 import gc
-import json
 from pathlib import Path
 
-from pddl_export.rules import Rule, RuleSet
+from pddl_export.bounded_json import JsonFileError, MiB, read_json_file
+from pddl_export.rules import COUNT_CAP, Rule, RuleSet
 from pddl_export.symbolic import code_str
 
 PDDL_DIR = "pddl"  # RUN/pddl holds domain.pddl, rules.json and report.json
@@ -31,6 +31,8 @@ def rules_to_json(rules: RuleSet) -> dict:
                        "fewer_than": [[code_str(c, b), n] for c, n in r.fewer_than]} for r in rules.rules]}
 
 
+MAX_RULE_BITS = 28  # codes are packed as action << 2 * bits | from << bits | to in int64 keys; learned codes have <= 25
+RULES_FILE_BYTES = 1024 * MiB  # a paper-scale rules file (327k rules) is about 80 MB
 FREEZE_BYTES = 20_000_000  # a rules file this big is loaded to stay: its objects leave the collector's sight
 
 
@@ -58,37 +60,67 @@ def paused_gc(freeze: bool = False):
 
 
 class _CodeStrings(dict):
-    """Bit string -> code, each distinct string parsed once."""
+    """Bit string -> code, each distinct string parsed (and checked: exactly `bits` characters 0 or 1) once."""
+
+    def __init__(self, bits: int) -> None:
+        super().__init__()
+        self.bits = bits
 
     def __missing__(self, s: str) -> int:
+        if not isinstance(s, str):
+            raise TypeError(f"a code must be a bit string, got {type(s).__name__}")
+        if len(s) != self.bits or s.strip("01"):
+            raise ValueError(f"code {s[:40]!r}{'...' if len(s) > 40 else ''} is not a string of {self.bits} bits "
+                             f"(0 or 1)")
         self[s] = value = int(s, 2)
         return value
 
 
+def _count(n) -> int:
+    """A count bound of a rule: an integer 2..COUNT_CAP (a huge one would overflow the int16 tables)."""
+    n = int(n)
+    if not 0 <= n <= COUNT_CAP:
+        raise ValueError(f"count bound {n if abs(n) < 10**12 else '(huge)'} is outside 0..{COUNT_CAP}")
+    return n
+
+
+def _ranged(d: dict, key: str, lo: int, hi: int) -> int:
+    """d[key] as an integer in lo..hi; ValueError naming the field otherwise."""
+    v = d[key]
+    if isinstance(v, bool) or (isinstance(v, float) and not v.is_integer()):
+        raise ValueError(f"field {key!r} must be an integer, got {v!r}")
+    v = int(v)
+    if not lo <= v <= hi:
+        raise ValueError(f"field {key!r} {v if abs(v) < 10**12 else '(huge)'} is outside {lo}..{hi}")
+    return v
+
+
 def rules_from_json(d: dict) -> RuleSet:
-    """Inverse of rules_to_json; refuses malformed files with a one-line error."""
+    """Inverse of rules_to_json; refuses malformed files with a one-line error (bits 1..MAX_RULE_BITS, codes
+    of exactly that many bit characters, counts within COUNT_CAP, max_objects within COUNT_CAP)."""
     try:
-        c = _CodeStrings().__getitem__  # a file names a few hundred codes millions of times
+        if not isinstance(d, dict):
+            raise TypeError(f"a JSON {type(d).__name__}, expected an object")
+        bits = _ranged(d, "bits", 1, MAX_RULE_BITS)
+        c = _CodeStrings(bits).__getitem__  # a file names a few hundred codes millions of times
         rules = tuple(Rule(int(r["action"]), c(r["from"]), c(r["to"]), tuple(map(c, r["requires"])),
-                           tuple(map(c, r["forbids"])), tuple((c(x), int(n)) for x, n in r["at_least"]),
-                           tuple((c(x), int(n)) for x, n in r["fewer_than"])) for r in d["rules"])
-        return RuleSet(int(d["bits"]), tuple(map(c, d["vocabulary"])), int(d["max_objects"]), rules,
-                       int(d["n_rules_before_generalization"]))
+                           tuple(map(c, r["forbids"])), tuple((c(x), _count(n)) for x, n in r["at_least"]),
+                           tuple((c(x), _count(n)) for x, n in r["fewer_than"])) for r in d["rules"])
+        return RuleSet(bits, tuple(map(c, d["vocabulary"])), _ranged(d, "max_objects", 1, COUNT_CAP), rules,
+                       _ranged(d, "n_rules_before_generalization", 0, 1 << 62))
     except KeyError as e:
         raise ValueError(f"malformed rules file: missing field {e}") from None
-    except (TypeError, ValueError, AttributeError) as e:
-        raise ValueError(f"malformed rules file: {type(e).__name__}: {e}") from None
+    except (TypeError, ValueError, AttributeError, OverflowError) as e:
+        raise ValueError(f"malformed rules file: {type(e).__name__}: {str(e).splitlines()[0][:200]}") from None
 
 
 def _read_rules_json(path: Path, run_dir: Path) -> dict:
-    """The JSON object of a rules file; one-line ValueError naming the file if it is not one."""
+    """The JSON object of a rules file (read by the bounded reader); one-line ValueError naming the file if it is
+    not one."""
     try:
-        d = json.loads(path.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as e:
-        raise ValueError(f"{path}: not valid JSON (line {e.lineno}, column {e.colno}: {e.msg}); "
-                         f"re-run 'symlearn export-pddl --run {run_dir}'") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise ValueError(f"{path}: cannot be read: {type(e).__name__}: {e}") from None
+        d = read_json_file(path, what="rules file", max_bytes=RULES_FILE_BYTES)
+    except JsonFileError as e:
+        raise JsonFileError(f"{e}; re-run 'symlearn export-pddl --run {run_dir}'") from None
     if not isinstance(d, dict):
         raise ValueError(f"{path}: not a rules file (a JSON {type(d).__name__}, expected an object with "
                          f"'bits', 'vocabulary', 'max_objects' and 'rules')")

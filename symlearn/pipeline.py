@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
+from pddl_export.bounded_json import JsonFileError, List, Map, Num, Obj, Opt, Str, check, read_json_file
 from symlearn.provenance import atomic_write_json, sha256_bytes, sha256_file
 
 RECORD_FILE = "pipeline.json"
@@ -150,19 +151,30 @@ def _hashes(out: Path, rels: tuple[str, ...]) -> dict[str, str | None]:
     return {r: path_hash(out / r) for r in rels}
 
 
-def load_record(out: Path) -> dict:
-    """OUT/pipeline.json, or an empty record; a foreign or unreadable file is refused with its name."""
-    import json
+_HASHES = Map(Opt(Str(64)), 100)  # relative path -> 16 hex digits, None where missing
+# One finished stage as run_pipeline records it; is_done compares argv, inputs and outputs.
+STAGE_RECORD = Obj(optional={"argv": List(List(Str(4096), 200), 20), "inputs": _HASHES, "outputs": _HASHES,
+                             "wall_s": Opt(Num()), "finished": Str(100), "out": Str(4096)})
+RECORD_SCHEMA = Obj({"kind": Str(100), "stages": Map(STAGE_RECORD, 100)},
+                    optional={"out": Str(4096), "preset": Str(100)})
 
+
+def load_record(out: Path) -> dict:
+    """OUT/pipeline.json, or an empty record; a foreign, unreadable or wrong-shaped file is refused in one line
+    naming the file (and the field)."""
     path = out / RECORD_FILE
     if not path.exists():
         return {"kind": RECORD_KIND, "stages": {}}
     try:
-        doc = json.loads(path.read_text())
-    except (OSError, ValueError) as e:
-        raise ValueError(f"{path} cannot be read ({type(e).__name__}); delete it to start over") from None
+        doc = read_json_file(path, what="pipeline record")
+    except JsonFileError as e:
+        raise ValueError(f"{e}; delete it to start over") from None
     if not isinstance(doc, dict) or doc.get("kind") != RECORD_KIND or not isinstance(doc.get("stages"), dict):
         raise ValueError(f"{path} is not a symlearn pipeline record; delete it to start over")
+    try:
+        check(doc, RECORD_SCHEMA, str(path))
+    except JsonFileError as e:
+        raise ValueError(f"{e}; delete it to start over") from None
     return doc
 
 

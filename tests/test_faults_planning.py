@@ -309,12 +309,15 @@ def test_row_log_cuts_a_torn_row_and_refuses_other_settings(tmp_path):
     path = tmp_path / "b.json.rows.jsonl"
     log = RowLog(path, {"planners": ["astar"], "timeout_s": 10.0})
     assert log.open() == {}
-    log.append(("p0.json", "astar", False), {"x": float("nan")})
+    row = {"problem": "p0", "planner": "astar", "found": True, "status": "solved", "plan_length": 1,
+           "planning_time_s": 0.1, "expansions": 2, "success": True, "symbolic_match": True, "max_distance_m": 0.01,
+           "closed_loop": False, "replans": 0, "failure_stage": None, "generator_length": 1}
+    log.append(("p0.json", "astar", False), {**row, "max_distance_m": float("nan")})
     log.close()
     with open(path, "a") as f:
         f.write('{"key": ["p1.json", "ast')  # a kill in the middle of a row
     log = RowLog(path, {"planners": ["astar"], "timeout_s": 10.0})
-    assert log.open() == {("p0.json", "astar", False): {"x": None}}
+    assert log.open() == {("p0.json", "astar", False): {**row, "max_distance_m": None}}
     log.close()
     assert path.read_text().endswith("}\n")
     for line in path.read_text().splitlines():

@@ -7,7 +7,6 @@ Everything loads with numpy alone (`allow_pickle=False`); see docs/DATA_FORMAT.m
 """
 from __future__ import annotations
 
-import json
 import zipfile
 from dataclasses import dataclass, fields
 from pathlib import Path
@@ -15,6 +14,7 @@ from typing import Sequence
 
 import numpy as np
 
+from pddl_export.bounded_json import JsonFileError, read_json_file
 from symlearn.provenance import sha256_bytes, sha256_file
 
 FORMAT_VERSION = 1
@@ -71,9 +71,9 @@ def load_manifest(root: Path, require_complete: bool = True) -> dict:
     if not path.exists():
         raise DataError(f"no data set at {root} (manifest.json missing); run 'symlearn collect' first")
     try:
-        m = json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as e:
-        raise DataError(f"{path} is not valid JSON: {e}") from None
+        m = read_json_file(path, what="data set manifest")
+    except JsonFileError as e:
+        raise DataError(str(e)) from None
     if not isinstance(m, dict) or m.get("kind") != DATA_KIND:
         raise DataError(f"{root} is not a symlearn interaction data set ({path} has no kind {DATA_KIND!r})")
     if m.get("format_version") != FORMAT_VERSION:

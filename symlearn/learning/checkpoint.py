@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from pddl_export.bounded_json import loads_bounded
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig
 from symlearn.provenance import atomic_write_bytes, sha256_file, versions
 
@@ -63,6 +64,8 @@ def load_checkpoint(path: Path, expect_config: ModelConfig | None = None) -> Che
     path = Path(path)
     if not path.exists():
         raise CheckpointError(f"no checkpoint at {path}; train a model first ('symlearn train')")
+    if not path.is_file():  # a FIFO would block torch.load, a device would be read without end
+        raise CheckpointError(f"{path} is not a regular file")
     try:
         blob = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as e:  # torch raises several types for foreign, empty or truncated files
@@ -91,10 +94,11 @@ def _record(blob: dict) -> Checkpoint:
             raise KeyError(f"field {key!r} missing")
         if not isinstance(blob[key], kind):
             raise TypeError(f"field {key!r} is {type(blob[key]).__name__}, expected {kind.__name__}")
-    cfg = ModelConfig.from_json(json.loads(blob["config"]))
+    cfg = ModelConfig.from_json(loads_bounded(blob["config"], "field 'config'"))
     return Checkpoint(cfg, blob["model"], blob["optimizer"] or None, blob["epoch"], blob["best_val"],
-                      json.loads(blob["history"]), blob["rng_states"],
-                      blob["effect_mean"].numpy(), blob["effect_std"].numpy(), json.loads(blob["meta"]))
+                      loads_bounded(blob["history"], "field 'history'"), blob["rng_states"],
+                      blob["effect_mean"].numpy(), blob["effect_std"].numpy(),
+                      loads_bounded(blob["meta"], "field 'meta'"))
 
 
 def _first_line(e: BaseException) -> str:

@@ -22,6 +22,7 @@ import numpy as np
 import torch
 import torch.distributed as dist
 
+from pddl_export.bounded_json import read_json_file
 from symlearn.learning.checkpoint import load_checkpoint, load_weights, save_checkpoint
 from symlearn.data.dataset import InteractionData, data_fingerprint, load_split
 from symlearn.data.model_input import model_inputs
@@ -329,8 +330,8 @@ def check_run_dir(run_dir: Path, data_dir: Path) -> None:
     manifest = run_dir / "manifest.json"
     if manifest.exists():
         try:
-            kind = json.loads(manifest.read_text()).get("kind")
-        except (ValueError, UnicodeDecodeError, AttributeError):
+            kind = read_json_file(manifest, what="manifest").get("kind")
+        except (ValueError, AttributeError):  # JsonFileError is a ValueError
             kind = None
         what = "a symlearn data set" if kind == DATA_KIND else "a folder with a manifest.json"
         raise TrainingError(f"--out {run_dir} holds {what} ({manifest}); choose a separate run folder")

@@ -24,6 +24,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
+from pddl_export.bounded_json import (AnyJson, Bool, Int, JsonFileError, Map, MiB, Num, Obj, Opt, Str, Tuple, check,
+                                      loads_bounded, read_bounded_bytes)
 from pddl_export.files import finite_or_null
 from pddl_export.rules_io import PDDL_DIR, RULES_FILE
 from symlearn.planning.execution import ExecutionConfig, ProblemRun, failure_causes, run_problem
@@ -204,6 +206,19 @@ def summary_tasks(rows: list[ProblemRun]) -> dict:
 
 ROWS_FORMAT = "symlearn-benchmark-rows"
 ROWS_VERSION = 1
+ROWS_FILE_BYTES = 512 * MiB  # a row is about 1-2 KB; a benchmark of 100k rows fits
+_TEXT = Str(100_000)
+# One finished row as ProblemRun.to_json writes it (non-finite numbers as null); ProblemRun refuses the rest.
+ROW_SCHEMA = Obj(
+    required={"problem": Str(1000), "planner": Str(200), "found": Bool(), "status": Str(100),
+              "plan_length": Opt(Int(0)), "planning_time_s": Opt(Num()), "expansions": Opt(Int(0)),
+              "success": Bool(), "symbolic_match": Bool(), "max_distance_m": Opt(Num()), "closed_loop": Bool(),
+              "replans": Int(0), "failure_stage": Opt(Str(100)), "generator_length": Int(0)},
+    optional={"message": _TEXT, "n_objects": Int(0), "timings": Map(Opt(AnyJson()), 1000), "task": Str(1000),
+              "failure_cause": Opt(Str(100)), "attribution": Map(AnyJson(), 1000), "goal_off_locations": Opt(Int(0))},
+    extra=False)
+# A line of the log after the first: the row's key (problem key, planner, closed loop) and the row.
+ROW_ENTRY_SCHEMA = Obj(required={"key": Tuple((Str(1000), Str(200), Bool())), "row": ROW_SCHEMA}, extra=False)
 
 
 def rows_path(out_file: Path) -> Path:
@@ -225,28 +240,44 @@ class RowLog:
         self._file = None
 
     def open(self) -> dict[tuple, dict]:
-        """Read (or create) the log; returns key -> finished row JSON."""
+        """Read (or create) the log; returns key -> finished row JSON.
+
+        Every line is read with the bounded reader and checked against the row schema (and as a ProblemRun)
+        here, before any row runs: a wrong-shaped line is refused naming the file and the line.
+        """
         if not self.path.exists():
             atomic_write_text(self.path, _line({"format": ROWS_FORMAT, "version": ROWS_VERSION,
                                                 "settings": self.settings}))
-        data = self.path.read_bytes()
+        data = read_bounded_bytes(self.path, ROWS_FILE_BYTES, "benchmark row log")
         whole = data[:data.rfind(b"\n") + 1]
-        lines = whole.decode("utf-8", errors="replace").splitlines()
+        lines = whole.splitlines()
+        fix = "delete it to start over"
         try:
-            head, entries = json.loads(lines[0]), [json.loads(x) for x in lines[1:]]
-        except (json.JSONDecodeError, IndexError) as e:
-            raise ValueError(f"{self.path}: not a benchmark row log ({e}); delete it to start over") from None
+            head = loads_bounded(lines[0], f"{self.path}: line 1")
+        except (JsonFileError, IndexError) as e:
+            raise ValueError(f"{self.path}: not a benchmark row log ({e}); {fix}") from None
         if not isinstance(head, dict) or head.get("format") != ROWS_FORMAT:
-            raise ValueError(f"{self.path}: not a benchmark row log; delete it to start over")
+            raise ValueError(f"{self.path}: not a benchmark row log; {fix}")
         if head.get("settings") != self.settings:
-            diff = sorted(k for k in set(self.settings) | set(head.get("settings") or {})
-                          if (head.get("settings") or {}).get(k) != self.settings.get(k))
+            old = head.get("settings") if isinstance(head.get("settings"), dict) else {}
+            diff = sorted(k for k in set(self.settings) | set(old) if old.get(k) != self.settings.get(k))
             raise ValueError(f"{self.path} holds a partial benchmark with other settings (differing: "
                              f"{', '.join(diff)}); re-run with the same settings to resume, or delete it")
+        done = {}
+        for n, text in enumerate(lines[1:], 2):
+            where = f"{self.path}: line {n}"
+            try:
+                entry = loads_bounded(text, where)
+                check(entry, ROW_ENTRY_SCHEMA, where)
+                ProblemRun(**entry["row"])  # the refusals of the row itself (unknown failure stage, ...)
+            except (TypeError, ValueError) as e:
+                msg = str(e).splitlines()[0] if str(e) else type(e).__name__
+                raise ValueError(f"{msg if msg.startswith(where) else f'{where}: {msg}'}; {fix}") from None
+            done[tuple(entry["key"])] = entry["row"]
         if len(whole) != len(data):
             with open(self.path, "r+b") as f:  # a row torn by a kill: cut it off
                 f.truncate(len(whole))
-        self.done = {tuple(e["key"]): e["row"] for e in entries}
+        self.done = done
         self._file = open(self.path, "a", encoding="utf-8")
         return self.done
 

@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import argparse
 import io
-import json
 import math
 from pathlib import Path
 
+from pddl_export.bounded_json import JsonFileError, MiB, read_json_file
 from symlearn.planning.benchmark import (LENGTH_BUCKETS, LOOPS, SHORTEST_BUCKETS, summary_failure_causes,
                                          summary_grid, summary_shortest_grid, summary_tasks)
 from symlearn.planning.execution import ProblemRun
@@ -267,9 +267,9 @@ def main(argv: list[str] | None = None) -> int:
     results = []
     for path in args.result:
         try:
-            results.append(json.loads(path.read_text()))
-        except (OSError, json.JSONDecodeError, UnicodeDecodeError) as e:
-            raise SystemExit(f"{path}: not a readable benchmark JSON ({str(e).splitlines()[0]})")
+            results.append(read_json_file(path, what="benchmark JSON", max_bytes=512 * MiB))
+        except JsonFileError as e:
+            raise SystemExit(f"not a readable benchmark JSON: {e}")
     try:
         result = merge_results(results, [str(p) for p in args.result])
         summary = grid_of(result)

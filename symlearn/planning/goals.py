@@ -13,13 +13,13 @@ geometric check of a settled scene against them. Building in the simulator is go
 """
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from pddl_export.bounded_json import MiB, read_json_file
 from symlearn.provenance import atomic_write_json
 from symlearn.sim.exploration import MAX_OBJECTS
 from symlearn.world import (FAR_ROW, LOCATIONS, N_ACTIONS, N_LOCATIONS, OBJECT_SIZE, TABLE_TOP_Z, ObjectType, Scene,
@@ -32,6 +32,9 @@ ARRANGEMENT_TOLERANCE_M = 0.02  # a settled object this far from where its arran
 MAX_TILT_DEG = 10.0  # an object tilted more than this has fallen or leans on something
 _OBJECT_KEYS = {"type", "initial", "goal"}
 _TOP_KEYS = {"format", "version", "objects", "reference_plan", "task", "seed", "description"}
+MAX_PLAN_STEPS = 100  # a reference plan is executed step by step in the simulator: a few dozen is plenty
+MAX_TEXT = 10_000  # characters of a task name or description
+GOAL_FILE_BYTES = 1 * MiB
 
 
 @dataclass(frozen=True)
@@ -103,6 +106,8 @@ def _plan(v, where: str) -> tuple[int, ...] | None:
         return None
     if not isinstance(v, list):
         raise ValueError(f"{where}: reference_plan must be a list of [pick, release] pairs or action ids")
+    if len(v) > MAX_PLAN_STEPS:
+        raise ValueError(f"{where}: reference_plan has {len(v)} steps, more than the {MAX_PLAN_STEPS} a goal may carry")
     out = []
     for step, a in enumerate(v):
         if _is_int(a) and 0 <= a < N_ACTIONS:
@@ -120,7 +125,8 @@ def parse_goal(d, where: str = "goal") -> Goal:
     """A Goal from a goal file's JSON, checked (check_goal); every refusal is one line naming `where`."""
     if not isinstance(d, dict):
         raise ValueError(f"{where}: expected a JSON object, got {type(d).__name__}")
-    if d.get("format") != GOAL_FORMAT or d.get("version") != GOAL_VERSION:
+    version = d.get("version")
+    if d.get("format") != GOAL_FORMAT or type(version) is not int or version != GOAL_VERSION:  # true == 1 in Python
         raise ValueError(f"{where}: not a symlearn goal file (expected format {GOAL_FORMAT!r}, version {GOAL_VERSION})")
     extra = sorted(set(d) - _TOP_KEYS)
     if extra:
@@ -128,8 +134,11 @@ def parse_goal(d, where: str = "goal") -> Goal:
     objs, task, seed = d.get("objects"), d.get("task", GOAL_TASK), d.get("seed", 0)
     if not isinstance(objs, list) or not 1 <= len(objs) <= MAX_OBJECTS:
         raise ValueError(f"{where}: objects must be a list of 1..{MAX_OBJECTS} objects")
-    if not isinstance(task, str) or not task:
-        raise ValueError(f"{where}: task must be a non-empty string, got {task!r}")
+    if not isinstance(task, str) or not task or len(task) > MAX_TEXT:
+        raise ValueError(f"{where}: task must be a non-empty string of at most {MAX_TEXT} characters, "
+                         f"got {task[:40] + '...' if isinstance(task, str) and len(task) > 40 else task!r}")
+    if not isinstance(d.get("description", ""), str) or len(d.get("description", "")) > MAX_TEXT:
+        raise ValueError(f"{where}: description must be a string of at most {MAX_TEXT} characters")
     if not (_is_int(seed) and seed >= 0):
         raise ValueError(f"{where}: seed must be a non-negative integer, got {seed!r}")
     spec, targets = [], []
@@ -149,13 +158,9 @@ def load_goal(path: Path) -> Goal:
     """Read and check a goal file; refuses it with a one-line ValueError naming the file."""
     path = Path(path)
     where = f"goal file {path}"
-    if not path.is_file():
+    if not path.exists():
         raise ValueError(f"{where}: no such file")
-    try:
-        d = json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as e:
-        raise ValueError(f"{where}: not valid JSON ({str(e).splitlines()[0]})") from None
-    return parse_goal(d, where)
+    return parse_goal(read_json_file(path, what="goal file", max_bytes=GOAL_FILE_BYTES), where)
 
 
 def save_goal(path: Path, goal: Goal) -> None:

@@ -10,13 +10,13 @@ are placed and encoded by symlearn.planning.scenes.
 """
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from pddl_export.bounded_json import MiB, read_json_file
 from symlearn.planning.paths import check_safe_name, is_safe_name
 from symlearn.sim.exploration import MAX_OBJECTS
 from symlearn.provenance import atomic_write_json
@@ -37,6 +37,9 @@ REACH_HALF_X, REACH_HALF_Y = 0.5, 0.6
 REACH_Z_MAX = 1.0
 QUATERNION_NORM_TOL = 1e-3
 _KEYS = ("format", "version", "name", "seed", "spec", "initial", "actions", "goal", "generator_length")
+MAX_ACTIONS = 100  # generator actions a problem file may list (random walks take a handful)
+MAX_TASK_CHARS = 10_000
+PROBLEM_FILE_BYTES = 4 * MiB  # a problem file is a few kilobytes
 
 
 @dataclass(frozen=True)
@@ -163,7 +166,7 @@ class Problem:
             raise ValueError(f"{p}: missing keys {', '.join(missing)}")
         if d["format"] != PROBLEM_FORMAT:
             raise ValueError(f"{p}: not a symlearn problem (format {d['format']!r})")
-        if d["version"] not in READABLE_VERSIONS:
+        if not _is_int(d["version"]) or d["version"] not in READABLE_VERSIONS:  # true == 1 in Python
             raise ValueError(f"{p}: problem version {d['version']!r}, this symlearn reads versions "
                              f"{', '.join(map(str, READABLE_VERSIONS))}")
         task, free = d.get("task", RANDOM_WALK), d.get("free", [])
@@ -175,9 +178,9 @@ class Problem:
         optimal = (d.get("optimal_length"), d.get("optimal_reason"), d.get("optimal_plan"))
         if optimal[2] is not None and not isinstance(optimal[2], list):
             raise ValueError(f"{p}: optimal_plan must be a list of action ids or null")
-        if not isinstance(task, str) or not task:
-            raise ValueError(f"{p}: task must be a non-empty string, got {task!r}")
-        if not isinstance(free, list) or not all(_is_int(i) for i in free):
+        if not isinstance(task, str) or not task or len(task) > MAX_TASK_CHARS:
+            raise ValueError(f"{p}: task must be a non-empty string of at most {MAX_TASK_CHARS} characters")
+        if not isinstance(free, list) or len(free) > MAX_OBJECTS or not all(_is_int(i) for i in free):
             raise ValueError(f"{p}: free must be a list of object indices, got {free!r}")
         check_safe_name(d["name"], where)  # the name becomes a folder (RUN/pddl/problems/NAME)
         if not _is_int(d["seed"]):
@@ -185,6 +188,8 @@ class Problem:
         spec = d["spec"]
         if not isinstance(spec, list) or not all(isinstance(e, list) and len(e) == 2 for e in spec):
             raise ValueError(f"{p}: spec must be a list of [type, location] pairs")
+        if not 1 <= len(spec) <= MAX_OBJECTS:
+            raise ValueError(f"{p}: spec lists {len(spec)} objects, expected 1..{MAX_OBJECTS}")
         parsed = []
         for t, loc in spec:
             if not isinstance(t, str) or t.upper() not in ObjectType.__members__:
@@ -195,6 +200,8 @@ class Problem:
         actions = d["actions"]
         if not isinstance(actions, list) or not all(_is_int(a) for a in actions):
             raise ValueError(f"{p}: actions must be a list of integer action ids")
+        if len(actions) > MAX_ACTIONS:
+            raise ValueError(f"{p}: {len(actions)} actions, more than the {MAX_ACTIONS} a problem may list")
         if d["generator_length"] != len(actions):
             raise ValueError(f"{p}: generator_length {d['generator_length']!r} does not match "
                              f"{len(actions)} actions")
@@ -234,6 +241,8 @@ def _scene(d, where: str) -> Scene:
     """A scene from JSON with type and shape checks on every object."""
     if not isinstance(d, dict) or not isinstance(d.get("objects"), list):
         raise ValueError(f"{where} must be an object with an 'objects' list")
+    if len(d["objects"]) > MAX_OBJECTS:
+        raise ValueError(f"{where}: {len(d['objects'])} objects, more than {MAX_OBJECTS}")
     for o in d["objects"]:
         if not isinstance(o, dict) or not isinstance(o.get("type"), str):
             raise ValueError(f"{where}: every object needs a type")
@@ -258,16 +267,8 @@ def load_problem(path: Path) -> Problem:
     path = Path(path)
     if not path.exists():
         raise ValueError(f"problem {path.name}: no such file {path}")
-    try:
-        d = json.loads(path.read_text(), parse_constant=_refuse_constant)
-    except (json.JSONDecodeError, UnicodeDecodeError, ValueError) as e:
-        raise ValueError(f"problem file {path}: not valid JSON ({str(e).splitlines()[0]})") from None
+    d = read_json_file(path, what="problem file", max_bytes=PROBLEM_FILE_BYTES)
     return Problem.from_json(d, where=f"problem file {path}")
-
-
-def _refuse_constant(name: str) -> float:
-    """json.loads hook: NaN and Infinity are not JSON."""
-    raise ValueError(f"{name} is not a JSON number")
 
 
 def load_problems(problems_dir: Path) -> list[tuple[Path, Problem]]:

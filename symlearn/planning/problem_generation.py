@@ -10,13 +10,13 @@ symbolic model and recorded too (symlearn.planning.shortest).
 """
 from __future__ import annotations
 
-import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from pddl_export.bounded_json import JsonFileError, read_json_file
 from symlearn.planning.paths import path_under
 from symlearn.planning.problem import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems,
                                        save_problem)
@@ -153,8 +153,8 @@ def prepare_problem_dir(out_dir: Path, settings: dict, overwrite: bool = False) 
         old = None
         if manifest.is_file():
             try:
-                old = json.loads(manifest.read_text())
-            except (json.JSONDecodeError, UnicodeDecodeError):
+                old = read_json_file(manifest, what="problem manifest")
+            except JsonFileError:
                 old = None
         if overwrite:
             for f in _own_files(out_dir):

@@ -14,14 +14,21 @@ the image with the same camera matrices. Files are written atomically (pddl_expo
 from __future__ import annotations
 
 import io
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from pddl_export.bounded_json import MiB, read_bounded_bytes
 from symlearn.provenance import atomic_write_bytes
 from symlearn.world import LOCATIONS, TABLE_TOP_Z, decode_action
 
+# What a recording read back (the report's filmstrip) may be: a recorded plan is 320x240 x a few dozen frames.
+MAX_GIF_BYTES = 64 * MiB
+MAX_FRAME_PIXELS = 4096 * 4096
+MAX_FRAMES = 1000
+MAX_TOTAL_PIXELS = 64_000_000  # every frame together: ~190 MB as RGB, and the filmstrip as much again
 ARROW_RGB = (230, 40, 40)
 TEXT_RGB = (255, 255, 255)
 
@@ -140,11 +147,54 @@ class PlanRecorder:
         return path
 
 
-def filmstrip_from_gif(gif: Path, out: Path, gap: int = 4) -> Path:
-    """A filmstrip PNG from every frame of a recorded GIF (for the report)."""
-    from PIL import Image, ImageSequence
+class RecordingError(ValueError):
+    """A recording that cannot be read back within bounds: not a regular file, too large, not a GIF, or more
+    pixels (one frame, or all frames together) than the caps allow; the message is one line naming the file."""
 
-    with Image.open(gif) as im:
-        frames = [f.convert("RGB") for f in ImageSequence.Iterator(im)]
+
+def read_gif_frames(gif: Path) -> list:
+    """Every frame of a recorded GIF as RGB images, with the pixel caps checked before each frame is decoded.
+
+    A GIF states its size in a few bytes, so a tiny file can declare 60 frames of 9000 x 9000 (30 GB once
+    decoded): the frame size is checked against MAX_FRAME_PIXELS on opening, and the running total against
+    MAX_TOTAL_PIXELS and MAX_FRAMES before each frame; Pillow's decompression-bomb check becomes the same refusal.
+    """
+    from PIL import Image, ImageSequence, UnidentifiedImageError
+
+    gif = Path(gif)
+    try:
+        data = read_bounded_bytes(gif, MAX_GIF_BYTES, "recording")
+    except ValueError as e:
+        raise RecordingError(str(e)) from None
+    frames = []
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            with Image.open(io.BytesIO(data), formats=["GIF"]) as im:
+                w, h = im.size
+                if w * h > MAX_FRAME_PIXELS:
+                    raise RecordingError(f"{gif}: frames of {w} x {h} pixels, more than the {MAX_FRAME_PIXELS} "
+                                         f"a recording's frame may have")
+                for i, frame in enumerate(ImageSequence.Iterator(im)):
+                    if i >= MAX_FRAMES or (i + 1) * w * h > MAX_TOTAL_PIXELS:
+                        raise RecordingError(f"{gif}: more than {i} frames of {w} x {h} pixels, beyond the "
+                                             f"{MAX_FRAMES} frames or {MAX_TOTAL_PIXELS} pixels a recording may have")
+                    frames.append(frame.convert("RGB"))
+    except RecordingError:
+        raise
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning) as e:
+        raise RecordingError(f"{gif}: too many pixels ({str(e).splitlines()[0][:120]})") from None
+    except (UnidentifiedImageError, OSError, EOFError, SyntaxError, ValueError, MemoryError) as e:
+        why = str(e).splitlines()[0][:120] if str(e) else ""
+        raise RecordingError(f"{gif}: not a readable GIF ({type(e).__name__}: {why})") from None
+    if not frames:
+        raise RecordingError(f"{gif}: a GIF without frames")
+    return frames
+
+
+def filmstrip_from_gif(gif: Path, out: Path, gap: int = 4) -> Path:
+    """A filmstrip PNG from every frame of a recorded GIF (for the report); RecordingError (one line) for a GIF
+    beyond the caps of read_gif_frames."""
+    frames = read_gif_frames(gif)
     rec = PlanRecorder(width=frames[0].width, height=frames[0].height, frames=frames)
     return rec.save_filmstrip(out)

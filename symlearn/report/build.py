@@ -8,13 +8,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from pddl_export.bounded_json import MiB, read_bounded_bytes
 from symlearn.provenance import atomic_write_bytes, atomic_write_text
 from symlearn.report import gather as g
+from symlearn.report import schemas
 from symlearn.report.figures import plot_png
 from symlearn.report.model import NOT_RUN, Report
 from symlearn.report.render import to_html, to_markdown
 
 FILES_DIR = "report_files"
+MAX_IMAGE_BYTES = 64 * MiB  # a figure of the run (symbols.png: ~150 KB)
 
 
 def _data_dir(run: Path, data: Path | None) -> tuple[Path | None, str]:
@@ -60,24 +63,29 @@ def build_report(run: Path, data: Path | None = None, benchmark: Path | None = N
     ev, ev_why = g.read_json(run / "eval.json")
     t1, t1_why = g.read_json(run / "table1.json")
     sy, sy_why = g.read_json(run / "symbols.json")
-    tm, _ = g.read_json(run / "transition_metrics.json")
+    tm, tm_why = g.read_json(run / "transition_metrics.json")
+    _, metrics_why = g.read_json(run / "metrics.json")
+    curves_why = "; ".join(w for w in (metrics_why, tm_why) if "cannot be read" in w)
     bench_path = Path(benchmark) if benchmark is not None else run / "benchmark.json"
-    bench, bench_why = g.read_json(bench_path)
+    bench, bench_why = g.read_json(bench_path, schemas.BENCHMARK)
     if benchmark is None and not bench_path.exists():
         bench_why = ""
     gif = find_recording(run, recording)
-    strip = None
+    strip, gif_why = None, ""
     if gif is not None:
-        from symlearn.planning.recording import filmstrip_from_gif
+        from symlearn.planning.recording import RecordingError, filmstrip_from_gif
 
-        strip = filmstrip_from_gif(gif, run / FILES_DIR / "plan_filmstrip.png")
+        try:
+            strip = filmstrip_from_gif(gif, run / FILES_DIR / "plan_filmstrip.png")
+        except RecordingError as e:  # beyond the pixel caps, or not a GIF: the section says so in one line
+            gif_why = g.cannot_read(gif, e)
     sections = [g.data_section(summary, shares, why or data_why),
                 g.effect_section(ev, _reason(ev_why, "symlearn evaluate")),
                 g.table1_section(t1, _reason(t1_why, "symlearn table1")),
                 g.symbols_section(sy, run, _reason(sy_why, "symlearn symbols")),
-                g.curves_section(g.history_from_checkpoint(run), (tm or {}).get("history")),
+                g.curves_section(g.history_from_checkpoint(run), (tm or {}).get("history"), curves_why),
                 g.benchmark_section(bench, bench_why),
-                g.plan_section(strip, gif)]
+                g.plan_section(strip, gif, gif_why)]
     rep = Report(run, sections)
     rep.sections.insert(0, g.scorecard_section(rep))
     return rep
@@ -99,7 +107,7 @@ def write_report(report: Report, run: Path) -> tuple[Path, Path]:
         for p in s.plots:
             pngs[p.name] = plot_png(p)
         for im in s.images:
-            pngs[im.name] = im.path.read_bytes()
+            pngs[im.name] = read_bounded_bytes(im.path, MAX_IMAGE_BYTES, "image")
     rel = {}
     for name, blob in pngs.items():
         target = files / f"{name}.png"

@@ -6,9 +6,10 @@ unreadable input becomes a "not run" section naming the file and the command tha
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
+from pddl_export.bounded_json import JsonFileError, Schema, check, read_json_file
+from symlearn.report import schemas
 from symlearn.report.model import Image, Mark, Plot, Report, Section, Table, not_run
 from symlearn.report.render import fmt
 
@@ -20,18 +21,26 @@ SYMBOL_IMAGES = (("symbols.png", "Symbol prototypes (the paper's Fig. 4)"),
                  ("symbol_examples.png", "Examples of one symbol (the paper's Fig. 5)"))
 
 
-def read_json(path: Path) -> tuple[dict | None, str]:
-    """(document, '') or (None, one-line reason): missing, unreadable or not a JSON object."""
+def read_json(path: Path, schema: Schema | None = None) -> tuple[dict | None, str]:
+    """(document, '') or (None, one-line reason): missing, refused by the bounded reader (not a regular file,
+    too large, not JSON, too deep, non-finite numbers) or not fitting `schema` (default: the schema of the
+    run file of that name in symlearn.report.schemas, else any JSON object)."""
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():
         return None, f"{path} not found"
+    schema = schema or schemas.RUN_FILES.get(path.name)
     try:
-        doc = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        return None, f"{path} cannot be read ({type(e).__name__}: {str(e).splitlines()[0][:100]})"
+        doc = read_json_file(path, schema, what="run file")
+    except JsonFileError as e:
+        return None, cannot_read(path, e)
     if not isinstance(doc, dict):
         return None, f"{path} is not a JSON object"
     return doc, ""
+
+
+def cannot_read(path: Path, e: Exception) -> str:
+    """'PATH cannot be read: REASON' from a reader's one-line refusal ('PATH: REASON')."""
+    return f"{path} cannot be read: {str(e).removeprefix(f'{path}: ')}"
 
 
 def data_section(summary: dict | None, shares: dict | None, why: str = "") -> Section:
@@ -140,12 +149,12 @@ def _series(history: list, keys: tuple[str, ...]) -> dict:
     return out
 
 
-def curves_section(effect_history: list | None, transition_history: list | None) -> Section:
-    """Learning curves of the effect model and the transition network."""
+def curves_section(effect_history: list | None, transition_history: list | None, why: str = "") -> Section:
+    """Learning curves of the effect model and the transition network; `why` names history files refused."""
     title = "Learning curves"
     if not effect_history and not transition_history:
-        return not_run("curves", title, "no training history: RUN/metrics.json (or best.pt) and "
-                                        "RUN/transition_metrics.json missing")
+        return not_run("curves", title, why or "no training history: RUN/metrics.json (or best.pt) and "
+                                               "RUN/transition_metrics.json missing")
     s = Section("curves", title)
     if effect_history:
         s.plots.append(Plot("effect_loss", "Effect model", "epoch", "loss",
@@ -155,7 +164,7 @@ def curves_section(effect_history: list | None, transition_history: list | None)
         if any(v[0] for v in mae.values()):
             s.plots.append(Plot("effect_val_mae", "Effect model: validation MAE", "epoch", "mm", mae))
     else:
-        s.text.append("effect model: not run (no history in RUN/metrics.json or RUN/best.pt)")
+        s.text.append("effect model: not run (no history in RUN/metrics.json or RUN/best.pt)" + (f"; {why}" if why else ""))
     if transition_history:
         s.plots.append(Plot("transition_loss", "Transition network", "epoch", "loss",
                             _series(transition_history, ("train_loss", "val_loss"))))
@@ -230,12 +239,12 @@ def _shortest_tables(shortest: dict) -> list[Table]:
                   tuple(detail), key="shortest_detail")]
 
 
-def plan_section(filmstrip: Path | None, gif: Path | None) -> Section:
-    """One executed plan as a filmstrip (start, then after each action)."""
+def plan_section(filmstrip: Path | None, gif: Path | None, why: str = "") -> Section:
+    """One executed plan as a filmstrip (start, then after each action); `why` a recording could not be read."""
     title = "An executed plan"
     if filmstrip is None:
-        return not_run("plan", title, "no recorded plan: run 'symlearn plan ... --record RUN/plan.gif' or "
-                                      "'symlearn benchmark ... --record RUN/recordings'")
+        return not_run("plan", title, why or "no recorded plan: run 'symlearn plan ... --record RUN/plan.gif' or "
+                                             "'symlearn benchmark ... --record RUN/recordings'")
     return Section("plan", title, text=[f"recorded in {gif}: start, then the scene after each action "
                                         "(arrow: pick -> release)"],
                    images=[Image("plan_filmstrip", f"Filmstrip of {Path(gif).name}", filmstrip)])
@@ -258,7 +267,9 @@ def history_from_checkpoint(run: Path) -> list | None:
         from symlearn.learning.checkpoint import CheckpointError, load_checkpoint
 
         try:
-            return load_checkpoint(Path(run) / "best.pt").history
-        except CheckpointError:
+            history = load_checkpoint(Path(run) / "best.pt").history
+            check(history, schemas.HISTORY, f"{Path(run) / 'best.pt'} (history)")
+            return history
+        except (CheckpointError, JsonFileError):
             return None
     return None

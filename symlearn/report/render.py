@@ -84,27 +84,36 @@ def to_html(report: Report, pngs: dict[str, bytes]) -> str:
             f"outputs; sections whose stage has not run say so.</p>{body}</body></html>\n")
 
 
+def md_text(s: str) -> str:
+    """Text from a run's files made inert in Markdown: HTML escaped (as report.html does), on one line, and
+    backslash, backticks and brackets escaped so that it opens no code span or link."""
+    s = html.escape(" ".join(str(s).split()), quote=False)
+    for c in "\\`[]":
+        s = s.replace(c, "\\" + c)
+    return s
+
+
 def _md_table(header, rows) -> list[str]:
-    cell = lambda v: fmt(v).replace("|", "\\|")  # noqa: E731
+    cell = lambda v: md_text(fmt(v)).replace("|", "\\|")  # noqa: E731
     return ["| " + " | ".join(cell(h) for h in header) + " |", "|" + "---|" * len(header),
             *("| " + " | ".join(cell(v) for v in r) + " |" for r in rows), ""]
 
 
 def to_markdown(report: Report, image_files: dict[str, str]) -> str:
     """The whole report as Markdown; `image_files` maps figure names to paths relative to the .md file."""
-    out = [f"# symlearn report: {report.run.name}", "", f"Run directory: `{report.run}`", ""]
+    out = [f"# symlearn report: {md_text(report.run.name)}", "", f"Run directory: {md_text(str(report.run))}", ""]
     for s in report.sections:
-        out += [f"## {s.title}", ""]
+        out += [f"## {md_text(s.title)}", ""]
         if s.status == NOT_RUN:
-            out += [f"*not run: {s.note}*", ""]
+            out += [f"*not run: {md_text(s.note)}*", ""]
             continue
-        out += [*(f"{t}\n" for t in s.text)]
+        out += [*(f"{md_text(t)}\n" for t in s.text)]
         if s.marks:
             out += _md_table(("claim", "ours", "paper", "criterion", "verdict"),
                              [(m.claim, m.ours, m.paper, m.criterion, m.verdict) for m in s.marks])
         for t in s.tables:
-            out += [f"*{t.caption}*", "", *_md_table(t.header, t.rows)]
+            out += [f"*{md_text(t.caption)}*", "", *_md_table(t.header, t.rows)]
         for name, caption in [(p.name, p.title) for p in s.plots] + [(i.name, i.caption) for i in s.images]:
             if name in image_files:
-                out += [f"![{caption}]({image_files[name]})", ""]
+                out += [f"![{md_text(caption)}]({image_files[name]})", ""]
     return "\n".join(out) + "\n"

@@ -29,6 +29,7 @@ from typing import Callable, Iterator
 
 import numpy as np
 
+from pddl_export.bounded_json import JsonFileError, read_json_file
 from symlearn.sim.exploration import ExplorationConfig, sample_action, sample_scene_spec
 from symlearn.data.dataset import DATA_KIND, FORMAT_VERSION, SPLITS, DataError, check_shard_entries
 from symlearn.provenance import atomic_write_bytes, atomic_write_json, sha256_file, versions
@@ -247,9 +248,9 @@ def _resume_state(out: Path, cfg: CollectConfig) -> dict[int, dict]:
                                "choose an empty or new --out")
         return {}
     try:
-        old = json.loads(mpath.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as e:
-        raise CollectError(f"{mpath} is not valid JSON ({e}); remove it or choose another --out")
+        old = read_json_file(mpath, what="data set manifest")
+    except JsonFileError as e:
+        raise CollectError(f"{e}; remove it or choose another --out") from None
     if not isinstance(old, dict):
         raise CollectError(f"{mpath} is not a data set manifest (a JSON {type(old).__name__}); choose another --out")
     if old.get("kind") != DATA_KIND or old.get("format_version") != FORMAT_VERSION:

@@ -110,7 +110,11 @@ class LearnedTransition:
 
 
 def planning_models(run_dir: Path) -> tuple[SymbolReader, LearnedTransition]:
-    """RUN's m(z) and what reads crops into its codes: the effect model's encoder, plus m(z)'s location bits if any."""
-    transition = LearnedTransition.from_run(Path(run_dir))
+    """RUN's m(z) and what reads crops into its codes: the effect model's encoder, plus m(z)'s location bits if any.
+
+    RUN/best.pt is loaded (and so checked) first: a damaged best.pt is named as such, not reported as a
+    transition.pt trained on another effect model (whose check compares best.pt's hash).
+    """
     model, _ = load_effect_model(Path(run_dir))
+    transition = LearnedTransition.from_run(Path(run_dir))
     return transition.reader(model), transition

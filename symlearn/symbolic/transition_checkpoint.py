@@ -10,6 +10,7 @@ from pathlib import Path
 
 import torch
 
+from pddl_export.bounded_json import loads_bounded
 from symlearn.provenance import atomic_write_bytes
 from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet
 
@@ -36,6 +37,8 @@ def load_transition(path: Path, expect_config: TransitionConfig | None = None) -
     path = Path(path)
     if not path.exists():
         raise TransitionError(f"no transition model at {path}; run 'symlearn train-transition' first")
+    if not path.is_file():  # a FIFO would block torch.load, a device would be read without end
+        raise TransitionError(f"{path} is not a regular file")
     try:
         blob = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as e:  # torch raises several types for foreign or truncated files
@@ -47,8 +50,8 @@ def load_transition(path: Path, expect_config: TransitionConfig | None = None) -
         raise TransitionError(f"{path} has transition format {blob.get('format_version')!r}, "
                               f"expected {TRANSITION_FORMAT}")
     try:
-        cfg = TransitionConfig.from_json(json.loads(blob["config"]))
-        meta = json.loads(blob["meta"])
+        cfg = TransitionConfig.from_json(loads_bounded(blob["config"], "field 'config'"))
+        meta = loads_bounded(blob["meta"], "field 'meta'")
         net = TransitionNet(cfg)
         net.load_state_dict(blob["model"])
     except (KeyError, TypeError, ValueError, RuntimeError) as e:
