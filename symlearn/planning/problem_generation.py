@@ -261,8 +261,8 @@ def add_shortest_plans(problems_dir: Path) -> dict[str, int]:
     manifest = problems_dir / PROBLEMS_MANIFEST
     if manifest.is_file():
         try:
-            settings = json.loads(manifest.read_text())
-        except (json.JSONDecodeError, UnicodeDecodeError):
+            settings = read_json_file(manifest, what="problem set manifest")
+        except JsonFileError:
             settings = None
         if isinstance(settings, dict) and settings.get("format") == MANIFEST_FORMAT:
             atomic_write_json(manifest, {**settings, "problem_version": PROBLEM_VERSION})
