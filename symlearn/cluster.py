@@ -16,6 +16,8 @@ temp folder (/tmp/ray by default); see docs/SCALING.md.
 from __future__ import annotations
 
 import contextlib
+import signal
+import threading
 from typing import Any, Callable, Iterable, Iterator
 
 ENGINES = ("local", "ray")
@@ -55,12 +57,20 @@ def ray_session(address: str | None, num_cpus: int) -> Iterator[Any]:
         yield ray
         return
     kwargs: dict = {"address": address} if address else {"num_cpus": num_cpus}
+    main = threading.current_thread() is threading.main_thread()
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)} if main else {}
     try:
         ray.init(include_dashboard=False, log_to_driver=False, configure_logging=False, **kwargs)
     except (ConnectionError, ValueError, RuntimeError) as e:
         where = f"the Ray cluster at {address!r}" if address else "a local Ray"
         raise EngineError(f"could not start or join {where}: {str(e).splitlines()[0] if str(e) else type(e).__name__}"
                           ) from None
+    finally:
+        # ray.init makes SIGTERM a sys.exit; a handler the caller set (collect's, which ends in a resumable
+        # CollectInterrupted) is put back. Either way the stack unwinds: tasks are cancelled, Ray shut down.
+        for s, h in handlers.items():
+            if callable(h) and h is not signal.default_int_handler:
+                signal.signal(s, h)
     try:
         yield ray
     finally:
