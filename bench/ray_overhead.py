@@ -14,6 +14,7 @@ local pool's rate per worker gives the projection of 1M samples in core-hours.
 from __future__ import annotations
 
 import argparse
+import os
 import shutil
 import statistics
 import tempfile
@@ -49,6 +50,7 @@ def main() -> None:
     import ray
 
     cfg = CollectConfig(n=args.n, seed=0, shard_size=args.shard_size)
+    load_before = os.getloadavg()[0]
     times: dict[str, list[float]] = {"local": [], "ray": [], "ray_warm": []}
     reference = None
     with tempfile.TemporaryDirectory() as tmp:
@@ -77,6 +79,7 @@ def main() -> None:
         "ratio_ray_vs_local": round(med["ray"] / med["local"], 3),
         "ratio_ray_warm_vs_local": round(med["ray_warm"] / med["local"], 3),
         "shards_identical": True,
+        "load_average_1min": {"before": round(load_before, 2), "after": round(os.getloadavg()[0], 2)},
         "per_core_samples_per_s": round(per_core, 2),
         "core_hours_per_million_samples": round(MILLION / per_core / 3600, 1),
     }
