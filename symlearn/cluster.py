@@ -69,7 +69,7 @@ def ray_session(address: str | None, num_cpus: int) -> Iterator[Any]:
         # ray.init makes SIGTERM a sys.exit; a handler the caller set (collect's, which ends in a resumable
         # CollectInterrupted) is put back. Either way the stack unwinds: tasks are cancelled, Ray shut down.
         for s, h in handlers.items():
-            if callable(h) and h is not signal.default_int_handler:
+            if callable(h):
                 signal.signal(s, h)
     try:
         yield ray
