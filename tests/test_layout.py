@@ -71,7 +71,8 @@ sys.meta_path.insert(0, _Spy())
 for n in names:
     _Spy.current = n
     importlib.import_module(n)
-print(json.dumps({"offenders": offenders, "pybullet_loaded": "pybullet" in sys.modules}))
+print(json.dumps({"offenders": offenders, "pybullet_loaded": "pybullet" in sys.modules,
+                  "ray_loaded": "ray" in sys.modules}))
 """
 
 
@@ -82,6 +83,22 @@ def test_no_module_but_the_simulator_imports_pybullet():
     assert r.returncode == 0, r.stderr[-2000:]
     out = json.loads(r.stdout.strip().splitlines()[-1])
     assert out["offenders"] == [] and not out["pybullet_loaded"], out
+    assert not out["ray_loaded"], "importing a module loaded Ray: the optional extra must be imported lazily"
+
+
+def test_ray_is_imported_only_inside_the_engine_module():
+    """Ray is an optional extra: one module imports it, and only inside its functions, so the package works without it."""
+    importers = {pkg: _imported_packages(ROOT / pkg, pkg).get("ray", set()) for pkg in PACKAGES}
+    assert importers == {"symlearn": {"symlearn.cluster"}, "search": set(), "pddl_export": set()}, importers
+    tree = ast.parse((ROOT / "symlearn" / "cluster.py").read_text())
+    def imports_ray(node) -> bool:
+        if isinstance(node, ast.Import):
+            return any(a.name.split(".")[0] == "ray" for a in node.names)
+        return isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == "ray"
+
+    assert not any(imports_ray(n) for n in tree.body)  # nothing at module level
+    inner = [n for n in ast.walk(tree) if isinstance(n, ast.Import) and any(a.name == "ray" for a in n.names)]
+    assert len(inner) == 1  # the check is not vacuous: the engine does import Ray, inside import_ray
 
 
 def test_the_probe_catches_a_module_that_imports_pybullet():

@@ -100,6 +100,35 @@ def test_two_process_ddp_ends_with_identical_weights(data, tmp_path):
     assert m["world_size"] == 2 and m["ranks_identical"] is True
 
 
+def test_two_nodes_by_rendezvous_train_one_run(data, tmp_path):
+    """docs/SCALING.md's two-node command, both "nodes" on this machine: one torchrun launcher per node,
+    joined by a c10d rendezvous, one process each, writing one shared run."""
+    import os
+    import socket
+
+    with socket.socket() as s:  # a free port for the rendezvous
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    run = tmp_path / "two_nodes"
+    cmd = [sys.executable, "-m", "torch.distributed.run", "--nnodes", "2", "--nproc-per-node", "1",
+           "--rdzv-backend", "c10d", "--rdzv-endpoint", f"127.0.0.1:{port}", "--rdzv-id", "test-two-nodes",
+           "-m", "symlearn.cli", "train", "--data", str(data), "--out", str(run), "--preset", "quick",
+           "--epochs", "1", "--batch-size", "4", "--no-bf16", "--quiet"]
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    nodes = [subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+             for _ in range(2)]
+    try:
+        outs = [n.communicate(timeout=300) for n in nodes]
+    finally:
+        for n in nodes:
+            if n.poll() is None:
+                n.kill()
+                n.wait()
+    assert [n.returncode for n in nodes] == [0, 0], [err[-2000:] for _, err in outs]
+    m = json.loads((run / "metrics.json").read_text())
+    assert m["world_size"] == 2 and m["ranks_identical"] is True
+
+
 def test_rider_weights_mark_exactly_the_riders(tiny_data):
     import dataclasses
 

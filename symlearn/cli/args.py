@@ -4,6 +4,8 @@ from __future__ import annotations
 import argparse
 import math
 
+from symlearn.cluster import ENGINES
+
 
 def int_range(text: str) -> tuple[int, int]:
     """'1-3' -> (1, 3); '4' -> (4, 4); anything else is an argparse error naming the text."""
@@ -75,6 +77,15 @@ class OneLineParser(argparse.ArgumentParser):
 
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def add_engine_flags(c: argparse.ArgumentParser, unit: str) -> None:
+    """--engine {local,ray} and --address, for the commands whose `unit`s (shards, rows) can run as Ray tasks."""
+    c.add_argument("--engine", choices=ENGINES, default="local",
+                   help=f"where each {unit} runs: this machine, or a Ray task (pip install symlearn[ray]; "
+                        "docs/SCALING.md)")
+    c.add_argument("--address", help="with --engine ray: the Ray cluster to join (head IP:6379, or auto); "
+                                     "default a local Ray")
 
 
 THREADS_HELP = ("torch CPU threads (default: torch's, one per core); use 1 per process when other jobs share the "

@@ -1,6 +1,7 @@
 """The `symlearn` command line: each sub-command maps its flags onto a config and calls the library.
 
     symlearn collect --out data/paper --n 12000 --workers 2 --seed 0
+    symlearn collect --out /shared/data/big --n 1000000 --workers 64 --engine ray --address auto
     symlearn scenarios --json
 """
 from __future__ import annotations
@@ -11,24 +12,28 @@ import sys
 import time
 from pathlib import Path
 
-from symlearn.cli.args import (THREADS_HELP, OneLineParser, int_range, non_negative_finite_float, non_negative_int,
-                               positive_finite_float, positive_int, set_threads)
+from symlearn.cli.args import (THREADS_HELP, OneLineParser, add_engine_flags, int_range, non_negative_finite_float,
+                               non_negative_int, positive_finite_float, positive_int, set_threads)
 from symlearn.cli.pipeline import add_pipeline_command
 from symlearn.cli.planning import add_planning_commands
 from symlearn.cli.report import add_report_command
 
 
 def cmd_collect(args: argparse.Namespace) -> int:
+    from symlearn.cluster import check_engine
     from symlearn.sim.collect import CollectConfig, collect
     from symlearn.data.dataset import summarize
     from symlearn.sim.exploration import ExplorationConfig
 
     expl = ExplorationConfig() if args.objects is None else ExplorationConfig.with_k_range(*args.objects)
     cfg = CollectConfig(n=args.n, seed=args.seed, shard_size=args.shard_size, exploration=expl)
+    check_engine(args.engine, args.address)  # before any work: a missing Ray is refused in one line
+    where = f" on Ray{f' at {args.address}' if args.address else ''}" if args.engine == "ray" else ""
     print(f"collect: {cfg.n} samples, seed {cfg.seed}, {len(cfg.shard_sizes())} shards, "
-          f"{args.workers} worker(s) -> {args.out}", file=sys.stderr)
+          f"{args.workers} worker(s){where} -> {args.out}", file=sys.stderr)
     t0 = time.time()
-    collect(Path(args.out), cfg, workers=args.workers, show_progress=not args.quiet)
+    collect(Path(args.out), cfg, workers=args.workers, show_progress=not args.quiet, engine=args.engine,
+            address=args.address)
     summary = summarize(Path(args.out))
     summary["wall_s"] = round(time.time() - t0, 1)
     print(json.dumps(summary, indent=2, allow_nan=False))
@@ -196,7 +201,9 @@ def add_collect_command(sub) -> None:
     c = sub.add_parser("collect", help="collect interaction data in the simulator")
     c.add_argument("--out", required=True, help="data set directory (created, or resumed)")
     c.add_argument("--n", type=positive_int, default=12000, help="number of samples (actions)")
-    c.add_argument("--workers", type=positive_int, default=1, help="worker processes")
+    c.add_argument("--workers", type=positive_int, default=1,
+                   help="worker processes (with --engine ray: shards in flight at once, and a local Ray's CPUs)")
+    add_engine_flags(c, "shard")
     c.add_argument("--seed", type=non_negative_int, default=0)
     c.add_argument("--objects", type=int_range, default=None,
                    help="objects per scene, e.g. 4-5 (default: the paper's mix of 1-3)")

@@ -13,6 +13,7 @@ ValueError / RuntimeError with one-line messages, which the main CLI prints.
     symlearn plan --run runs/paper --problem problems/p13/problem_0000.json --planner astar --closed-loop
     symlearn benchmark --run runs/paper --problems problems/p13 --planners astar,astar-ucs --out bench.json
     symlearn benchmark --run runs/paper --problems problems/grid --planners astar,symk-sas --out g.json --plots plots/
+    symlearn benchmark --run runs/paper --problems problems/grid --planners astar --out g.json --engine ray --workers 8
 
 `problems` records its settings in OUT/problems.manifest: the same command again completes an
 interrupted set, other settings are refused unless --overwrite. `benchmark` appends every finished
@@ -26,8 +27,8 @@ import math
 import sys
 from pathlib import Path
 
-from symlearn.cli.args import (THREADS_HELP, int_range, non_negative_int, planner_list, positive_finite_float,
-                               positive_int, set_threads)
+from symlearn.cli.args import (THREADS_HELP, add_engine_flags, int_range, non_negative_int, planner_list,
+                               positive_finite_float, positive_int, set_threads)
 from symlearn.symbolic.locations import DEFAULT_LOCATION_BITS, LOCATION_BITS
 
 
@@ -213,14 +214,19 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 
 def cmd_benchmark(args: argparse.Namespace) -> int:
+    from symlearn.cluster import check_engine
     from symlearn.planning.benchmark import benchmark, format_goal_placement, format_table
     from symlearn.planning.benchmark_plots import format_grid, format_shortest_grid, write_plots
 
+    check_engine(args.engine, args.address)  # before any work: a missing Ray is refused in one line
+    if args.workers > 1 and args.engine != "ray":
+        raise ValueError(f"--workers {args.workers}: the local engine runs rows one after another; add --engine ray")
     set_threads(args.threads)
     note_rule_loading(Path(args.run), list(args.planners))
     res = benchmark(Path(args.run), args.problems, args.planners, Path(args.out), closed_loop=args.closed_loop,
                     timeout_s=args.timeout, max_replans=args.max_replans, show_progress=not args.quiet,
-                    record_dir=Path(args.record) if args.record else None, risk_weight=args.risk_weight)
+                    record_dir=Path(args.record) if args.record else None, risk_weight=args.risk_weight,
+                    engine=args.engine, workers=args.workers, address=args.address)
     print(format_table(res))
     print(format_goal_placement(res))
     print()
@@ -351,6 +357,9 @@ def add_benchmark_command(sub) -> None:
     c.add_argument("--quiet", action="store_true")
     c.add_argument("--record", help="directory for GIFs of failed plans (<problem>_<planner>.gif)")
     _add_execution_flags(c)
+    add_engine_flags(c, "problem-planner pair")
+    c.add_argument("--workers", type=positive_int, default=1,
+                   help="with --engine ray: pairs in flight at once, and a local Ray's CPUs (default 1)")
     c.set_defaults(func=cmd_benchmark)
 
 

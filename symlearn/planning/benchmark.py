@@ -22,7 +22,7 @@ import statistics
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
 from pddl_export.bounded_json import (AnyJson, Bool, Int, JsonFileError, Map, MiB, Num, Obj, Opt, Str, Tuple, check,
                                       loads_bounded, read_bounded_bytes)
@@ -407,31 +407,109 @@ def _run_rows(run_dir: Path, problems: list[SetProblem], fns: dict, log: RowLog,
     if todo:
         encoder, transition = planning_models(run_dir)
         rules = _current_rules(run_dir, fns)
-        first_plans: dict[tuple, object] = {}  # (problem key, planner) -> the open loop's plan
+        total = len(problems) * len(fns) * len(loops)
+
+        def emit(key: tuple, row: dict) -> None:
+            log.append(key, row)
+            if show_progress:
+                print(progress_line(len(log.done), total, key, row), flush=True)
+
         with TabletopSimulator() as sim:
-            for p, name, loop in todo:
-                cfg = ExecutionConfig(closed_loop=loop, max_replans=max_replans, timeout_s=timeout_s)
-                rec = None if record_dir is None or loop else PlanRecorder()
-                # closed loop starts from the open loop's very plan, so the two differ only by what execution does
-                fn = fns[name] if loop else _first_call_kept(fns[name], first_plans, (p.key, name))
-                row = run_problem(sim, encoder, transition, p.problem, name, fn, cfg, recorder=rec, rules=rules,
-                                  initial_plan=first_plans.pop((p.key, name), None) if loop else None)
-                row = dataclasses.replace(row, problem=p.label)
-                if rec is not None and not row.success:
-                    rec.save_gif(Path(record_dir) / f"{p.label.replace('/', '_')}_{name}.gif")
-                log.append((p.key, name, loop), finite_or_null(row.to_json()))
-                if show_progress:
-                    print(f"[{len(log.done)}/{len(problems) * len(fns) * len(loops)}] {p.label} {name}"
-                          f"{' closed-loop' if loop else ''}: {row.status} len {row.plan_length} "
-                          f"success {row.success}", flush=True)
+            for p in problems:
+                for name in fns:
+                    pair_loops = [loop for loop in loops if (p.key, name, loop) not in log.done]
+                    if pair_loops:
+                        _run_pair(sim, encoder, transition, rules, p, name, fns[name], pair_loops, timeout_s,
+                                  max_replans, record_dir, emit)
     elif show_progress:
         print(f"every row was already in {log.path}", flush=True)
     return [ProblemRun(**log.done[(p.key, name, loop)]) for p in problems for name in fns for loop in loops]
 
 
+def progress_line(n_done: int, total: int, key: tuple, row: dict) -> str:
+    """The line a benchmark prints as a row finishes: '[3/8] problem planner closed-loop: status len N success B'."""
+    return (f"[{n_done}/{total}] {row['problem']} {key[1]}{' closed-loop' if key[2] else ''}: {row['status']} "
+            f"len {row['plan_length']} success {row['success']}")
+
+
+def _run_pair(sim, encoder, transition, rules, p: SetProblem, name: str, fn, loops: list[bool], timeout_s: float,
+              max_replans: int, record_dir: Path | None, emit: Callable[[tuple, dict], None]) -> None:
+    """The rows of one (problem, planner) pair for `loops` in order, each handed to emit(row key, row JSON) as it
+    finishes. Closed loop starts from the open loop's very plan when both run, so the two differ only by what
+    execution does."""
+    first_plans: dict[tuple, object] = {}  # (problem key, planner) -> the open loop's plan
+    for loop in loops:
+        cfg = ExecutionConfig(closed_loop=loop, max_replans=max_replans, timeout_s=timeout_s)
+        rec = None if record_dir is None or loop else PlanRecorder()
+        planner = fn if loop else _first_call_kept(fn, first_plans, (p.key, name))
+        row = run_problem(sim, encoder, transition, p.problem, name, planner, cfg, recorder=rec, rules=rules,
+                          initial_plan=first_plans.pop((p.key, name), None) if loop else None)
+        row = dataclasses.replace(row, problem=p.label)
+        if rec is not None and not row.success:
+            rec.save_gif(Path(record_dir) / f"{p.label.replace('/', '_')}_{name}.gif")
+        emit((p.key, name, loop), finite_or_null(row.to_json()))
+
+
+_worker_state: dict = {}  # in a Ray worker: the loaded models, planners and simulator of the last settings seen
+
+
+def _ray_pair(settings_json: str, run_dir: str, planners: list[str], risk_weight: float, p: SetProblem, name: str,
+              loops: list[bool], timeout_s: float, max_replans: int,
+              record_dir: str | None) -> list[tuple[tuple, dict]]:
+    """One (problem, planner) pair as a Ray task, on one torch thread; a worker loads the run once per settings."""
+    import torch
+
+    from symlearn.sim.simulator import TabletopSimulator
+    from symlearn.symbolic.learned_transition import planning_models
+
+    torch.set_num_threads(1)
+    if _worker_state.get("settings") != settings_json:
+        old = _worker_state.pop("sim", None)
+        if old is not None:
+            old.close()
+        _worker_state.clear()
+        fns = make_planners(list(planners), Path(run_dir), risk_weight=risk_weight)
+        encoder, transition = planning_models(Path(run_dir))
+        _worker_state.update(settings=settings_json, fns=fns, encoder=encoder, transition=transition,
+                             rules=_current_rules(Path(run_dir), fns), sim=TabletopSimulator())
+    w, rows = _worker_state, []
+    _run_pair(w["sim"], w["encoder"], w["transition"], w["rules"], p, name, w["fns"][name], loops, timeout_s,
+              max_replans, Path(record_dir) if record_dir else None, lambda key, row: rows.append((key, row)))
+    return rows
+
+
+def _run_rows_ray(run_dir: Path, problems: list[SetProblem], planners: list[str], risk_weight: float, settings: dict,
+                  log: RowLog, closed_loop: bool, timeout_s: float, max_replans: int, show_progress: bool,
+                  record_dir: Path | None, workers: int, address: str | None) -> None:
+    """The rows the log lacks, one Ray task per (problem, planner) pair, `workers` in flight; logged as they finish."""
+    from symlearn.cluster import as_finished, ray_session
+
+    loops = [False, True] if closed_loop else [False]
+    total = len(problems) * len(planners) * len(loops)
+    jobs = []
+    for p in problems:
+        for name in planners:
+            todo = [loop for loop in loops if (p.key, name, loop) not in log.done]
+            if todo:
+                jobs.append(((p.key, name), (json.dumps(settings, sort_keys=True), str(run_dir.resolve()),
+                                             list(planners), risk_weight, p, name, todo, timeout_s, max_replans,
+                                             str(record_dir.resolve()) if record_dir else None)))
+    if not jobs:
+        if show_progress:
+            print(f"every row was already in {log.path}", flush=True)
+        return
+    with ray_session(address, num_cpus=workers) as ray:
+        for _, rows in as_finished(ray, _ray_pair, jobs, window=workers):
+            for key, row in rows:
+                log.append(key, row)
+                if show_progress:
+                    print(progress_line(len(log.done), total, tuple(key), row), flush=True)
+
+
 def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners: list[str], out_file: Path,
               closed_loop: bool = False, timeout_s: float = 30.0, max_replans: int = 3,
-              show_progress: bool = True, record_dir: Path | None = None, risk_weight: float = 1.0) -> dict:
+              show_progress: bool = True, record_dir: Path | None = None, risk_weight: float = 1.0,
+              engine: str = "local", workers: int = 1, address: str | None = None) -> dict:
     """Plan and execute every problem with every planner (closed loop too if asked); write out_file.
 
     problems_dir is one problem folder or several (see problem_sets): with several, each row's key and
@@ -440,9 +518,18 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
     final JSON equals an uninterrupted run's (its timings aside). The log is removed once out_file is
     written. With record_dir, each failed open-loop run is saved as record_dir/<problem>_<planner>.gif.
     risk_weight is that of the RISK_PLANNERS (symlearn.planning.planners.PlannerContext), recorded when one plans.
+    engine "ray" runs each (problem, planner) pair's rows as a Ray task on one torch thread, `workers` at once, on
+    the cluster at `address` or a local Ray of `workers` CPUs (symlearn.cluster); rows are logged as they finish,
+    and the result equals a local run's apart from timings. The local engine runs rows one after another.
     """
+    from symlearn.cluster import check_engine
+
     if not planners:
         raise ValueError("no planners given")
+    check_engine(engine, address)
+    if not (isinstance(workers, int) and workers >= 1) or (workers > 1 and engine != "ray"):
+        raise ValueError(f"workers={workers!r}: the local engine runs rows one after another; "
+                         "more workers need --engine ray")
     if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
         raise ValueError(f"timeout {timeout_s!r} must be a finite positive number of seconds")
     run_dir, out_file = Path(run_dir), Path(out_file)
@@ -456,8 +543,11 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
     log = RowLog(rows_path(out_file), settings)
     try:
         log.open()
-        rows = _run_rows(run_dir, problems, fns, log, closed_loop, timeout_s, max_replans, show_progress,
-                         record_dir)
+        if engine == "ray":
+            _run_rows_ray(run_dir, problems, list(fns), risk_weight, settings, log, closed_loop, timeout_s,
+                          max_replans, show_progress, Path(record_dir) if record_dir else None, workers, address)
+        rows = _run_rows(run_dir, problems, fns, log, closed_loop, timeout_s, max_replans, show_progress and
+                         engine != "ray", record_dir)
     finally:
         log.close()
     result = {"run": str(run_dir), "problems": str(sets[0]) if len(sets) == 1 else [str(d) for d in sets],

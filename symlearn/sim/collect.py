@@ -9,6 +9,10 @@ left are removed. SIGINT or SIGTERM of the collecting process ends its workers (
 their own when their parent dies) and leaves no temp file. The format is described in
 docs/DATA_FORMAT.md and read back by `symlearn.data.dataset`.
 
+With `engine="ray"` (symlearn.cluster) each missing shard is a Ray task that collects it from the
+same seed and returns its arrays; this process writes them through the same atomic shard writer, so a
+Ray collection is byte for byte the local one, and resumes the same way.
+
     >>> cfg = CollectConfig(n=40, seed=1)          # doctest: +SKIP
     >>> collect(Path("data/tiny"), cfg, workers=2)  # doctest: +SKIP
 """
@@ -351,15 +355,42 @@ def _collect_parallel(out: Path, cfg: CollectConfig, todo: list[int], workers: i
         remove_temp_files(out)
 
 
-def collect(out: Path, cfg: CollectConfig, workers: int = 1, show_progress: bool = True) -> dict:
+def _ray_shard(cfg: CollectConfig, index: int, size: int) -> dict[str, np.ndarray]:
+    """One shard as a Ray task: its arrays, collected in the worker from the shard's own seed."""
+    return collect_shard(cfg, index, size)
+
+
+def _collect_ray(out: Path, cfg: CollectConfig, todo: list[int], workers: int, address: str | None,
+                 finish: Callable[[dict], None], update: Callable[[int], None]) -> None:
+    """Collect shards `todo` as Ray tasks, `workers` at once; this process writes each as it arrives."""
+    from symlearn.cluster import as_finished, ray_session
+
+    sizes = cfg.shard_sizes()
+    with ray_session(address, num_cpus=workers) as ray:
+        for index, arrays in as_finished(ray, _ray_shard, ((i, (cfg, i, sizes[i])) for i in todo), window=workers):
+            finish(_write_shard(out, index, arrays))
+            update(1)
+
+
+def collect(out: Path, cfg: CollectConfig, workers: int = 1, show_progress: bool = True, engine: str = "local",
+            address: str | None = None) -> dict:
     """Collect (or finish collecting) a data set into `out`; returns the final manifest.
 
-    SIGINT or SIGTERM ends the workers, removes temp files and raises CollectInterrupted;
-    re-running the same call resumes.
+    engine "local" runs shards in this process (workers=1) or a pool of `workers` processes; "ray" runs
+    them as Ray tasks, `workers` in flight, on the cluster at `address` or a local Ray of `workers` CPUs
+    (symlearn.cluster), with a progress bar over shards. Either way the shards are the same bytes.
+    SIGINT or SIGTERM ends the workers (cancels the tasks), removes temp files and raises
+    CollectInterrupted; re-running the same call resumes.
     """
+    from symlearn.cluster import EngineError, check_engine
+
     out = Path(out)
     if not _is_int(workers) or workers < 1:
         raise CollectError(f"workers={workers!r} must be at least 1")
+    try:
+        check_engine(engine, address)
+    except EngineError as e:
+        raise CollectError(str(e)) from None
     _refuse_run_folder(out)
     done = _resume_state(out, cfg)
     out.mkdir(parents=True, exist_ok=True)
@@ -368,8 +399,11 @@ def collect(out: Path, cfg: CollectConfig, workers: int = 1, show_progress: bool
     todo = [i for i in range(len(sizes)) if i not in done]
     from tqdm import tqdm
 
-    bar = tqdm(total=cfg.n, initial=sum(sizes[i] for i in done), unit="sample", smoothing=0.05,
-               disable=not show_progress, desc="collect")
+    if engine == "ray":  # results come whole, a shard at a time
+        bar = tqdm(total=len(sizes), initial=len(done), unit="shard", disable=not show_progress, desc="collect")
+    else:
+        bar = tqdm(total=cfg.n, initial=sum(sizes[i] for i in done), unit="sample", smoothing=0.05,
+                   disable=not show_progress, desc="collect")
 
     def finish(info: dict) -> None:
         done[info["index"]] = info
@@ -378,7 +412,9 @@ def collect(out: Path, cfg: CollectConfig, workers: int = 1, show_progress: bool
     with _interruptible():
         try:
             atomic_write_json(out / "manifest.json", _manifest(cfg, done))
-            if workers == 1 or len(todo) <= 1:
+            if engine == "ray" and todo:
+                _collect_ray(out, cfg, todo, workers, address, finish, bar.update)
+            elif workers == 1 or len(todo) <= 1:
                 for i in todo:
                     finish(_write_shard(out, i, collect_shard(cfg, i, sizes[i], progress=bar.update)))
             else:
