@@ -14,7 +14,7 @@ def main() -> None:
     ap.add_argument("--run", required=True)
     ap.add_argument("--problems", required=True)
     ap.add_argument("--out", required=True)
-    ap.add_argument("--planners", default=",".join(PLANNERS))
+    ap.add_argument("--planners", default=",".join(n for n, s in PLANNERS.items() if not s.needs_lifted))
     ap.add_argument("--timeout", type=float, default=30.0)
     args = ap.parse_args()
     out = Path(args.out)

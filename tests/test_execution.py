@@ -414,8 +414,11 @@ def test_registry_holds_every_planner_and_is_immutable():
     assert list(PLANNERS) == ["astar", "astar-ucs", "astar-likely", "astar-outcomes", "fast-downward", "symk", "pyperplan", "fast-downward-opt",
                               "fast-downward-blind", "fast-downward-sas", "fast-downward-sas-opt", "symk-sas",
                               "symk-sas-topk", "fast-downward-sas-ms", "fast-downward-sas-lama",
-                              "rules-astar", "rules-bfs", "rules-outcomes"]
-    assert [n for n, s in PLANNERS.items() if not s.needs_rules] == ["astar", "astar-ucs", "astar-likely", "astar-outcomes"]
+                              "rules-astar", "rules-bfs", "rules-outcomes", "fast-downward-lifted",
+                              "fast-downward-lifted-opt"]
+    assert [n for n, s in PLANNERS.items() if not s.needs_rules and not s.needs_lifted] == [
+        "astar", "astar-ucs", "astar-likely", "astar-outcomes"]
+    assert [n for n, s in PLANNERS.items() if s.needs_lifted] == ["fast-downward-lifted", "fast-downward-lifted-opt"]
     assert all(s.name == n and s.description for n, s in PLANNERS.items())
     with pytest.raises(TypeError):
         PLANNERS["mine"] = PLANNERS["astar"]  # type: ignore[index]
