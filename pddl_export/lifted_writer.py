@@ -162,7 +162,8 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
             new_loc = {"stay": n, "shift": shifted}.get(where, where if isinstance(where, int) else n)
             if not 0 <= new_loc < N_LOCATIONS:
                 raise ValueError(f"rule {index}: a rider ends at no location ({new_loc})")
-            after[loc_name(new_loc)] = new_r
+            if loc_name(new_loc) in before or loc_name(new_loc) in landing or loc_name(new_loc) == to:
+                after[loc_name(new_loc)] = new_r  # elsewhere the rule does not know the height it lands beside
             eff += [f"(not (rests {term} {ho}))", f"(rests {term} {level_name(0)})"]
             if new_loc != n:
                 eff += [f"(not (at {term} {loc_name(n)}))", f"(at {term} {loc_name(new_loc)})"]
@@ -182,6 +183,8 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
     for loc in list(before) + [x for x in after if x not in before]:
         old = before.get(loc, hv if loc == to else landing.get(loc))
         new = after.get(loc, under.get(loc, old))
+        if old is None or new is None:
+            raise ValueError(f"rule {index}: the height at {loc} is not known before and after the move")
         if old != new:
             eff += [f"(not (height {loc} {old}))", f"(height {loc} {new})"]
     # beneath facts a landing re-adds where it also lifted them cancel out; keep the effects consistent

@@ -252,3 +252,27 @@ def test_export_lifted_and_plan_with_stock_fast_downward_on_a_tiny_run(tiny_run_
     verdict = pyval.PDDLValidator().validate(str(tmp_path / "tasks" / "domain.pddl"),
                                              str(tmp_path / "tasks" / "problem.pddl"), str(tmp_path / "plan.txt"))
     assert verdict.status == "VALID"
+
+
+def test_moves_the_world_model_never_makes_still_write_a_domain_fast_downward_reads(world_rules, tmp_path):
+    """Riders falling off a carried stick (staying, or landing elsewhere) and a cube ending off its location are
+    outcomes m(z) gives that the symbolic world does not: their schemas must still be PDDL the translator reads."""
+    import dataclasses
+
+    from pddl_export.lifted_rules import STRUCTURE, Rule
+    from search.stock_planners import solve_texts
+    base = {"cls": (1, 4), "o.stick": True, "o.place": 0, "o.level": 1, "u.level": 0, "v.level": 0,
+            "riders.sides": (-1, 1), "riders.place": (0, 0), "riders.level": (3, 3), "beneath": (0, 0),
+            "landing": (), "u.at": False, "v.at": False}
+    key = tuple((n, base[n]) for n in STRUCTURE)
+    falls = Rule(0, key, (("to", 0, 1, 1), None, None, ("stay", 3, 2, 3), (5, 0, 2, 3)), 4)
+    cube = dict(base, cls="cube", **{"o.stick": False, "o.level": 2, "riders.sides": (), "riders.place": (),
+                                     "riders.level": (), "beneath": ()})
+    off = Rule(0, tuple((n, cube[n]) for n in STRUCTURE), (("to", 2, 2, 3), None, None), 3)
+    rules = dataclasses.replace(world_rules, rules=(falls, off), stick_of={(1, 1): True, (2, 3): False})
+    text = domain_pddl(rules)
+    assert "None" not in text and text.count("(:action") == 2
+    start = [(1 << 9) | (1 << 6) | 1, (2 << 9) | (0 << 6) | 3, (2 << 9) | (2 << 6) | 3]  # a stick at 1, two riders
+    goal = SymbolicGoal(((1 << 9) | (4 << 6) | 1, None, None))  # the stick at 4
+    res = solve_texts(text, problem_pddl(rules, start, goal, "p"), "fd-blind", 60)
+    assert res.status.value == "solved", res.message
