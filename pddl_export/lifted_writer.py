@@ -19,6 +19,7 @@ the pair, so its rules name the two locations (`pick-release-stick-l1-l2-...`).
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -44,12 +45,15 @@ def domain_name(rules: LiftedRules) -> str:
 
 @dataclass(frozen=True)
 class Schema:
-    """One action schema: its name, the robot action it stands for, and its PDDL text."""
+    """One action schema: its name, the robot action it stands for, its parts and its PDDL text."""
 
     name: str
     pick: int | None  # None: lifted (?from is the first parameter after the blocks)
     release: int | None
     text: str
+    params: tuple = ()
+    pre: tuple = ()
+    eff: tuple = ()
 
 
 def _bit_literals(rules: LiftedRules, term: str, kind: int, present: bool = True) -> list[str]:
@@ -194,7 +198,7 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
     where = f"-{frm}-{to}" if concrete else ""
     name = f"pick-release-{kind}{where}-{index}"
     text = _schema_text(name, params, pre, eff, _comment(rule, f))
-    return Schema(name, pick, release, text)
+    return Schema(name, pick, release, text, tuple(params), tuple(dict.fromkeys(pre)), tuple(eff))
 
 
 PLACES = ("on-spot", "minus-y-near", "minus-y-mid", "minus-y-far", "plus-y-near", "plus-y-mid", "plus-y-far", "off-x")
@@ -240,7 +244,29 @@ def _schema_text(name: str, params, pre, eff, comment: str) -> str:
 
 
 def schemas(rules: LiftedRules) -> tuple[Schema, ...]:
+    """The domain's action schemas, one per rule.
+
+    (A form with one schema per kind of move and a conditional effect per rule would ground to far fewer
+    actions, but Fast Downward's translator then works out, for every fact one clause adds and another
+    deletes, the negation of the other clauses' conditions: a 4-object task did not translate in 10 minutes.)
+    """
     return tuple(rule_schema(rules, r, i) for i, r in enumerate(rules.rules))
+
+
+def action_decoder(rules: LiftedRules):
+    """Plan step ('(pick-release-cube-3 o1 l0 l4 ...)') -> robot action id (pick * 6 + release)."""
+    by_name = {s.name: s for s in schemas(rules)}
+
+    def action_id(step: str) -> int:
+        words = step.strip().strip("()").split()
+        if not words or words[0].lower() not in by_name:
+            raise ValueError(f"plan step {step!r} names no action of the lifted domain")
+        s = by_name[words[0].lower()]
+        if s.pick is not None:
+            return s.pick * N_LOCATIONS + s.release
+        frm, to = words[2].lower(), words[3].lower()
+        return int(frm[1:]) * N_LOCATIONS + int(to[1:])
+    return action_id
 
 
 def domain_pddl(rules: LiftedRules) -> str:
@@ -309,16 +335,5 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
 
 def plan_actions(rules: LiftedRules, steps: Sequence[str]) -> list[int]:
     """Plan steps ('(pick-release-cube-3 o1 l0 l4 ...)') -> robot action ids (pick * 6 + release)."""
-    by_name = {s.name: s for s in schemas(rules)}
-    out = []
-    for step in steps:
-        words = step.strip().strip("()").split()
-        if not words or words[0].lower() not in by_name:
-            raise ValueError(f"plan step {step!r} names no action of the lifted domain")
-        s = by_name[words[0].lower()]
-        if s.pick is not None:
-            out.append(s.pick * N_LOCATIONS + s.release)
-        else:
-            frm, to = words[2].lower(), words[3].lower()
-            out.append(int(frm[1:]) * N_LOCATIONS + int(to[1:]))
-    return out
+    decode = action_decoder(rules)
+    return [decode(step) for step in steps]

@@ -19,7 +19,7 @@ import numpy as np
 
 from pddl_export.files import atomic_write_text
 from pddl_export.lifted_rules import LiftedRules, LiftedTransition
-from pddl_export.lifted_writer import domain_pddl, plan_actions, problem_pddl
+from pddl_export.lifted_writer import action_decoder, domain_pddl, problem_pddl
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
 from search.result import PlanResult, PlanStatus, failed
 from search.stock_planners import solve_texts
@@ -37,6 +37,7 @@ class LiftedPlanner:
     def __init__(self, rules: LiftedRules, name: str, engine: str, write_dir: Path | None = None) -> None:
         self.lifted, self.name, self.engine = rules, name, engine
         self.domain = domain_pddl(rules)
+        self.action_id = action_decoder(rules)
         self.write_dir = None if write_dir is None else Path(write_dir)
         self.calls = 0
 
@@ -66,7 +67,7 @@ class LiftedPlanner:
         self._save(problem)
         write_s = time.perf_counter() - t0
         res = solve_texts(self.domain, problem, self.engine, max(timeout_s - write_s, 0.001),
-                          action_id=lambda step: plan_actions(self.lifted, [step])[0])
+                          action_id=self.action_id)
         extra = dict(res.extra, pddl_write_time_s=round(write_s, 5))
         predicted = self.predictions(init, list(res.plan), goal) if res.found else ()
         return dataclasses.replace(res, planner=self.name, predicted_states=predicted,
