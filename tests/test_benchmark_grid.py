@@ -287,3 +287,18 @@ def test_shortest_grid_text_markdown_plots_and_report(tmp_path):
     assert detail.rows[0][:4] == ("astar", "closed", "3", "1.00") and detail.rows[0][5] == "1.25; departure 1, no_plan 1"
     old = benchmark_section({"summary": {"astar": {}}})
     assert any("before problems recorded their shortest plans" in line for line in old.text)
+
+
+def test_every_row_field_is_one_the_row_log_reads():
+    """A field added to ProblemRun must be in the row log's schema, or a resumed benchmark refuses its own rows."""
+    import dataclasses
+
+    from pddl_export.bounded_json import check
+    from symlearn.planning.benchmark import ROW_SCHEMA
+
+    names = {f.name for f in dataclasses.fields(ProblemRun)}
+    assert names == set(ROW_SCHEMA.required) | set(ROW_SCHEMA.optional)
+    row = ProblemRun(problem="p", planner="astar", found=True, status="solved", plan_length=2, planning_time_s=0.1,
+                     expansions=3, success=True, symbolic_match=True, max_distance_m=0.001, closed_loop=True,
+                     replans=0, failure_stage=None, generator_length=2, optimal_length=2, executed_length=2)
+    check(json.loads(json.dumps(row.to_json())), ROW_SCHEMA, "row")

@@ -215,7 +215,8 @@ ROW_SCHEMA = Obj(
               "success": Bool(), "symbolic_match": Bool(), "max_distance_m": Opt(Num()), "closed_loop": Bool(),
               "replans": Int(0), "failure_stage": Opt(Str(100)), "generator_length": Int(0)},
     optional={"message": _TEXT, "n_objects": Int(0), "timings": Map(Opt(AnyJson()), 1000), "task": Str(1000),
-              "failure_cause": Opt(Str(100)), "attribution": Map(AnyJson(), 1000), "goal_off_locations": Opt(Int(0))},
+              "failure_cause": Opt(Str(100)), "attribution": Map(AnyJson(), 1000), "goal_off_locations": Opt(Int(0)),
+              "optimal_length": Opt(Int(0)), "executed_length": Opt(Int(0))},
     extra=False)
 # A line of the log after the first: the row's key (problem key, planner, closed loop) and the row.
 ROW_ENTRY_SCHEMA = Obj(required={"key": Tuple((Str(1000), Str(200), Bool())), "row": ROW_SCHEMA}, extra=False)
