@@ -334,8 +334,9 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, RuntimeError, OSError) as e:
         print(f"symlearn {args.command}: error: {e}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt as e:  # Ctrl-C, or SIGINT / SIGTERM turned into CollectInterrupted
-        print(f"symlearn {args.command}: interrupted; re-run the same command to resume", file=sys.stderr)
+    except KeyboardInterrupt as e:  # Ctrl-C, SIGINT / SIGTERM turned into CollectInterrupted, PlannerInterrupted
+        why = f" ({e})" if str(e) else ""
+        print(f"symlearn {args.command}: interrupted{why}; re-run the same command to resume", file=sys.stderr)
         return 128 + getattr(e, "signum", 2)
 
 

@@ -18,6 +18,7 @@ import dataclasses
 import json
 import math
 import os
+import signal
 import statistics
 import time
 from dataclasses import dataclass
@@ -28,6 +29,7 @@ from pddl_export.bounded_json import (AnyJson, Bool, Int, JsonFileError, Map, Mi
                                       loads_bounded, read_bounded_bytes)
 from pddl_export.files import finite_or_null
 from pddl_export.rules_io import PDDL_DIR, RULES_FILE
+from search.processes import PlannerInterrupted
 from symlearn.planning.execution import ExecutionConfig, ProblemRun, failure_causes, run_problem
 from symlearn.planning.planners import RISK_PLANNERS, make_planners
 from symlearn.planning.problem import RANDOM_WALK, Problem, load_problems
@@ -375,6 +377,28 @@ class _first_call_kept:
         return getattr(self.fn, name)
 
 
+class _not_killed:
+    """The planner function, raising PlannerInterrupted instead of returning a result of a planner killed by a signal.
+
+    A planner process killed from outside (search.processes.external_signal) has no result: its row
+    must not be logged as one, so the benchmark stops there and the same command again redoes it.
+    """
+
+    def __init__(self, fn, name: str) -> None:
+        self.fn, self.name = fn, name
+
+    def __call__(self, transition, start, goal, timeout_s):
+        res = self.fn(transition, start, goal, timeout_s)
+        signum = res.extra.get("killed_by_signal")
+        if signum:
+            raise PlannerInterrupted(int(signum), f"{self.name} was killed by {signal.Signals(int(signum)).name} "
+                                     "(not by its time limit); its row is not saved")
+        return res
+
+    def __getattr__(self, name: str):
+        return getattr(self.fn, name)
+
+
 def _current_rules(run_dir: Path, fns: dict):
     """The run's exported rules when they match its transition model (for the attribution of every planner), else None.
 
@@ -420,8 +444,8 @@ def _run_rows(run_dir: Path, problems: list[SetProblem], fns: dict, log: RowLog,
                 for name in fns:
                     pair_loops = [loop for loop in loops if (p.key, name, loop) not in log.done]
                     if pair_loops:
-                        _run_pair(sim, encoder, transition, rules, p, name, fns[name], pair_loops, timeout_s,
-                                  max_replans, record_dir, emit)
+                        _run_pair(sim, encoder, transition, rules, p, name, _not_killed(fns[name], name), pair_loops,
+                                  timeout_s, max_replans, record_dir, emit)
     elif show_progress:
         print(f"every row was already in {log.path}", flush=True)
     return [ProblemRun(**log.done[(p.key, name, loop)]) for p in problems for name in fns for loop in loops]
@@ -451,6 +475,7 @@ def _run_pair(sim, encoder, transition, rules, p: SetProblem, name: str, fn, loo
         emit((p.key, name, loop), finite_or_null(row.to_json()))
 
 
+INTERRUPTED = "interrupted"  # _ray_pair's last entry when a planner was killed by a signal (its row is not one)
 _worker_state: dict = {}  # in a Ray worker: the loaded models, planners and simulator of the last settings seen
 
 
@@ -474,8 +499,12 @@ def _ray_pair(settings_json: str, run_dir: str, planners: list[str], risk_weight
         _worker_state.update(settings=settings_json, fns=fns, encoder=encoder, transition=transition,
                              rules=_current_rules(Path(run_dir), fns), sim=TabletopSimulator())
     w, rows = _worker_state, []
-    _run_pair(w["sim"], w["encoder"], w["transition"], w["rules"], p, name, w["fns"][name], loops, timeout_s,
-              max_replans, Path(record_dir) if record_dir else None, lambda key, row: rows.append((key, row)))
+    try:
+        _run_pair(w["sim"], w["encoder"], w["transition"], w["rules"], p, name, _not_killed(w["fns"][name], name),
+                  loops, timeout_s, max_replans, Path(record_dir) if record_dir else None,
+                  lambda key, row: rows.append((key, row)))
+    except PlannerInterrupted as e:  # no row for it: the driver logs the rows before it, then stops (_run_rows_ray)
+        rows.append((INTERRUPTED, {"signum": e.signum, "message": str(e)}))
     return rows
 
 
@@ -502,6 +531,8 @@ def _run_rows_ray(run_dir: Path, problems: list[SetProblem], planners: list[str]
     with ray_session(address, num_cpus=workers) as ray:
         for _, rows in as_finished(ray, _ray_pair, jobs, window=workers):
             for key, row in rows:
+                if key == INTERRUPTED:
+                    raise PlannerInterrupted(row["signum"], row["message"])
                 log.append(key, row)
                 if show_progress:
                     print(progress_line(len(log.done), total, tuple(key), row), flush=True)

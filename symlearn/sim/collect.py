@@ -304,11 +304,14 @@ def _refuse_run_folder(out: Path) -> None:
 
 @contextlib.contextmanager
 def _interruptible() -> Iterator[None]:
-    """Turn SIGTERM (and SIGINT) into CollectInterrupted in the main thread, so cleanup runs; later ones are ignored."""
+    """Turn SIGTERM (and SIGINT) into CollectInterrupted in the main thread, so cleanup runs; later ones are ignored.
+
+    A signal ignored on entry (SIG_IGN) is left ignored."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    sigs = (signal.SIGINT, signal.SIGTERM)
+    # a signal the caller ignores (SIGINT in a shell's background job) stays ignored
+    sigs = tuple(s for s in (signal.SIGINT, signal.SIGTERM) if signal.getsignal(s) != signal.SIG_IGN)
     old = {s: signal.getsignal(s) for s in sigs}
 
     def handler(signum, frame):
