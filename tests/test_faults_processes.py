@@ -159,3 +159,50 @@ def test_benchmark_never_records_a_planner_killed_by_a_signal(tiny_run, problems
     res = bm.benchmark(tiny_run.path, problems, ["astar"], out, timeout_s=10, show_progress=False)
     assert [r["status"] for r in res["rows"]] != ["error", "error"] and len(res["rows"]) == 2
     assert all("killed" not in (r["message"] or "") for r in res["rows"])
+
+
+# ------------------------------------------------------------------------------- 10. pipeline errors reach the terminal
+
+
+@pytest.mark.parametrize("flag, value", [("--workers", "0"), ("--shard-size", "0"), ("--seed", "-1"), ("--n", "0"),
+                                         ("--problems", "-2"), ("--workers", "two")])
+def test_pipeline_bad_flag_is_one_line_and_leaves_nothing(tmp_path, capsys, flag, value):
+    out = tmp_path / "pipe"
+    with pytest.raises(SystemExit) as info:
+        cli("pipeline", "--out", out, f"{flag}={value}")
+    err = capsys.readouterr().err.strip().splitlines()
+    assert info.value.code == 2 and len(err) == 1 and f"argument {flag}: '{value}'" in err[0], err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("kw", [dict(workers=0), dict(shard_size=0), dict(seed=-1), dict(workers=1.5), dict(n=0)])
+def test_pipeline_settings_refuse_bad_values_before_any_folder(tmp_path, kw):
+    from symlearn.pipeline import PipelineSettings
+
+    with pytest.raises(ValueError, match="must be an integer of at least"):
+        PipelineSettings(preset="quick", out=tmp_path / "pipe", **kw)
+    assert not (tmp_path / "pipe").exists()
+
+
+def test_a_failing_pipeline_stage_prints_its_reason(tmp_path, capsys):
+    out = tmp_path / "pipe"
+    out.mkdir()
+    (out / "data").write_text("not a folder")  # the collect stage cannot write its data set here
+    rc, _ = cli("pipeline", "--out", out, "--n", "4", "--shard-size", "4")
+    line = _one_line_error(capsys, "pipeline", "'symlearn collect' exited 2: ", str(out / "data"),
+                           str(out / "logs" / "collect.log"))
+    assert rc == 2 and line.count("symlearn") == 2, line
+
+
+def test_a_stage_that_crashes_prints_one_line_and_keeps_the_traceback_in_its_log(tmp_path, capsys, monkeypatch):
+    import symlearn.cli.main as main_mod
+
+    def crash(args):
+        raise IndexError("index 0 is out of bounds\nfor axis 0")
+
+    monkeypatch.setattr(main_mod, "cmd_collect", crash)
+    out = tmp_path / "pipe"
+    rc, _ = cli("pipeline", "--out", out, "--n", "4", "--shard-size", "4")
+    line = _one_line_error(capsys, "pipeline", "'symlearn collect' failed: IndexError: index 0 is out of bounds; see")
+    assert rc == 2 and "for axis 0" not in line
+    assert "Traceback (most recent call last)" in (out / "logs" / "collect.log").read_text()

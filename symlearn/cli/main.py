@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 
 from symlearn.cli.args import (THREADS_HELP, OneLineParser, add_engine_flags, int_range, non_negative_finite_float,
-                               non_negative_int, positive_finite_float, positive_int, set_threads)
+                               non_negative_int, positive_finite_float, positive_int, set_threads, thread_count)
 from symlearn.cli.pipeline import add_pipeline_command
 from symlearn.cli.planning import add_planning_commands
 from symlearn.cli.report import add_report_command
@@ -252,7 +252,7 @@ def add_train_command(sub) -> None:
     t.add_argument("--no-bf16", action="store_true", help="plain float32 (bf16 autocast is the default)")
     t.add_argument("--compile", action="store_true", help="torch.compile the model")
     t.add_argument("--no-resume", action="store_true", help="start over even if RUN/last.pt exists")
-    t.add_argument("--threads", type=positive_int, help="CPU threads; use 1 per process when the cores are shared "
+    t.add_argument("--threads", type=thread_count, help="CPU threads; use 1 per process when the cores are shared "
                    "(OpenMP threads that wait for busy cores slow training several-fold)")
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=cmd_train)
@@ -308,7 +308,7 @@ def add_export_pddl_command(sub) -> None:
     x.add_argument("--problems", nargs="+", metavar="DIR",
                    help="with --lifted: also write each problem set as a standalone folder "
                         "(RUN/pddl/lifted/SET/domain.pddl, p01.pddl, ..., index.json)")
-    x.add_argument("--threads", type=positive_int, help=THREADS_HELP)
+    x.add_argument("--threads", type=thread_count, help=THREADS_HELP)
     x.set_defaults(func=cmd_export_pddl)
 
 

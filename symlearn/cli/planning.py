@@ -28,7 +28,7 @@ import sys
 from pathlib import Path
 
 from symlearn.cli.args import (THREADS_HELP, add_engine_flags, int_range, non_negative_int, planner_list,
-                               positive_finite_float, positive_int, set_threads)
+                               positive_finite_float, positive_int, set_threads, thread_count)
 from symlearn.symbolic.locations import DEFAULT_LOCATION_BITS, LOCATION_BITS
 
 
@@ -273,7 +273,7 @@ def add_train_transition_command(sub) -> None:
                    "it; 7 (without N): whether, then its height in 5 cm layers; 9: which way and how far, then "
                    "the height (docs/DESIGN.md, 'Location bits')")
     t.add_argument("--seed", type=int, default=0)
-    t.add_argument("--threads", type=positive_int, help=THREADS_HELP)
+    t.add_argument("--threads", type=thread_count, help=THREADS_HELP)
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=cmd_train_transition)
 
@@ -323,7 +323,7 @@ def _add_execution_flags(c: argparse.ArgumentParser) -> None:
                    help=f"seconds per planner call, finite and in (0, {MAX_TIMEOUT_S:g}]")
     # search-time inference runs the networks on small batches, many times slower on 2 threads than on 1 when
     # another busy process shares the cores (docs/BENCHMARKS.md), so one thread unless asked for more
-    c.add_argument("--threads", type=positive_int, default=1, help="torch CPU threads for the networks (default 1)")
+    c.add_argument("--threads", type=thread_count, default=1, help="torch CPU threads for the networks (default 1)")
     c.add_argument("--risk-weight", type=positive_finite_float, default=1.0,
                    help="astar-likely, astar-outcomes and rules-outcomes only: each action costs 1 + W * (-log "
                         "P(its predicted next state)) (rules-outcomes: W times a second outcome's extra -log P) "
