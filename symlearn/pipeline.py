@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Callable
 
 from pddl_export.bounded_json import JsonFileError, List, Map, Num, Obj, Opt, Str, check, read_json_file
+from symlearn.folder_lock import folder_lock
 from symlearn.provenance import atomic_write_json, sha256_bytes, sha256_file
 
 RECORD_FILE = "pipeline.json"
@@ -229,7 +230,12 @@ def _last_error(log: Path, command: str, tail_bytes: int = 65536) -> str:
 def run_pipeline(s: PipelineSettings, echo: Callable[[str], None] = print) -> dict:
     """Run (or resume) every stage; returns the record written to OUT/pipeline.json."""
     out = Path(s.out)
-    out.mkdir(parents=True, exist_ok=True)
+    with folder_lock(out):  # one writer: a second pipeline into this folder is refused at once
+        return _run_stages(s, out, echo)
+
+
+def _run_stages(s: PipelineSettings, out: Path, echo: Callable[[str], None]) -> dict:
+    """run_pipeline's work, inside OUT's lock."""
     record = load_record(out)
     record.update(kind=RECORD_KIND, out=str(out), preset=s.preset)
     n = len(STAGES)

@@ -206,3 +206,268 @@ def test_a_stage_that_crashes_prints_one_line_and_keeps_the_traceback_in_its_log
     line = _one_line_error(capsys, "pipeline", "'symlearn collect' failed: IndexError: index 0 is out of bounds; see")
     assert rc == 2 and "for axis 0" not in line
     assert "Traceback (most recent call last)" in (out / "logs" / "collect.log").read_text()
+
+
+# ------------------------------------------------------------------------------- 15. --threads
+
+
+@pytest.mark.parametrize("value", ["2000", str(2**31)])
+@pytest.mark.parametrize("command", ["plan", "benchmark", "train", "train-transition", "export-pddl"])
+def test_threads_beyond_the_cap_are_refused_in_one_line(tmp_path, capsys, command, value):
+    required = {"plan": ["--run", "r", "--problem", "p.json"], "benchmark": ["--run", "r", "--problems", "p",
+                                                                             "--out", "b.json"],
+                "train": ["--data", "d", "--out", "r"], "train-transition": ["--run", "r", "--data", "d"],
+                "export-pddl": ["--run", "r", "--data", "d"]}[command]
+    with pytest.raises(SystemExit) as info:
+        cli(command, *required, "--threads", value)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert info.value.code == 2 and len(err) == 1, err
+    assert f"argument --threads: '{value}' is more threads than this machine can use (at most " in err[0], err
+
+
+def test_set_threads_refuses_beyond_the_cap():
+    from symlearn.cli.args import max_threads, set_threads
+
+    with pytest.raises(ValueError, match="--threads"):
+        set_threads(max_threads() + 1)
+
+
+# ------------------------------------------------------------------------------- 9. one writer per folder
+
+
+HOLDER = """
+import sys, time
+sys.path.insert(0, {root!r})
+from symlearn.folder_lock import locked
+with locked({lock!r}):
+    print("held", flush=True)
+    time.sleep(120)
+"""
+
+
+@pytest.fixture
+def holder():
+    """Start a process holding the lock at a path; yields a function (lock path) -> its pid; ends it after."""
+    procs = []
+
+    def hold(lock: Path) -> int:
+        lock.parent.mkdir(parents=True, exist_ok=True)
+        proc = subprocess.Popen([sys.executable, "-c", HOLDER.format(root=str(ROOT), lock=str(lock))],
+                                stdout=subprocess.PIPE, text=True, start_new_session=True)
+        procs.append(proc)
+        assert proc.stdout.readline().strip() == "held"
+        return proc.pid
+
+    yield hold
+    for proc in procs:
+        proc.kill()
+        proc.wait(timeout=10)
+
+
+def test_a_second_collect_into_a_folder_is_refused_with_the_holders_pid(tmp_path, capsys, holder):
+    from symlearn.folder_lock import LOCK_NAME
+
+    out = tmp_path / "data"
+    pid = holder(out / LOCK_NAME)
+    rc, _ = cli("collect", "--out", out, "--n", "4", "--shard-size", "4", "--quiet")
+    _one_line_error(capsys, "collect", f"{out} is being written by another symlearn process (pid {pid}")
+    assert rc == 2 and sorted(p.name for p in out.iterdir()) == [LOCK_NAME]
+
+
+def test_a_second_problems_into_a_folder_is_refused_with_the_holders_pid(tmp_path, capsys, holder):
+    from symlearn.folder_lock import LOCK_NAME
+
+    out = tmp_path / "p"
+    pid = holder(out / LOCK_NAME)
+    rc, _ = cli("problems", "--out", out, "--n", "1", "--objects", "1-1", "--length", "1-1")
+    _one_line_error(capsys, "problems", f"pid {pid}")
+    assert rc == 2 and sorted(p.name for p in out.iterdir()) == [LOCK_NAME]
+
+
+def test_a_second_pipeline_into_a_folder_is_refused_with_the_holders_pid(tmp_path, capsys, holder):
+    from symlearn.folder_lock import LOCK_NAME
+
+    out = tmp_path / "pipe"
+    pid = holder(out / LOCK_NAME)
+    rc, _ = cli("pipeline", "--out", out, "--n", "4", "--shard-size", "4")
+    _one_line_error(capsys, "pipeline", f"pid {pid}")
+    assert rc == 2 and sorted(p.name for p in out.iterdir()) == [LOCK_NAME]  # no logs/, no data/
+
+
+def test_a_second_benchmark_on_one_out_is_refused_before_any_row(tiny_run, problems, tmp_path, capsys, holder):
+    from symlearn.planning.benchmark import lock_path, rows_path
+
+    out = tmp_path / "b.json"
+    pid = holder(lock_path(out))
+    rc, _ = cli("benchmark", "--run", tiny_run.path, "--problems", problems, "--planners", "astar", "--out", out,
+                "--quiet")
+    _one_line_error(capsys, "benchmark", f"{out} is being written by another symlearn process (pid {pid}")
+    assert rc == 2 and not out.exists() and not rows_path(out).exists()
+
+
+def test_a_lock_of_a_killed_holder_does_not_block_and_is_removed(tmp_path):
+    from symlearn.folder_lock import LOCK_NAME, folder_lock
+
+    out = tmp_path / "data"
+    out.mkdir()
+    lock = out / LOCK_NAME
+    proc = subprocess.Popen([sys.executable, "-c", HOLDER.format(root=str(ROOT), lock=str(lock))],
+                            stdout=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "held"
+    proc.kill()  # SIGKILL: its lock file stays, naming a dead pid, but the kernel released the lock
+    proc.wait(timeout=10)
+    assert lock.read_text().strip() == str(proc.pid)
+    with folder_lock(out):
+        assert lock.read_text().strip() == str(os.getpid())
+        with open(lock) as f:  # held: another open file description cannot take it
+            with pytest.raises(BlockingIOError):
+                fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    assert not lock.exists() and out.is_dir()
+
+
+def test_a_refused_lock_leaves_no_new_folder(tmp_path):
+    from symlearn.folder_lock import folder_lock
+
+    with pytest.raises(RuntimeError):
+        with folder_lock(tmp_path / "new"):
+            raise RuntimeError("refused inside")
+    assert not (tmp_path / "new").exists()
+
+
+# ------------------------------------------------------------------------------- 3., 13. output paths
+
+
+def test_plan_record_over_the_runs_network_is_refused_before_any_work(tiny_run_copy, problems, capsys):
+    target = tiny_run_copy / "transition.pt"
+    before = target.read_bytes()
+    rc, _ = cli("plan", "--run", tiny_run_copy, "--problem", problems / "problem_0000.json", "--record", target)
+    _one_line_error(capsys, "plan", f"--record {target} exists and is not a GIF; refusing to replace it")
+    assert rc == 2 and target.read_bytes() == before
+    assert not (tiny_run_copy / "transition.png").exists() and not (tiny_run_copy / "pddl" / "problems").exists()
+
+
+def test_plan_record_whose_filmstrip_is_the_same_path_is_refused(tiny_run, problems, tmp_path, capsys):
+    rc, _ = cli("plan", "--run", tiny_run.path, "--problem", problems / "problem_0000.json",
+                "--record", tmp_path / "x.png")
+    _one_line_error(capsys, "plan", "--record and its filmstrip would both be written to")
+    assert rc == 2 and not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("case", ["folder", "text file", "filmstrip not a PNG", "under a file"])
+def test_plan_record_paths_that_are_not_its_own_are_refused(tiny_run, problems, tmp_path, capsys, case):
+    gif = tmp_path / "plan.gif"
+    if case == "folder":
+        gif.mkdir()
+    elif case == "text file":
+        gif.write_text("my notes")
+    elif case == "filmstrip not a PNG":
+        (tmp_path / "plan.png").write_text("not a picture")
+    else:
+        (tmp_path / "f").write_text("a file")
+        gif = tmp_path / "f" / "plan.gif"
+    before = {p.name: (p.read_bytes() if p.is_file() else None) for p in tmp_path.iterdir()}
+    rc, _ = cli("plan", "--run", tiny_run.path, "--problem", problems / "problem_0000.json", "--record", gif)
+    _one_line_error(capsys, "plan", "--record")
+    assert rc == 2 and {p.name: (p.read_bytes() if p.is_file() else None) for p in tmp_path.iterdir()} == before
+
+
+def test_plan_record_may_replace_its_own_gif_and_png(tmp_path):
+    from symlearn.cli.planning import _record_paths
+
+    gif = tmp_path / "plan.gif"
+    gif.write_bytes(b"GIF89a" + bytes(20))
+    (tmp_path / "plan.png").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(20))
+    assert _record_paths(str(gif)) == (gif, tmp_path / "plan.png")
+
+
+def _bench(tiny_run, problems, out, *extra):
+    return cli("benchmark", "--run", tiny_run.path, "--problems", problems, "--planners", "astar", "--out", out,
+               "--quiet", *extra)
+
+
+@pytest.mark.parametrize("case", ["out is a folder", "out is another file", "record is a file", "plots is a file",
+                                  "record is out", "row log is a folder"])
+def test_benchmark_outputs_are_refused_before_any_row(tiny_run, problems, tmp_path, capsys, monkeypatch, case):
+    import symlearn.planning.benchmark as bm
+
+    monkeypatch.setattr(bm, "_run_rows", lambda *a, **k: pytest.fail("a row ran before the outputs were checked"))
+    out, extra = tmp_path / "b.json", []
+    if case == "out is a folder":
+        out.mkdir()
+    elif case == "out is another file":
+        out = tmp_path / "eval.json"
+        out.write_text(json.dumps({"mae_mm": 1.0}))
+    elif case == "record is a file":
+        (tmp_path / "rec").write_text("x")
+        extra = ["--record", tmp_path / "rec"]
+    elif case == "plots is a file":
+        (tmp_path / "plots").write_text("x")
+        extra = ["--plots", tmp_path / "plots"]
+    elif case == "record is out":
+        extra = ["--record", out]
+    else:
+        bm.rows_path(out).mkdir()
+    before = {p.name: (p.read_bytes() if p.is_file() else None) for p in tmp_path.iterdir()}
+    rc, _ = _bench(tiny_run, problems, out, *extra)
+    _one_line_error(capsys, "benchmark")
+    assert rc == 2 and {p.name: (p.read_bytes() if p.is_file() else None) for p in tmp_path.iterdir()} == before
+
+
+def test_benchmark_out_may_replace_a_benchmark_result(tmp_path):
+    from symlearn.planning.benchmark import check_outputs
+
+    out = tmp_path / "b.json"
+    out.write_text(json.dumps({"summary": {}, "rows": []}))
+    check_outputs(out, tmp_path / "recordings")  # no refusal
+
+
+# ------------------------------------------------------------------------------- 2. problems --overwrite
+
+
+def test_problems_overwrite_refuses_before_deleting_anything(sim, tmp_path, capsys):
+    from symlearn.planning.problem_generation import generate_problems
+
+    out = tmp_path / "set"
+    generate_problems(out, 2, objects=(1, 1), length=(1, 1), seed=0, sim=sim)
+    (out / "notes.txt").write_text("mine")
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    rc, _ = cli("problems", "--out", out, "--n", "2", "--objects", "1-1", "--length", "1-1", "--seed", "3",
+                "--overwrite")
+    _one_line_error(capsys, "problems", "notes.txt")
+    assert rc == 2 and {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
+def test_a_goal_problem_is_not_written_into_a_generated_set(sim, tmp_path, capsys):
+    from symlearn.planning.problem_generation import generate_problems
+
+    out = tmp_path / "set"
+    generate_problems(out, 2, objects=(1, 1), length=(1, 1), seed=0, sim=sim)
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    goal = sorted((ROOT / "examples" / "goals").glob("*.json"))[0]
+    rc, _ = cli("problems", "--goal", goal, "--out", out)
+    _one_line_error(capsys, "problems", "holds a generated problem set")
+    assert rc == 2 and {p.name: p.read_bytes() for p in out.iterdir()} == before
+    # the set stays usable: the same command completes it, --overwrite replaces it
+    assert cli("problems", "--out", out, "--n", "2", "--objects", "1-1", "--length", "1-1")[0] == 0
+    assert cli("problems", "--out", out, "--n", "1", "--objects", "1-1", "--length", "1-1", "--overwrite")[0] == 0
+    assert sorted(p.name for p in out.iterdir()) == ["problem_0000.json", "problems.manifest"]
+
+
+# ------------------------------------------------------------------------------- 7. plan's failures reach the terminal
+
+
+def test_plan_refuses_a_task_folder_it_cannot_write_before_any_work(tiny_run_copy, problems, capsys):
+    (tiny_run_copy / "pddl" / "problems").write_text("in the way")  # as a read-only folder: nothing can go there
+    rc, _ = cli("plan", "--run", tiny_run_copy, "--problem", problems / "problem_0000.json",
+                "--planner", "fast-downward-sas")
+    _one_line_error(capsys, "plan", "cannot write the planner's tasks to", "is not a writable folder")
+    assert rc == 2
+
+
+def test_plan_exits_non_zero_with_the_reason_when_the_planner_cannot_run(tiny_run_copy, problems, capsys,
+                                                                         monkeypatch):
+    monkeypatch.setattr("search.sas_planners.search_binary", lambda package="": None)
+    rc, out = cli("plan", "--run", tiny_run_copy, "--problem", problems / "problem_0000.json",
+                  "--planner", "fast-downward-sas")
+    _one_line_error(capsys, "plan", "fast-downward-sas could not plan", "the search binary of")
+    assert rc == 1 and "found False (error)" in out

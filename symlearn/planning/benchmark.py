@@ -14,6 +14,7 @@ symlearn.planning.benchmark_plots renders them.
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import math
@@ -33,6 +34,7 @@ from search.processes import PlannerInterrupted
 from symlearn.planning.execution import ExecutionConfig, ProblemRun, failure_causes, run_problem
 from symlearn.planning.planners import RISK_PLANNERS, make_planners
 from symlearn.planning.problem import RANDOM_WALK, Problem, load_problems
+from symlearn.folder_lock import locked
 from symlearn.planning.recording import PlanRecorder
 from symlearn.provenance import atomic_write_json, atomic_write_text, sha256_bytes, sha256_file, versions
 
@@ -565,13 +567,71 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
     if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
         raise ValueError(f"timeout {timeout_s!r} must be a finite positive number of seconds")
     run_dir, out_file = Path(run_dir), Path(out_file)
-    # refuses unknown names (and missing or stale rules) first
-    fns = make_planners(list(planners), run_dir, risk_weight=risk_weight)
-    sets = problem_sets(problems_dir)
-    problems = load_sets(sets)
-    settings = _settings(run_dir, sets, problems, list(planners), closed_loop, timeout_s, max_replans, risk_weight)
-    t0 = time.perf_counter()
+    check_outputs(out_file, record_dir)  # before any row runs
+    created = not out_file.parent.exists()
     out_file.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        with locked(lock_path(out_file), out_file):  # a second benchmark on this --out is refused at once
+            # refuses unknown names (and missing or stale rules) first
+            fns = make_planners(list(planners), run_dir, risk_weight=risk_weight)
+            sets = problem_sets(problems_dir)
+            problems = load_sets(sets)
+            settings = _settings(run_dir, sets, problems, list(planners), closed_loop, timeout_s, max_replans,
+                                 risk_weight)
+            return _run_and_write(run_dir, sets, problems, list(planners), fns, out_file, settings, closed_loop,
+                                  timeout_s, max_replans, show_progress, record_dir, risk_weight,
+                                  time.perf_counter())
+    finally:
+        if created:
+            with contextlib.suppress(OSError):
+                out_file.parent.rmdir()  # only if a refusal left it empty
+
+
+def lock_path(out_file: Path) -> Path:
+    """The lock file of a benchmark's output while it runs: OUT.lock (symlearn.folder_lock)."""
+    out_file = Path(out_file)
+    return out_file.with_name(out_file.name + ".lock")
+
+
+MAX_RESULT_BYTES = 512 * 2**20  # an existing --out larger than this is not read to check what it is
+
+
+def is_benchmark_result(path: Path) -> bool:
+    """Whether an existing file is a benchmark result (a JSON object with 'summary' and 'rows'), so --out may
+    replace it; anything else (a run's eval.json, a checkpoint) is not."""
+    path = Path(path)
+    if path.stat().st_size > MAX_RESULT_BYTES:
+        return False
+    try:
+        doc = json.loads(path.read_bytes())
+    except (ValueError, RecursionError):
+        return False
+    return isinstance(doc, dict) and isinstance(doc.get("summary"), dict) and isinstance(doc.get("rows"), list)
+
+
+def check_outputs(out_file: Path, record_dir: Path | None = None) -> None:
+    """Refuse, before any work, an --out that is a folder or another kind of file, a row log or lock that is not
+    one, a --record that is a file, and two of them on one path (one-line ValueErrors)."""
+    from symlearn.outputs import distinct_outputs, file_output, folder_output
+
+    paths = {"--out": Path(out_file), "--out's row log": rows_path(out_file), "--out's lock": lock_path(out_file)}
+    if record_dir is not None:
+        paths["--record"] = Path(record_dir)
+    distinct_outputs(paths)
+    file_output(paths["--out"], "--out", kind="a benchmark result", is_own=is_benchmark_result)
+    file_output(paths["--out's row log"], "--out's row log", kind="a benchmark row log",
+                magic=(b'{"format":"' + ROWS_FORMAT.encode() + b'"',))
+    lock = paths["--out's lock"]
+    if lock.is_dir():
+        raise ValueError(f"{lock} is a folder; it is where --out's lock goes")
+    if record_dir is not None:
+        folder_output(Path(record_dir), "--record")
+
+
+def _run_and_write(run_dir: Path, sets: list[Path], problems: list[SetProblem], planners: list[str], fns: dict,
+                   out_file: Path, settings: dict, closed_loop: bool, timeout_s: float, max_replans: int,
+                   show_progress: bool, record_dir: Path | None, risk_weight: float, t0: float) -> dict:
+    """Run (or resume) the rows through OUT.rows.jsonl, then write out_file and remove the log."""
     log = RowLog(rows_path(out_file), settings)
     try:
         log.open()

@@ -36,6 +36,7 @@ import numpy as np
 from pddl_export.bounded_json import JsonFileError, read_json_file
 from symlearn.sim.exploration import ExplorationConfig, sample_action, sample_scene_spec
 from symlearn.data.dataset import DATA_KIND, FORMAT_VERSION, SPLITS, DataError, check_shard_entries
+from symlearn.folder_lock import folder_lock
 from symlearn.provenance import atomic_write_bytes, atomic_write_json, sha256_file, versions
 from symlearn.sim.simulator import SimConfig, TabletopSimulator
 
@@ -394,9 +395,15 @@ def collect(out: Path, cfg: CollectConfig, workers: int = 1, show_progress: bool
         check_engine(engine, address)
     except EngineError as e:
         raise CollectError(str(e)) from None
-    _refuse_run_folder(out)
-    done = _resume_state(out, cfg)
-    out.mkdir(parents=True, exist_ok=True)
+    with folder_lock(out):  # one writer: a second `collect` into this folder is refused at once
+        _refuse_run_folder(out)
+        done = _resume_state(out, cfg)
+        return _collect_locked(out, cfg, workers, show_progress, done, engine, address)
+
+
+def _collect_locked(out: Path, cfg: CollectConfig, workers: int, show_progress: bool, done: dict, engine: str,
+                    address: str | None) -> dict:
+    """collect's work, inside the folder's lock: the shards not in `done`, then the final manifest."""
     remove_temp_files(out)
     sizes = cfg.shard_sizes()
     todo = [i for i in range(len(sizes)) if i not in done]
