@@ -471,3 +471,57 @@ def test_plan_exits_non_zero_with_the_reason_when_the_planner_cannot_run(tiny_ru
                   "--planner", "fast-downward-sas")
     _one_line_error(capsys, "plan", "fast-downward-sas could not plan", "the search binary of")
     assert rc == 1 and "found False (error)" in out
+
+
+# ------------------------------------------------------------------------------- 6. every planner's time limit
+
+
+@pytest.fixture(scope="module")
+def planning_task(tiny_run, problems, sim):
+    """(transition, start codes, symbolic goal) of the first problem under the tiny run's networks."""
+    from symlearn.planning.scenes import place_scene, scene_codes, symbolic_goal
+    from symlearn.planning.problem import load_problem
+    from symlearn.symbolic.learned_transition import planning_models
+
+    encoder, transition = planning_models(tiny_run.path)
+    problem = load_problem(problems / "problem_0000.json")
+    goal = symbolic_goal(sim, encoder, problem)
+    place_scene(sim, problem.initial)
+    return transition, scene_codes(sim, encoder, problem.initial), goal
+
+
+def _registry() -> list[str]:
+    from symlearn.planning.planners import PLANNERS
+
+    return list(PLANNERS)
+
+
+@pytest.mark.parametrize("name", _registry())
+def test_every_planner_reports_timeout_under_a_tiny_limit(tiny_run, planning_task, name):
+    """The limit covers all of a planner's work (grounding, writing, parsing): past it, the answer is TIMEOUT."""
+    from symlearn.planning.planners import make_planners
+
+    fn = make_planners([name], tiny_run.path)[name]
+    transition, start, goal = planning_task
+    limit = 1e-6  # below any call's own duration: a planner that answers at all answers after it
+    t0 = time.perf_counter()
+    res = fn(transition, start, goal, limit)
+    elapsed = time.perf_counter() - t0
+    assert res.status is PlanStatus.TIMEOUT, (res.status, res.message)
+    assert elapsed < limit + 20.0  # generous: process start and reaping on two busy cores; the point is the status
+
+
+def test_pyperplan_grounding_counts_against_its_limit(tiny_run, planning_task, monkeypatch):
+    """Grounding the STRIPS task ran outside the limit (0.5 s asked, ERROR after 6.3 s): now it is inside it."""
+    import symlearn.planning.planners as pl
+
+    def slow_grounding(*args, **kwargs):
+        time.sleep(60)
+
+    monkeypatch.setattr(pl, "strips_pddl", slow_grounding)
+    fn = pl.make_planners(["pyperplan"], tiny_run.path)["pyperplan"]
+    transition, start, goal = planning_task
+    t0 = time.perf_counter()
+    res = fn(transition, start, goal, 0.5)
+    assert res.status is PlanStatus.TIMEOUT, res.message
+    assert time.perf_counter() - t0 < 30.0  # far below the 60 s grounding: it was cut off
