@@ -17,6 +17,7 @@ from symlearn.cli.args import (THREADS_HELP, OneLineParser, add_engine_flags, in
 from symlearn.cli.pipeline import add_pipeline_command
 from symlearn.cli.planning import add_planning_commands
 from symlearn.cli.report import add_report_command
+from symlearn.outputs import folder_output
 
 
 def cmd_collect(args: argparse.Namespace) -> int:
@@ -87,6 +88,7 @@ def cmd_train(args: argparse.Namespace) -> int:
     if args.constant_lr:
         over["cosine_lr"] = False
     cfg = TrainConfig.from_preset(args.preset, bf16=not args.no_bf16, compile=args.compile, **over)
+    folder_output(Path(args.out), "--out")
     set_threads(args.threads)
     _init_distributed()
     print(f"train: preset {cfg.preset}, {cfg.epochs} epochs, seed {cfg.seed}, attention {cfg.model.attention} "
@@ -177,8 +179,8 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
              "pddl_fidelity_cases": args.pddl_fidelity_cases, "scenes": args.scenes, "seed": args.seed,
              "outcome_min_ratio": args.outcome_min_ratio, "larger_scenes": args.larger_scenes}
     cfg = ExportConfig(**{k: v for k, v in given.items() if v is not None})  # unset flags keep ExportConfig's defaults
+    out = folder_output(Path(args.out), "--out") if args.out else None  # before hours of enumeration
     set_threads(args.threads)
-    out = Path(args.out) if args.out else None
     rep = export_pddl(Path(args.run), Path(args.data), cfg, out, extra_data=tuple(Path(d) for d in args.extra_data))
     where = out or Path(args.run) / "pddl"
     print(f"vocabulary {rep['vocabulary_size']} codes; {rep['n_enumerated_cases']} enumerated cases at "
