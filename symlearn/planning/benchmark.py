@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Callable, Sequence
 
 from pddl_export.bounded_json import (AnyJson, Bool, Int, JsonFileError, Map, MiB, Num, Obj, Opt, Str, Tuple, check,
-                                      loads_bounded, read_bounded_bytes)
+                                      loads_bounded, read_bounded_bytes, read_json_file)
 from pddl_export.files import finite_or_null
 from pddl_export.rules_io import PDDL_DIR, RULES_FILE
 from search.processes import PlannerInterrupted
@@ -593,18 +593,15 @@ def lock_path(out_file: Path) -> Path:
     return out_file.with_name(out_file.name + ".lock")
 
 
-MAX_RESULT_BYTES = 512 * 2**20  # an existing --out larger than this is not read to check what it is
+MAX_RESULT_BYTES = 512 * MiB  # an existing --out larger than this is not read to check what it is
 
 
 def is_benchmark_result(path: Path) -> bool:
     """Whether an existing file is a benchmark result (a JSON object with 'summary' and 'rows'), so --out may
     replace it; anything else (a run's eval.json, a checkpoint) is not."""
-    path = Path(path)
-    if path.stat().st_size > MAX_RESULT_BYTES:
-        return False
     try:
-        doc = json.loads(path.read_bytes())
-    except (ValueError, RecursionError):
+        doc = read_json_file(path, what="benchmark result", max_bytes=MAX_RESULT_BYTES)
+    except JsonFileError:
         return False
     return isinstance(doc, dict) and isinstance(doc.get("summary"), dict) and isinstance(doc.get("rows"), list)
 
