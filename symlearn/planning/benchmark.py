@@ -580,7 +580,7 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
                                  risk_weight)
             return _run_and_write(run_dir, sets, problems, list(planners), fns, out_file, settings, closed_loop,
                                   timeout_s, max_replans, show_progress, record_dir, risk_weight,
-                                  time.perf_counter())
+                                  time.perf_counter(), engine, workers, address)
     finally:
         if created:
             with contextlib.suppress(OSError):
@@ -627,8 +627,9 @@ def check_outputs(out_file: Path, record_dir: Path | None = None) -> None:
 
 def _run_and_write(run_dir: Path, sets: list[Path], problems: list[SetProblem], planners: list[str], fns: dict,
                    out_file: Path, settings: dict, closed_loop: bool, timeout_s: float, max_replans: int,
-                   show_progress: bool, record_dir: Path | None, risk_weight: float, t0: float) -> dict:
-    """Run (or resume) the rows through OUT.rows.jsonl, then write out_file and remove the log."""
+                   show_progress: bool, record_dir: Path | None, risk_weight: float, t0: float, engine: str,
+                   workers: int, address: str | None) -> dict:
+    """Run (or resume) the rows through OUT.rows.jsonl (on `engine`), then write out_file and remove the log."""
     log = RowLog(rows_path(out_file), settings)
     try:
         log.open()
