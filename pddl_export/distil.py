@@ -259,6 +259,9 @@ def distil_rules(enumeration: Enumeration) -> RuleSet:
     vocab = np.array(enum.vocabulary, np.int64)
     v, m = len(vocab), enum.max_objects - 1
     cases = _cases(enum)
+    if not len(cases):
+        raise ValueError(f"nothing to distil: no enumerated case (no scene of the {v} vocabulary codes with at most "
+                         f"{enum.max_objects} objects); collect more data or lower --min-count")
     actions, own_idx, others, outcome = cases[:, 0], cases[:, 1], cases[:, 2:2 + m], cases[:, -1]
     n_before = int(np.sum(outcome != vocab[own_idx]))
     key = actions * v + own_idx

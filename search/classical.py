@@ -37,8 +37,8 @@ import tempfile
 import time
 from typing import Any
 
-from search.processes import (DeadlineExceeded, forget_inherited, kill_group, planner_guard, register_group,
-                              temp_dir, unregister_group, within)
+from search.processes import (DeadlineExceeded, external_signal, forget_inherited, kill_group, planner_guard,
+                              register_group, temp_dir, unregister_group, within)
 from search.result import PlanResult, PlanStatus, failed, one_line
 from search.up_problem import parsed_domain
 from search.up_solve import PLANNERS, solve_here
@@ -190,6 +190,10 @@ def solve_pddl(
                       f"(no answer after {total:.2f} s; planner process group killed)",
                       total_time_s=total, planner_time_s=total)
     if answer is None:
+        killed = external_signal(exitcode)
+        if killed is not None:  # not a result: the benchmark must not record it (search.processes)
+            return failed(name, PlanStatus.ERROR, t0, f"{name} was killed by {signal.Signals(killed).name} (not by "
+                          "its time limit)", total_time_s=total, killed_by_signal=killed)
         return failed(name, PlanStatus.ERROR, t0, f"planner process died (exit code {exitcode})", total_time_s=total)
     if "error" in answer:
         return failed(name, PlanStatus.ERROR, t0, answer["error"], total_time_s=total)

@@ -5,7 +5,12 @@ own process group, registered here while it lives, with its temporary folders. A
 its group at the deadline and in `finally`; while any planner runs, SIGTERM, SIGINT and SIGHUP
 to this (main) process kill every registered group and remove the registered folders before
 the signal takes its usual course (the previous handler, or the default action), and an
-`atexit` hook does the same at interpreter exit.
+`atexit` hook does the same at interpreter exit. A signal the caller ignores (SIG_IGN: `nohup`
+ignores SIGHUP, a shell's background job SIGINT) stays ignored: no handler is put in its place.
+A planner call ended by a signal is never a result: when the caller's own handler lets the
+program go on, the call raises PlannerInterrupted; a planner process killed from outside
+(SIGKILL, SIGTERM, SIGINT, SIGHUP, SIGQUIT; not a crash such as SIGSEGV) is reported with
+`extra["killed_by_signal"]` (see `external_signal`), which the benchmark refuses to record.
 
     >>> with planner_guard(), temp_dir("symlearn-fd-") as tmp:                 # doctest: +SKIP
     ...     rc, out, err, timed_out = run_group([binary, "--search", s], "task", 10.0, cwd=tmp)
@@ -30,6 +35,27 @@ _SIGNALS = tuple(getattr(signal, n) for n in ("SIGTERM", "SIGINT", "SIGHUP") if 
 _previous: dict[int, Any] = {}  # signal -> the handler before planner_guard installed ours
 _depth = 0  # nesting depth of planner_guard in the main thread
 _lock = threading.RLock()
+# signals that end a process from outside (a user, a supervisor, the OOM killer), as opposed to its own crash
+_EXTERNAL = {getattr(signal, n) for n in ("SIGKILL", "SIGTERM", "SIGINT", "SIGHUP", "SIGQUIT") if hasattr(signal, n)}
+
+
+class PlannerInterrupted(KeyboardInterrupt):
+    """A signal ended a planner call: its planners were killed, so there is no result to report or record.
+
+    A KeyboardInterrupt, so `except Exception` (and search/execution's error-to-status conversions)
+    let it through; the CLI ends with "interrupted; re-run the same command to resume".
+    """
+
+    def __init__(self, signum: int, message: str = "") -> None:
+        super().__init__(message or f"planners stopped by {signal.Signals(signum).name}")
+        self.signum = signum
+
+
+def external_signal(returncode: int | None) -> int | None:
+    """The signal number when a process's return code says it was killed from outside, else None (crashes too)."""
+    if returncode is None or returncode >= 0:
+        return None
+    return -returncode if -returncode in _EXTERNAL else None
 
 
 def kill_group(pgid: int) -> None:
@@ -78,15 +104,19 @@ def forget_inherited() -> None:
 
 
 def _on_signal(signum: int, frame: Any) -> None:
-    """Kill the planners, remove their folders, then let the signal do what it did before planner_guard."""
+    """Kill the planners, remove their folders, then let the signal do what it did before planner_guard.
+
+    If that handler lets the program go on, the interrupted call raises PlannerInterrupted: its
+    planners are dead, and what they left must not pass for a result.
+    """
     cleanup()
     previous = _previous.get(signum, signal.SIG_DFL)
     _restore()
     if callable(previous):
         previous(signum, frame)  # e.g. Python's SIGINT handler: KeyboardInterrupt
-    elif previous == signal.SIG_DFL:
-        signal.signal(signum, signal.SIG_DFL)
-        os.kill(os.getpid(), signum)
+        raise PlannerInterrupted(signum)
+    signal.signal(signum, signal.SIG_DFL)  # previous is SIG_DFL (or None: a handler not set from Python)
+    os.kill(os.getpid(), signum)
 
 
 def _restore() -> None:
@@ -107,7 +137,10 @@ def planner_guard() -> Iterator[None]:
     if main:
         if _depth == 0:
             for sig in _SIGNALS:
-                _previous[sig] = signal.getsignal(sig)
+                previous = signal.getsignal(sig)
+                if previous == signal.SIG_IGN:  # the caller ignores it (nohup, a background job): so do we
+                    continue
+                _previous[sig] = previous
                 signal.signal(sig, _on_signal)
         _depth += 1
     try:

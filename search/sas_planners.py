@@ -21,6 +21,7 @@ from __future__ import annotations
 import importlib.util
 import math
 import re
+import signal
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,7 +33,7 @@ from pddl_export.files import atomic_write_text
 from pddl_export.pddl_writer import action_id_from_name
 from pddl_export.rules import apply_rules
 from pddl_export.sas_writer import Negation, SASEncoder, TaskTimeoutError, TaskTooLargeError
-from search.processes import planner_guard, run_group, temp_dir
+from search.processes import external_signal, planner_guard, run_group, temp_dir
 from search.result import PlanResult, PlanStatus, failed
 from pddl_export.symbolic import SymbolicGoal
 
@@ -168,6 +169,10 @@ def _run_search(binary: Path, search: str, task_text: str, planner: str, timeout
         if timed_out:
             extra["top_k_timed_out"] = True
         expansions = _read_log(log, extra)
+        killed = external_signal(code)
+        if killed is not None and not plans:  # not a result: the benchmark must not record it (search.processes)
+            return failed(planner, PlanStatus.ERROR, t0, f"{planner} was killed by {signal.Signals(killed).name} "
+                          "(not by its time limit)", killed_by_signal=killed, **extra)
         if not plans:
             status, why = _EXIT.get(code, (PlanStatus.ERROR, f"exited with code {code}"))
             why = why if status is PlanStatus.UNSOLVABLE else f"{planner} {why}"

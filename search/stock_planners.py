@@ -33,13 +33,14 @@ import importlib.util
 import math
 import re
 import shutil
+import signal
 import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from search.processes import planner_guard, run_group, temp_dir
+from search.processes import external_signal, planner_guard, run_group, temp_dir
 from search.result import PlanResult, PlanStatus, failed
 from search.sas_planners import MEMORY_LIMIT_MB, _limit_memory
 
@@ -298,6 +299,10 @@ def _solve_in(tmp: Path, domain: Path, problem: Path, planner: str, timeout_s: f
         where = _phase(out) if spec.tool == "fast-downward" else "parsing, grounding or search"
         return failed(planner, PlanStatus.TIMEOUT, t0, f"{planner} hit the {timeout_s:g} s time limit during "
                       f"{where} (process group killed)", **extra)
+    killed = external_signal(code)
+    if killed is not None:  # not a result: the benchmark must not record it (search.processes)
+        return failed(planner, PlanStatus.ERROR, t0, f"{planner} was killed by {signal.Signals(killed).name} (not by "
+                      "its time limit)", killed_by_signal=killed, **extra)
     plan_name = "sas_plan" if spec.tool == "fast-downward" else problem.name + ".soln"
     return _finish(planner, spec, code, out, err, plan_name, tmp, action_id, t0, extra)
 

@@ -14,11 +14,13 @@ from __future__ import annotations
 
 import contextlib
 import time
+import traceback
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
 from pddl_export.bounded_json import JsonFileError, List, Map, Num, Obj, Opt, Str, check, read_json_file
+from symlearn.folder_lock import folder_lock
 from symlearn.provenance import atomic_write_json, sha256_bytes, sha256_file
 
 RECORD_FILE = "pipeline.json"
@@ -48,10 +50,10 @@ class PipelineSettings:
     def __post_init__(self) -> None:
         if self.preset not in PRESETS:
             raise ValueError(f"unknown preset {self.preset!r}; known: {', '.join(PRESETS)}")
-        for name in ("n", "epochs", "transition_epochs", "problems"):
-            v = getattr(self, name)
-            if v is not None and v < 1:
-                raise ValueError(f"--{name.replace('_', '-')} {v} must be at least 1")
+        for name in ("n", "epochs", "transition_epochs", "problems", "workers", "shard_size", "seed"):
+            v, least = getattr(self, name), 0 if name == "seed" else 1
+            if v is not None and not (isinstance(v, int) and not isinstance(v, bool) and v >= least):
+                raise ValueError(f"--{name.replace('_', '-')} {v!r} must be an integer of at least {least}")
         if self.stop_after is not None and self.stop_after not in STAGE_NAMES:
             raise ValueError(f"unknown stage {self.stop_after!r}; stages: {', '.join(STAGE_NAMES)}")
 
@@ -195,17 +197,45 @@ def _run_commands(argv: list[list[str]], log: Path) -> None:
     with open(log, "a") as fh, contextlib.redirect_stdout(fh), contextlib.redirect_stderr(fh):
         for cmd in argv:
             print(f"$ symlearn {' '.join(cmd)}", flush=True)
-            rc = main(cmd)
+            try:
+                rc = main(cmd)
+            except SystemExit as e:  # argparse refused a flag (its one line is in the log)
+                rc = e.code if isinstance(e.code, int) else 2
+            except Exception as e:  # noqa: BLE001 - a stage's bug: the traceback to its log, one line to the terminal
+                traceback.print_exc()
+                first = (str(e).strip().splitlines() or [""])[0]
+                raise RuntimeError(f"'symlearn {cmd[0]}' failed: {type(e).__name__}: {first}; see {log}") from None
             if rc == 130:  # the command caught Ctrl-C: stop here too; the next run resumes
                 raise KeyboardInterrupt
             if rc != 0:
-                raise RuntimeError(f"'symlearn {cmd[0]}' exited {rc}; see {log}")
+                fh.flush()
+                reason = _last_error(log, cmd[0])
+                raise RuntimeError(f"'symlearn {cmd[0]}' exited {rc}{': ' + reason if reason else ''}; see {log}")
+
+
+def _last_error(log: Path, command: str, tail_bytes: int = 65536) -> str:
+    """The last 'symlearn COMMAND: error: ...' (or 'interrupted') line in the end of a log, without its prefix; ''."""
+    with open(log, "rb") as f:
+        f.seek(max(f.seek(0, 2) - tail_bytes, 0))
+        lines = f.read().decode("utf-8", errors="replace").splitlines()
+    for line in reversed(lines):
+        for prefix in (f"symlearn {command}: error: ", f"symlearn {command}: "):
+            if line.startswith(prefix):
+                return line[len(prefix):].strip()
+        if line.startswith("symlearn: error: "):  # argparse's refusal of a flag
+            return line[len("symlearn: error: "):].strip()
+    return ""
 
 
 def run_pipeline(s: PipelineSettings, echo: Callable[[str], None] = print) -> dict:
     """Run (or resume) every stage; returns the record written to OUT/pipeline.json."""
     out = Path(s.out)
-    out.mkdir(parents=True, exist_ok=True)
+    with folder_lock(out):  # one writer: a second pipeline into this folder is refused at once
+        return _run_stages(s, out, echo)
+
+
+def _run_stages(s: PipelineSettings, out: Path, echo: Callable[[str], None]) -> dict:
+    """run_pipeline's work, inside OUT's lock."""
     record = load_record(out)
     record.update(kind=RECORD_KIND, out=str(out), preset=s.preset)
     n = len(STAGES)

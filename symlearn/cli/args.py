@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 
 from symlearn.cluster import ENGINES
 
@@ -39,6 +40,21 @@ def positive_int(text: str) -> int:
     value = _integer(text)
     if value < 1:
         raise argparse.ArgumentTypeError(f"{text!r} must be a positive integer")
+    return value
+
+
+def max_threads() -> int:
+    """The most CPU threads --threads accepts: 4 per core (more only waits for the cores, and a huge count
+    overflows torch's int, or makes each small network call spawn hundreds of idle threads)."""
+    return 4 * (os.cpu_count() or 1)
+
+
+def thread_count(text: str) -> int:
+    """'2' -> 2, for --threads: an integer in 1..max_threads(); anything else is an argparse error naming the text."""
+    value = positive_int(text)
+    if value > max_threads():
+        raise argparse.ArgumentTypeError(f"{text!r} is more threads than this machine can use "
+                                         f"(at most {max_threads()}: 4 per core)")
     return value
 
 
@@ -93,8 +109,10 @@ THREADS_HELP = ("torch CPU threads (default: torch's, one per core); use 1 per p
 
 
 def set_threads(n: int | None) -> None:
-    """torch.set_num_threads(n) when a --threads value was given."""
+    """torch.set_num_threads(n) when a --threads value was given (at most max_threads())."""
     if n:
+        if not 1 <= n <= max_threads():
+            raise ValueError(f"--threads {n} must be between 1 and {max_threads()} (4 per core)")
         import torch
 
         torch.set_num_threads(n)

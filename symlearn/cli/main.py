@@ -13,10 +13,11 @@ import time
 from pathlib import Path
 
 from symlearn.cli.args import (THREADS_HELP, OneLineParser, add_engine_flags, int_range, non_negative_finite_float,
-                               non_negative_int, positive_finite_float, positive_int, set_threads)
+                               non_negative_int, positive_finite_float, positive_int, set_threads, thread_count)
 from symlearn.cli.pipeline import add_pipeline_command
 from symlearn.cli.planning import add_planning_commands
 from symlearn.cli.report import add_report_command
+from symlearn.outputs import folder_output
 
 
 def cmd_collect(args: argparse.Namespace) -> int:
@@ -87,6 +88,7 @@ def cmd_train(args: argparse.Namespace) -> int:
     if args.constant_lr:
         over["cosine_lr"] = False
     cfg = TrainConfig.from_preset(args.preset, bf16=not args.no_bf16, compile=args.compile, **over)
+    folder_output(Path(args.out), "--out")
     set_threads(args.threads)
     _init_distributed()
     print(f"train: preset {cfg.preset}, {cfg.epochs} epochs, seed {cfg.seed}, attention {cfg.model.attention} "
@@ -177,8 +179,8 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
              "pddl_fidelity_cases": args.pddl_fidelity_cases, "scenes": args.scenes, "seed": args.seed,
              "outcome_min_ratio": args.outcome_min_ratio, "larger_scenes": args.larger_scenes}
     cfg = ExportConfig(**{k: v for k, v in given.items() if v is not None})  # unset flags keep ExportConfig's defaults
+    out = folder_output(Path(args.out), "--out") if args.out else None  # before hours of enumeration
     set_threads(args.threads)
-    out = Path(args.out) if args.out else None
     rep = export_pddl(Path(args.run), Path(args.data), cfg, out, extra_data=tuple(Path(d) for d in args.extra_data))
     where = out or Path(args.run) / "pddl"
     print(f"vocabulary {rep['vocabulary_size']} codes; {rep['n_enumerated_cases']} enumerated cases at "
@@ -252,7 +254,7 @@ def add_train_command(sub) -> None:
     t.add_argument("--no-bf16", action="store_true", help="plain float32 (bf16 autocast is the default)")
     t.add_argument("--compile", action="store_true", help="torch.compile the model")
     t.add_argument("--no-resume", action="store_true", help="start over even if RUN/last.pt exists")
-    t.add_argument("--threads", type=positive_int, help="CPU threads; use 1 per process when the cores are shared "
+    t.add_argument("--threads", type=thread_count, help="CPU threads; use 1 per process when the cores are shared "
                    "(OpenMP threads that wait for busy cores slow training several-fold)")
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=cmd_train)
@@ -308,7 +310,7 @@ def add_export_pddl_command(sub) -> None:
     x.add_argument("--problems", nargs="+", metavar="DIR",
                    help="with --lifted: also write each problem set as a standalone folder "
                         "(RUN/pddl/lifted/SET/domain.pddl, p01.pddl, ..., index.json)")
-    x.add_argument("--threads", type=positive_int, help=THREADS_HELP)
+    x.add_argument("--threads", type=thread_count, help=THREADS_HELP)
     x.set_defaults(func=cmd_export_pddl)
 
 
@@ -334,8 +336,9 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, RuntimeError, OSError) as e:
         print(f"symlearn {args.command}: error: {e}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt as e:  # Ctrl-C, or SIGINT / SIGTERM turned into CollectInterrupted
-        print(f"symlearn {args.command}: interrupted; re-run the same command to resume", file=sys.stderr)
+    except KeyboardInterrupt as e:  # Ctrl-C, SIGINT / SIGTERM turned into CollectInterrupted, PlannerInterrupted
+        why = f" ({e})" if str(e) else ""
+        print(f"symlearn {args.command}: interrupted{why}; re-run the same command to resume", file=sys.stderr)
         return 128 + getattr(e, "signum", 2)
 
 

@@ -7,6 +7,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from symlearn.cli.args import non_negative_int, positive_int
+
 
 def cmd_pipeline(args: argparse.Namespace) -> int:
     from symlearn.pipeline import PipelineSettings, run_pipeline
@@ -24,12 +26,13 @@ def add_pipeline_command(sub) -> None:
     p = sub.add_parser("pipeline", help="run every stage (collect ... report) into one folder; resumes")
     p.add_argument("--preset", default="quick", choices=["quick", "paper"])
     p.add_argument("--out", required=True, help="folder for data/, run/, problems/, logs/ and pipeline.json")
-    p.add_argument("--n", type=int, help="samples to collect (preset's if unset: quick 1000, paper 12000)")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--epochs", type=int, help="effect model epochs (preset's if unset)")
-    p.add_argument("--transition-epochs", type=int, help="transition network epochs (preset's if unset)")
-    p.add_argument("--problems", type=int, help="planning problems to benchmark (quick 5, paper 20)")
-    p.add_argument("--workers", type=int, default=1, help="collection worker processes")
-    p.add_argument("--shard-size", type=int, default=250, help="samples per data shard")
+    # each value is checked here, before OUT is made, not first by the stage that uses it
+    p.add_argument("--n", type=positive_int, help="samples to collect (preset's if unset: quick 1000, paper 12000)")
+    p.add_argument("--seed", type=non_negative_int, default=0)
+    p.add_argument("--epochs", type=positive_int, help="effect model epochs (preset's if unset)")
+    p.add_argument("--transition-epochs", type=positive_int, help="transition network epochs (preset's if unset)")
+    p.add_argument("--problems", type=positive_int, help="planning problems to benchmark (quick 5, paper 20)")
+    p.add_argument("--workers", type=positive_int, default=1, help="collection worker processes")
+    p.add_argument("--shard-size", type=positive_int, default=250, help="samples per data shard")
     p.add_argument("--stop-after", help=argparse.SUPPRESS)  # tests: simulate an interruption after a stage
     p.set_defaults(func=cmd_pipeline)

@@ -24,11 +24,12 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
 from pathlib import Path
 
 from symlearn.cli.args import (THREADS_HELP, add_engine_flags, int_range, non_negative_int, planner_list,
-                               positive_finite_float, positive_int, set_threads)
+                               positive_finite_float, positive_int, set_threads, thread_count)
 from symlearn.symbolic.locations import DEFAULT_LOCATION_BITS, LOCATION_BITS
 
 
@@ -186,9 +187,11 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.learned_transition import planning_models
 
+    gif, strip = _record_paths(args.record)  # refused before any work
     set_threads(args.threads)
     problem = load_problem(Path(args.problem))
     write_dir = path_under(Path(args.run) / "pddl" / "problems", problem.name)  # the name is checked at load
+    _check_writable(write_dir)
     note_rule_loading(Path(args.run), [args.planner])
     fn = make_planners([args.planner], Path(args.run), write_dir=write_dir, risk_weight=args.risk_weight)[args.planner]
     encoder, transition = planning_models(Path(args.run))
@@ -201,8 +204,8 @@ def cmd_plan(args: argparse.Namespace) -> int:
     with TabletopSimulator() as sim:
         row = run_problem(sim, encoder, transition, problem, args.planner, fn, cfg, recorder=recorder)
     if recorder is not None:
-        print(f"wrote {recorder.save_gif(Path(args.record))} ({len(recorder.frames)} frames) and "
-              f"{recorder.save_filmstrip(Path(args.record).with_suffix('.png'))}")
+        print(f"wrote {recorder.save_gif(gif)} ({len(recorder.frames)} frames) and "
+              f"{recorder.save_filmstrip(strip)}")
     if write_dir.exists():
         print(f"wrote {write_dir / 'problem.pddl'}")
     print(f"{problem.name} [{args.planner}{', closed loop' if row.closed_loop else ''}]: found {row.found} "
@@ -210,7 +213,32 @@ def cmd_plan(args: argparse.Namespace) -> int:
           f"time {row.planning_time_s:.3f} s, expansions {row.expansions}, success {row.success}, "
           f"symbolic match {row.symbolic_match}, max distance {row.max_distance_m} m, replans {row.replans}, "
           f"failure {row.failure_stage}")
+    if row.status == "error":  # the planner could not run: not an answer about the problem
+        print(f"symlearn plan: error: {args.planner} could not plan {problem.name}: {row.message}", file=sys.stderr)
+        return 1
     return 0
+
+
+def _record_paths(record: str | None) -> tuple[Path | None, Path | None]:
+    """plan --record: the GIF and its filmstrip (.png beside it), checked: two paths, neither a folder nor a file
+    of another kind (e.g. RUN/transition.pt), so nothing is replaced that the user did not ask to replace."""
+    from symlearn.outputs import GIF_MAGIC, PNG_MAGIC, distinct_outputs, file_output
+
+    if not record:
+        return None, None
+    gif = Path(record)
+    strip = gif.with_suffix(".png")
+    distinct_outputs({"--record": gif, "its filmstrip": strip})
+    return (file_output(gif, "--record", kind="a GIF", magic=GIF_MAGIC),
+            file_output(strip, "--record's filmstrip", kind="a PNG", magic=PNG_MAGIC))
+
+
+def _check_writable(folder: Path) -> None:
+    """Refuse, before any work, a folder plan must write into (RUN/pddl/problems/NAME) that it cannot write."""
+    existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
+    if existing is not None and not (existing.is_dir() and os.access(existing, os.W_OK | os.X_OK)):
+        raise ValueError(f"cannot write the planner's tasks to {folder}: {existing} is not a writable folder "
+                         f"(a read-only run? copy it somewhere writable)")
 
 
 def cmd_benchmark(args: argparse.Namespace) -> int:
@@ -218,9 +246,15 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
     from symlearn.planning.benchmark import benchmark, format_goal_placement, format_table
     from symlearn.planning.benchmark_plots import format_grid, format_shortest_grid, write_plots
 
+    from symlearn.outputs import distinct_outputs, folder_output
+
     check_engine(args.engine, args.address)  # before any work: a missing Ray is refused in one line
     if args.workers > 1 and args.engine != "ray":
         raise ValueError(f"--workers {args.workers}: the local engine runs rows one after another; add --engine ray")
+    outputs = {"--out": Path(args.out), "--record": args.record, "--plots": args.plots}
+    distinct_outputs({k: Path(v) for k, v in outputs.items() if v})  # --out and its row log: benchmark() checks
+    if args.plots:
+        folder_output(Path(args.plots), "--plots")
     set_threads(args.threads)
     note_rule_loading(Path(args.run), list(args.planners))
     res = benchmark(Path(args.run), args.problems, args.planners, Path(args.out), closed_loop=args.closed_loop,
@@ -273,7 +307,7 @@ def add_train_transition_command(sub) -> None:
                    "it; 7 (without N): whether, then its height in 5 cm layers; 9: which way and how far, then "
                    "the height (docs/DESIGN.md, 'Location bits')")
     t.add_argument("--seed", type=int, default=0)
-    t.add_argument("--threads", type=positive_int, help=THREADS_HELP)
+    t.add_argument("--threads", type=thread_count, help=THREADS_HELP)
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=cmd_train_transition)
 
@@ -323,7 +357,7 @@ def _add_execution_flags(c: argparse.ArgumentParser) -> None:
                    help=f"seconds per planner call, finite and in (0, {MAX_TIMEOUT_S:g}]")
     # search-time inference runs the networks on small batches, many times slower on 2 threads than on 1 when
     # another busy process shares the cores (docs/BENCHMARKS.md), so one thread unless asked for more
-    c.add_argument("--threads", type=positive_int, default=1, help="torch CPU threads for the networks (default 1)")
+    c.add_argument("--threads", type=thread_count, default=1, help="torch CPU threads for the networks (default 1)")
     c.add_argument("--risk-weight", type=positive_finite_float, default=1.0,
                    help="astar-likely, astar-outcomes and rules-outcomes only: each action costs 1 + W * (-log "
                         "P(its predicted next state)) (rules-outcomes: W times a second outcome's extra -log P) "

@@ -14,10 +14,12 @@ symlearn.planning.benchmark_plots renders them.
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import math
 import os
+import signal
 import statistics
 import time
 from dataclasses import dataclass
@@ -25,12 +27,14 @@ from pathlib import Path
 from typing import Callable, Sequence
 
 from pddl_export.bounded_json import (AnyJson, Bool, Int, JsonFileError, Map, MiB, Num, Obj, Opt, Str, Tuple, check,
-                                      loads_bounded, read_bounded_bytes)
+                                      loads_bounded, read_bounded_bytes, read_json_file)
 from pddl_export.files import finite_or_null
 from pddl_export.rules_io import PDDL_DIR, RULES_FILE
+from search.processes import PlannerInterrupted
 from symlearn.planning.execution import ExecutionConfig, ProblemRun, failure_causes, run_problem
 from symlearn.planning.planners import RISK_PLANNERS, make_planners
 from symlearn.planning.problem import RANDOM_WALK, Problem, load_problems
+from symlearn.folder_lock import locked
 from symlearn.planning.recording import PlanRecorder
 from symlearn.provenance import atomic_write_json, atomic_write_text, sha256_bytes, sha256_file, versions
 
@@ -375,6 +379,28 @@ class _first_call_kept:
         return getattr(self.fn, name)
 
 
+class _not_killed:
+    """The planner function, raising PlannerInterrupted instead of returning a result of a planner killed by a signal.
+
+    A planner process killed from outside (search.processes.external_signal) has no result: its row
+    must not be logged as one, so the benchmark stops there and the same command again redoes it.
+    """
+
+    def __init__(self, fn, name: str) -> None:
+        self.fn, self.name = fn, name
+
+    def __call__(self, transition, start, goal, timeout_s):
+        res = self.fn(transition, start, goal, timeout_s)
+        signum = res.extra.get("killed_by_signal")
+        if signum:
+            raise PlannerInterrupted(int(signum), f"{self.name} was killed by {signal.Signals(int(signum)).name} "
+                                     "(not by its time limit); its row is not saved")
+        return res
+
+    def __getattr__(self, name: str):
+        return getattr(self.fn, name)
+
+
 def _current_rules(run_dir: Path, fns: dict):
     """The run's exported rules when they match its transition model (for the attribution of every planner), else None.
 
@@ -420,8 +446,8 @@ def _run_rows(run_dir: Path, problems: list[SetProblem], fns: dict, log: RowLog,
                 for name in fns:
                     pair_loops = [loop for loop in loops if (p.key, name, loop) not in log.done]
                     if pair_loops:
-                        _run_pair(sim, encoder, transition, rules, p, name, fns[name], pair_loops, timeout_s,
-                                  max_replans, record_dir, emit)
+                        _run_pair(sim, encoder, transition, rules, p, name, _not_killed(fns[name], name), pair_loops,
+                                  timeout_s, max_replans, record_dir, emit)
     elif show_progress:
         print(f"every row was already in {log.path}", flush=True)
     return [ProblemRun(**log.done[(p.key, name, loop)]) for p in problems for name in fns for loop in loops]
@@ -451,6 +477,7 @@ def _run_pair(sim, encoder, transition, rules, p: SetProblem, name: str, fn, loo
         emit((p.key, name, loop), finite_or_null(row.to_json()))
 
 
+INTERRUPTED = "interrupted"  # _ray_pair's last entry when a planner was killed by a signal (its row is not one)
 _worker_state: dict = {}  # in a Ray worker: the loaded models, planners and simulator of the last settings seen
 
 
@@ -474,8 +501,12 @@ def _ray_pair(settings_json: str, run_dir: str, planners: list[str], risk_weight
         _worker_state.update(settings=settings_json, fns=fns, encoder=encoder, transition=transition,
                              rules=_current_rules(Path(run_dir), fns), sim=TabletopSimulator())
     w, rows = _worker_state, []
-    _run_pair(w["sim"], w["encoder"], w["transition"], w["rules"], p, name, w["fns"][name], loops, timeout_s,
-              max_replans, Path(record_dir) if record_dir else None, lambda key, row: rows.append((key, row)))
+    try:
+        _run_pair(w["sim"], w["encoder"], w["transition"], w["rules"], p, name, _not_killed(w["fns"][name], name),
+                  loops, timeout_s, max_replans, Path(record_dir) if record_dir else None,
+                  lambda key, row: rows.append((key, row)))
+    except PlannerInterrupted as e:  # no row for it: the driver logs the rows before it, then stops (_run_rows_ray)
+        rows.append((INTERRUPTED, {"signum": e.signum, "message": str(e)}))
     return rows
 
 
@@ -502,6 +533,8 @@ def _run_rows_ray(run_dir: Path, problems: list[SetProblem], planners: list[str]
     with ray_session(address, num_cpus=workers) as ray:
         for _, rows in as_finished(ray, _ray_pair, jobs, window=workers):
             for key, row in rows:
+                if key == INTERRUPTED:
+                    raise PlannerInterrupted(row["signum"], row["message"])
                 log.append(key, row)
                 if show_progress:
                     print(progress_line(len(log.done), total, tuple(key), row), flush=True)
@@ -534,13 +567,69 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
     if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
         raise ValueError(f"timeout {timeout_s!r} must be a finite positive number of seconds")
     run_dir, out_file = Path(run_dir), Path(out_file)
-    # refuses unknown names (and missing or stale rules) first
-    fns = make_planners(list(planners), run_dir, risk_weight=risk_weight)
-    sets = problem_sets(problems_dir)
-    problems = load_sets(sets)
-    settings = _settings(run_dir, sets, problems, list(planners), closed_loop, timeout_s, max_replans, risk_weight)
-    t0 = time.perf_counter()
+    check_outputs(out_file, record_dir)  # before any row runs
+    created = not out_file.parent.exists()
     out_file.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        with locked(lock_path(out_file), out_file):  # a second benchmark on this --out is refused at once
+            # refuses unknown names (and missing or stale rules) first
+            fns = make_planners(list(planners), run_dir, risk_weight=risk_weight)
+            sets = problem_sets(problems_dir)
+            problems = load_sets(sets)
+            settings = _settings(run_dir, sets, problems, list(planners), closed_loop, timeout_s, max_replans,
+                                 risk_weight)
+            return _run_and_write(run_dir, sets, problems, list(planners), fns, out_file, settings, closed_loop,
+                                  timeout_s, max_replans, show_progress, record_dir, risk_weight,
+                                  time.perf_counter(), engine, workers, address)
+    finally:
+        if created:
+            with contextlib.suppress(OSError):
+                out_file.parent.rmdir()  # only if a refusal left it empty
+
+
+def lock_path(out_file: Path) -> Path:
+    """The lock file of a benchmark's output while it runs: OUT.lock (symlearn.folder_lock)."""
+    out_file = Path(out_file)
+    return out_file.with_name(out_file.name + ".lock")
+
+
+MAX_RESULT_BYTES = 512 * MiB  # an existing --out larger than this is not read to check what it is
+
+
+def is_benchmark_result(path: Path) -> bool:
+    """Whether an existing file is a benchmark result (a JSON object with 'summary' and 'rows'), so --out may
+    replace it; anything else (a run's eval.json, a checkpoint) is not."""
+    try:
+        doc = read_json_file(path, what="benchmark result", max_bytes=MAX_RESULT_BYTES)
+    except JsonFileError:
+        return False
+    return isinstance(doc, dict) and isinstance(doc.get("summary"), dict) and isinstance(doc.get("rows"), list)
+
+
+def check_outputs(out_file: Path, record_dir: Path | None = None) -> None:
+    """Refuse, before any work, an --out that is a folder or another kind of file, a row log or lock that is not
+    one, a --record that is a file, and two of them on one path (one-line ValueErrors)."""
+    from symlearn.outputs import distinct_outputs, file_output, folder_output
+
+    paths = {"--out": Path(out_file), "--out's row log": rows_path(out_file), "--out's lock": lock_path(out_file)}
+    if record_dir is not None:
+        paths["--record"] = Path(record_dir)
+    distinct_outputs(paths)
+    file_output(paths["--out"], "--out", kind="a benchmark result", is_own=is_benchmark_result)
+    file_output(paths["--out's row log"], "--out's row log", kind="a benchmark row log",
+                magic=(b'{"format":"' + ROWS_FORMAT.encode() + b'"',))
+    lock = paths["--out's lock"]
+    if lock.is_dir():
+        raise ValueError(f"{lock} is a folder; it is where --out's lock goes")
+    if record_dir is not None:
+        folder_output(Path(record_dir), "--record")
+
+
+def _run_and_write(run_dir: Path, sets: list[Path], problems: list[SetProblem], planners: list[str], fns: dict,
+                   out_file: Path, settings: dict, closed_loop: bool, timeout_s: float, max_replans: int,
+                   show_progress: bool, record_dir: Path | None, risk_weight: float, t0: float, engine: str,
+                   workers: int, address: str | None) -> dict:
+    """Run (or resume) the rows through OUT.rows.jsonl (on `engine`), then write out_file and remove the log."""
     log = RowLog(rows_path(out_file), settings)
     try:
         log.open()

@@ -146,6 +146,9 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     arrays = [a for pair in code_sets for a in pair]
     counts = code_counts(*arrays)
     vocab = sorted(c for c, n in counts.items() if n >= cfg.min_count)
+    if not vocab:
+        raise ValueError(f"no code has --min-count {cfg.min_count} training objects in {data_dir} (the most "
+                         f"frequent has {max(counts.values(), default=0)}); lower --min-count or collect more data")
     t_vocab = time.perf_counter() - t0
     added: list[int] = []
     if cfg.scenes == "observed":

@@ -48,6 +48,7 @@ from pddl_export.sas_writer import SASEncoder
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
 from search.classical import solve_pddl
 from search.learned_astar import plan_symbolic
+from search.processes import DeadlineExceeded, within
 from search.result import PlanResult, PlanStatus, failed
 from search.rules_outcomes import plan_rules_outcomes
 from search.rules_search import plan_rules
@@ -246,16 +247,21 @@ class _RulesPlanner:
                                                                       .replace(".pddl", ".sas"))
         return solve_sas(encoder, init, goal, self.engine, timeout_s, write_to=sas_path)
 
+    def _texts(self, rules: RuleSet, domain: str | None, init: list[int], goal: SymbolicGoal) -> tuple:
+        """(domain text, problem text, prebuilt unified-planning problem or None) of this call."""
+        if self.form == "strips":  # built directly: unified-planning's reader is too slow for its size
+            task = strips_pddl(rules, init, goal, self.model_hash)
+            return task.domain, task.problem, strips_problem(task)
+        return domain, problem_pddl(rules, init, goal, self.model_hash), None
+
     def _solve_pddl(self, rules: RuleSet, domain: str | None, transition: TransitionFn, init: list[int],
                     goal: SymbolicGoal, timeout_s: float) -> PlanResult:
         t0 = time.perf_counter()
-        try:
-            prebuilt = None
-            if self.form == "strips":  # built directly: unified-planning's reader is too slow for its size
-                task = strips_pddl(rules, init, goal, self.model_hash)
-                dom, prob, prebuilt = task.domain, task.problem, strips_problem(task)
-            else:
-                dom, prob = domain, problem_pddl(rules, init, goal, self.model_hash)
+        try:  # grounding (STRIPS) can take longer than the whole limit: it is part of the call
+            dom, prob, prebuilt = within(lambda: self._texts(rules, domain, init, goal), timeout_s)
+        except DeadlineExceeded:
+            return failed(self.name, PlanStatus.TIMEOUT, t0, f"time limit of {timeout_s:g} s reached while writing "
+                          f"the {self.form} task", pddl_write_time_s=round(time.perf_counter() - t0, 5))
         except (ValueError, RuntimeError) as e:  # codes outside the vocabulary, too many states
             return failed(self.name, PlanStatus.ERROR, t0, str(e))
         prob_path = self._next_path("problem", ".pddl")
@@ -266,7 +272,10 @@ class _RulesPlanner:
             elif rules is not self.rules:
                 atomic_write_text(prob_path.with_name(prob_path.name.replace("problem", "domain")), dom)
         write_s = time.perf_counter() - t0
-        res = solve_pddl(dom, prob, self.engine, max(timeout_s - write_s, 0.001),
+        if write_s >= timeout_s:
+            return failed(self.name, PlanStatus.TIMEOUT, t0, f"time limit of {timeout_s:g} s reached while writing "
+                          f"the {self.form} task", pddl_write_time_s=round(write_s, 5))
+        res = solve_pddl(dom, prob, self.engine, timeout_s - write_s,
                          cache_domain=self.form == "conditional", problem=prebuilt)
         res = dataclasses.replace(res, planning_time_s=write_s + res.planning_time_s,
                                   extra=dict(res.extra, pddl_write_time_s=round(write_s, 5)))
@@ -416,9 +425,34 @@ def planner_spec(name: str) -> PlannerSpec:
     return PLANNERS[name]
 
 
+class WithinLimit:
+    """A registry planner whose time limit covers all of its call: an answer that comes after timeout_s (a plan,
+    a proof or an error) is reported as TIMEOUT, as search.classical does for its route, so no planner's
+    results count work outside the limit. A planner killed by a signal keeps its result (the benchmark
+    refuses it). Attributes (a rule planner's `rules`, `planning_model`) are the wrapped function's.
+    """
+
+    def __init__(self, fn: PlannerFn, name: str) -> None:
+        self.fn, self.name = fn, name
+
+    def __call__(self, transition: TransitionFn, start: np.ndarray, goal: SymbolicGoal, timeout_s: float) -> PlanResult:
+        t0 = time.perf_counter()
+        res = self.fn(transition, start, goal, timeout_s)
+        total = time.perf_counter() - t0
+        if total <= timeout_s or res.status is PlanStatus.TIMEOUT or res.extra.get("killed_by_signal"):
+            return res
+        return failed(self.name, PlanStatus.TIMEOUT, t0, f"{self.name} hit the {timeout_s:g} s time limit (answered "
+                      f"{res.status.value} after {total:.3f} s)", **{k: v for k, v in res.extra.items()
+                                                                      if k.endswith("_s")})
+
+    def __getattr__(self, name: str):
+        return getattr(self.fn, name)
+
+
 def make_planner(name: str, context: PlannerContext = PlannerContext()) -> PlannerFn:
-    """Build planner `name`'s function; unknown names and rule-based planners without rules are refused."""
-    return planner_spec(name).build(context)
+    """Build planner `name`'s function (its time limit covering the whole call, WithinLimit); unknown names and
+    rule-based planners without rules are refused."""
+    return WithinLimit(planner_spec(name).build(context), name)
 
 
 def make_planners(names: list[str], run_dir: Path, write_dir: Path | None = None,

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from pddl_export.bounded_json import JsonFileError, read_json_file
+from symlearn.folder_lock import LOCK_NAME, folder_lock
 from symlearn.planning.paths import path_under
 from symlearn.planning.problem import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems,
                                        save_problem)
@@ -149,7 +150,7 @@ def prepare_problem_dir(out_dir: Path, settings: dict, overwrite: bool = False) 
     manifest = out_dir / PROBLEMS_MANIFEST
     if out_dir.exists() and not out_dir.is_dir():
         raise ValueError(f"--out {out_dir} is a file, not a folder")
-    if out_dir.is_dir() and any(out_dir.iterdir()):
+    if out_dir.is_dir() and any(f.name != LOCK_NAME for f in out_dir.iterdir()):
         old = None
         if manifest.is_file():
             try:
@@ -157,12 +158,14 @@ def prepare_problem_dir(out_dir: Path, settings: dict, overwrite: bool = False) 
             except JsonFileError:
                 old = None
         if overwrite:
-            for f in _own_files(out_dir):
-                f.unlink()
-            others = sorted(f.name for f in out_dir.iterdir())
-            if others:
+            own = _own_files(out_dir)
+            others = sorted(f.name for f in out_dir.iterdir() if f not in own and f.name != LOCK_NAME)
+            if others:  # refused before anything is removed: the folder stays as it was
                 raise ValueError(f"{out_dir} holds files that are not problems of a set ({', '.join(others[:3])}); "
-                                 f"--overwrite removes only problem files: choose an empty --out")
+                                 f"--overwrite removes only a set's own files: move those away, or choose an "
+                                 f"empty --out")
+            for f in own:
+                f.unlink()
         elif not isinstance(old, dict):
             raise ValueError(f"{out_dir} already holds files but no problem manifest ({manifest.name}); "
                              f"use --overwrite to replace its problems, or another --out")
@@ -206,14 +209,21 @@ def generate_problems(out_dir: Path, n: int, objects: tuple[int, int] = (1, 3), 
     (same settings, recorded in out_dir/problems.manifest) is completed: problems already written
     are kept, so an interrupted run resumes. Another non-empty folder is refused unless `overwrite`.
     """
-    from symlearn.sim.simulator import TabletopSimulator
-
     if not _is_count(n):
         raise ValueError(f"n={n!r} must be an integer of at least 1")
     if not _is_count(seed, least=0):
         raise ValueError(f"seed={seed!r} must be a non-negative integer")
     cfg = ProblemConfig(objects=tuple(objects), length=tuple(length), on_locations=bool(on_locations))
     out_dir = Path(out_dir)
+    with folder_lock(out_dir):  # one writer: a second `problems` into this folder is refused at once
+        return _generate(out_dir, n, cfg, seed, sim, overwrite, stratify)
+
+
+def _generate(out_dir: Path, n: int, cfg: ProblemConfig, seed: int, sim, overwrite: bool,
+              stratify: bool) -> list[Path]:
+    """generate_problems' work, inside the folder's lock."""
+    from symlearn.sim.simulator import TabletopSimulator
+
     prepare_problem_dir(out_dir, _settings(n, cfg, seed, stratify), overwrite)
     if stratify:
         jobs = [(cell_name(k, b, i), ProblemConfig(objects=(k, k), length=b, on_locations=cfg.on_locations),

@@ -13,10 +13,12 @@ from pathlib import Path
 
 import numpy as np
 
+from symlearn.folder_lock import folder_lock
 from symlearn.planning.goal_problems import goal_file_problem, goal_problem
 from symlearn.planning.paths import path_under
 from symlearn.planning.problem import PROBLEM_VERSION, Problem, load_problem, save_problem
-from symlearn.planning.problem_generation import MANIFEST_FORMAT, _done, prepare_problem_dir
+from symlearn.planning.problem_generation import (MANIFEST_FORMAT, PROBLEMS_MANIFEST, _done,
+                                                  prepare_problem_dir)
 from symlearn.planning.structures import TEMPLATES, Template, structure_goal
 from symlearn.sim.exploration import MAX_OBJECTS
 
@@ -64,20 +66,22 @@ def generate_structures(out_dir: Path, n: int, objects: tuple[int, int] = (1, 5)
     objects = (int(objects[0]), int(objects[1]))
     templates = fitting_templates(objects)
     out_dir = Path(out_dir)
-    prepare_problem_dir(out_dir, _settings(suite, n, objects, seed), overwrite)
-    own, paths = sim is None, []
-    try:
-        for i in range(n):
-            name = f"problem_{i:04d}"
-            path = path_under(out_dir, f"{name}.json")
-            if not _done(path, name):
-                sim = sim or TabletopSimulator()
-                rng = np.random.default_rng([seed, i])
-                save_problem(path, structure_problem(sim, templates[i % len(templates)], objects, rng, name, seed))
-            paths.append(path)
-    finally:
-        if own and sim is not None:
-            sim.close()
+    with folder_lock(out_dir):  # one writer: a second `problems` into this folder is refused at once
+        prepare_problem_dir(out_dir, _settings(suite, n, objects, seed), overwrite)
+        own, paths = sim is None, []
+        try:
+            for i in range(n):
+                name = f"problem_{i:04d}"
+                path = path_under(out_dir, f"{name}.json")
+                if not _done(path, name):
+                    sim = sim or TabletopSimulator()
+                    rng = np.random.default_rng([seed, i])
+                    save_problem(path, structure_problem(sim, templates[i % len(templates)], objects, rng, name,
+                                                         seed))
+                paths.append(path)
+        finally:
+            if own and sim is not None:
+                sim.close()
     return paths
 
 
@@ -86,13 +90,23 @@ def write_goal_problem(goal_path: Path, out_dir: Path, sim=None, overwrite: bool
     goal_path, out_dir = Path(goal_path), Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise ValueError(f"--out {out_dir} is a file, not a folder")
+    _refuse_a_set_folder(out_dir)
     problem = goal_file_problem(goal_path, sim)
-    path = path_under(out_dir, f"{problem.name}.json")
-    if path.exists() and not overwrite and _load_or_none(path) != problem:
-        raise ValueError(f"{path} already holds another problem; use --overwrite to replace it")
-    out_dir.mkdir(parents=True, exist_ok=True)
-    save_problem(path, problem)
+    with folder_lock(out_dir):
+        _refuse_a_set_folder(out_dir)  # again, now that no other `problems` writes here
+        path = path_under(out_dir, f"{problem.name}.json")
+        if path.exists() and not overwrite and _load_or_none(path) != problem:
+            raise ValueError(f"{path} already holds another problem; use --overwrite to replace it")
+        save_problem(path, problem)
     return path
+
+
+def _refuse_a_set_folder(out_dir: Path) -> None:
+    """A goal problem does not join a generated set (its folder's problems.manifest): the set's own command,
+    run again, could then neither complete nor --overwrite it."""
+    if (out_dir / PROBLEMS_MANIFEST).exists():
+        raise ValueError(f"{out_dir} holds a generated problem set ({PROBLEMS_MANIFEST}); write goal problems to a "
+                         f"folder of their own (benchmark --problems takes several folders: A,B)")
 
 
 def _load_or_none(path: Path) -> Problem | None:

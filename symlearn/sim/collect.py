@@ -36,6 +36,7 @@ import numpy as np
 from pddl_export.bounded_json import JsonFileError, read_json_file
 from symlearn.sim.exploration import ExplorationConfig, sample_action, sample_scene_spec
 from symlearn.data.dataset import DATA_KIND, FORMAT_VERSION, SPLITS, DataError, check_shard_entries
+from symlearn.folder_lock import folder_lock
 from symlearn.provenance import atomic_write_bytes, atomic_write_json, sha256_file, versions
 from symlearn.sim.simulator import SimConfig, TabletopSimulator
 
@@ -304,11 +305,14 @@ def _refuse_run_folder(out: Path) -> None:
 
 @contextlib.contextmanager
 def _interruptible() -> Iterator[None]:
-    """Turn SIGTERM (and SIGINT) into CollectInterrupted in the main thread, so cleanup runs; later ones are ignored."""
+    """Turn SIGTERM (and SIGINT) into CollectInterrupted in the main thread, so cleanup runs; later ones are ignored.
+
+    A signal ignored on entry (SIG_IGN) is left ignored."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    sigs = (signal.SIGINT, signal.SIGTERM)
+    # a signal the caller ignores (SIGINT in a shell's background job) stays ignored
+    sigs = tuple(s for s in (signal.SIGINT, signal.SIGTERM) if signal.getsignal(s) != signal.SIG_IGN)
     old = {s: signal.getsignal(s) for s in sigs}
 
     def handler(signum, frame):
@@ -391,9 +395,15 @@ def collect(out: Path, cfg: CollectConfig, workers: int = 1, show_progress: bool
         check_engine(engine, address)
     except EngineError as e:
         raise CollectError(str(e)) from None
-    _refuse_run_folder(out)
-    done = _resume_state(out, cfg)
-    out.mkdir(parents=True, exist_ok=True)
+    with folder_lock(out):  # one writer: a second `collect` into this folder is refused at once
+        _refuse_run_folder(out)
+        done = _resume_state(out, cfg)
+        return _collect_locked(out, cfg, workers, show_progress, done, engine, address)
+
+
+def _collect_locked(out: Path, cfg: CollectConfig, workers: int, show_progress: bool, done: dict, engine: str,
+                    address: str | None) -> dict:
+    """collect's work, inside the folder's lock: the shards not in `done`, then the final manifest."""
     remove_temp_files(out)
     sizes = cfg.shard_sizes()
     todo = [i for i in range(len(sizes)) if i not in done]
