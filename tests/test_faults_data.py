@@ -62,12 +62,19 @@ def _env(tmpdir: Path) -> dict:
     return {**os.environ, "PYTHONPATH": str(REPO), "TMPDIR": str(tmpdir), "OMP_NUM_THREADS": "1"}
 
 
+def _default_signals() -> None:
+    """In the child: SIGINT and SIGTERM as a user's terminal gives them. A suite started in the background (`cmd &`)
+    hands its children SIGINT ignored, and collect keeps an ignored signal ignored (docs/RELIABILITY.md)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
 def _start_collect(out: Path, tmpdir: Path, stderr_path: Path) -> subprocess.Popen:
     """`symlearn collect` with two workers, in a new session, stderr to a file."""
     return subprocess.Popen([sys.executable, "-m", "symlearn.cli.main", "collect", "--out", str(out), *COLLECT_ARGS,
                              "--workers", "2"],
                             start_new_session=True, env=_env(tmpdir), cwd=REPO, stdout=subprocess.DEVNULL,
-                            stderr=stderr_path.open("w"))
+                            stderr=stderr_path.open("w"), preexec_fn=_default_signals)
 
 
 def _temp_files(folder: Path) -> list[str]:
