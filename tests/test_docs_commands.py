@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from symlearn.cli.main import build_parser
+from search.stock_planners import STOCK_PLANNERS
 from symlearn.planning.planners import PLANNERS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -78,7 +79,8 @@ def command_problems(command: str, subcommands: dict[str, argparse.ArgumentParse
             problems.append(f"unknown flag {flag}")
             continue
         if flag == "--planners" and not _placeholder(value):
-            problems += [f"unknown planner {n!r}" for n in value.split(",") if n and n not in PLANNERS]
+            known = STOCK_PLANNERS if toks[1] == "bench/stock_fd.py" else PLANNERS  # it runs stock configurations
+            problems += [f"unknown planner {n!r}" for n in value.split(",") if n and n not in known]
         action = actions[flag]
         if action is not None and action.choices and value and not _placeholder(value):
             try:
