@@ -83,14 +83,19 @@ LENGTH_BUCKETS = ("1-2", "3-4", "5-6", "7-8", "9+", "?")  # reference (generator
 LOOPS = ("open", "closed")
 
 
-def length_bucket(length: int | None) -> str:
-    """The reference-length bucket of a problem: "1-2", "3-4", "5-6", "7-8", "9+", or "?" for 0 or unknown."""
+def _pair_bucket(length, top: str) -> str:
+    """"1-2", "3-4", "5-6", "7-8" for a length of 1-8, `top` above 8, "?" for 0 or unknown."""
     if not isinstance(length, int) or length <= 0:
         return "?"
     if length > 8:
-        return "9+"
+        return top
     lo = length - (length + 1) % 2
     return f"{lo}-{lo + 1}"
+
+
+def length_bucket(length: int | None) -> str:
+    """The reference-length bucket of a problem: "1-2", "3-4", "5-6", "7-8", "9+", or "?" for 0 or unknown."""
+    return _pair_bucket(length, "9+")
 
 
 def _cell(rows: list[ProblemRun]) -> dict:
@@ -125,15 +130,7 @@ OFF_LOCATIONS = "off"  # the column of goals with a judged object off the table 
 
 def shortest_bucket(row: ProblemRun) -> str:
     """A row's shortest-plan column: "1-2" ... "9-12", "off" (a goal off the locations), or "?" (undecided)."""
-    if row.goal_off_locations:
-        return OFF_LOCATIONS
-    n = row.optimal_length
-    if not isinstance(n, int) or n <= 0:
-        return "?"
-    if n > 8:
-        return "9-12"
-    lo = n - (n + 1) % 2
-    return f"{lo}-{lo + 1}"
+    return OFF_LOCATIONS if row.goal_off_locations else _pair_bucket(row.optimal_length, "9-12")
 
 
 def _shortest_cell(rows: list[ProblemRun]) -> dict:
