@@ -1,6 +1,7 @@
 import json
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -115,8 +116,16 @@ def test_two_nodes_by_rendezvous_train_one_run(data, tmp_path):
            "-m", "symlearn.cli", "train", "--data", str(data), "--out", str(run), "--preset", "quick",
            "--epochs", "1", "--batch-size", "4", "--no-bf16", "--quiet"]
     env = dict(os.environ, OMP_NUM_THREADS="1")
-    nodes = [subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
-             for _ in range(2)]
+    # the first launcher hosts the rendezvous store: the second starts once it listens (both started at once on
+    # one machine, both may try to host it, and the loser can hang in the rendezvous)
+    nodes = [subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)]
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and nodes[0].poll() is None:
+        with socket.socket() as probe:
+            if probe.connect_ex(("127.0.0.1", port)) == 0:
+                break
+        time.sleep(0.2)
+    nodes.append(subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env))
     try:
         outs = [n.communicate(timeout=300) for n in nodes]
     finally:
