@@ -1,22 +1,23 @@
 """Lifted rules: what one pick-and-release does to the pieces it touches, distilled from transitions.
 
-Physics here is local. An action (pick p, release r) takes the top piece at p (`o`), with whatever stands on
-a far-row stick's ends (its riders), off what it stood on (`u`), and puts it on the top piece at r (`v`); every
-other piece stays as it was. So a rule need not say which codes all other objects hold (the per-action rules
-of `pddl_export.rules` do): it names the pieces in those roles, describes each (type, kept learned bits,
-level, whether it stands at the action's location or covers it with a stick end) and says what each becomes.
+Physics here is local. An action (pick p, release r) takes the top piece at p (`o`), with whatever stands on a
+far-row stick's ends (its riders), and puts it on the top at r; every other piece keeps its location and level.
+So a rule need not say which codes all other objects hold (the per-action rules of `pddl_export.rules` do): it
+describes the move (`participants`, `signature`) and says what the moved pieces become, and which learned bits
+change on what the move leaves on top at p and on what it lands on at r.
 
-A rule's `key` keeps the structure of the move (`STRUCTURE`: the move's class, the types and presence of the
-roles, the riders' sides) and only the descriptions its outcome depends on: fields are added in `REFINEMENTS`
-order and the coarsest key under which every observed description agrees on one outcome is kept (a greedy
-decision list). Rules of one move are thus mutually consistent: wherever two match, they give one outcome.
+A rule's `key` keeps the structure of the move (`STRUCTURE`: the move's class, o's type, place and level, the
+levels left at p and found at r, the riders' sides, places and levels, the levels under and beside a far-row
+stick's ends, whether a piece stands on top at p and at r) and only the learned bits its outcome depends on:
+`REFINEMENTS` are added in order and the coarsest key under which every observed description agrees on one
+outcome is kept (a greedy decision list). Wherever two rules match, they give one outcome.
 
 The class of a move is "cube" for a cube (lifted over both locations), "near" for a stick moved within the near
 row (nothing covers a neighbour there), and the concrete (p, r) pair otherwise: a far-row stick's ends cover its
 row neighbours, and which ones overlap before and after depends on the pair.
 
-`LiftedRules.step` applies them to a state's codes (the Python form of the PDDL that `lifted_writer` writes):
-a move no rule covers leaves the state as it is, as the PDDL offers no action for it.
+`LiftedRules.step_pieces` and `step_codes` apply them to a state (the Python form of the PDDL that
+`lifted_writer` writes): a move no rule covers leaves the state as it is, as the PDDL offers no action for it.
 """
 from __future__ import annotations
 

@@ -1,21 +1,22 @@
 """The lifted PDDL domain of distilled rules, its problems, and plans read back as robot actions.
 
-One domain for any number of objects: typed blocks (`cube`, `stick`), the six table locations and eight levels as
-constants, and the relations a person would write for this table: `(at ?b ?l)`, `(level ?b ?h)`, `(on ?b ?s)`
-(a support is a block or the table), `(top ?l ?s)` (what an object released at ?l lands on) and `(off ?b)` (the
-block stands off its location; nothing picks it). The learned bits a rule tests are unary predicates
-(`bit-I`, I the learned bit's index; docs/DOMAIN.md says what each means in the shipped run). Each rule of
-`pddl_export.lifted_rules` is one action schema: STRIPS with typing, equality and negative preconditions, no
-conditional effects, no quantifiers, no axioms, so that every Fast Downward heuristic, pyperplan and pddlgym
-take it. `top` holds one support per location and `level` one level per block, so Fast Downward's translator
-finds both as mutex groups.
+One domain for any number of objects: typed blocks (`cube`, `stick`), the six table locations, eight levels and the
+places as constants, and relations read from the location bits: `(at ?b ?l)` (nearest location), `(level ?b ?h)`
+(its top, in 5 cm layers), `(place ?b ?p)` (on its location, or which way and how far off), `(height ?l ?h)` (the
+top at a location: where a released object lands), `(rests ?b ?h)` (what is left at its location when it is
+lifted) and `(beneath ?l ?h)` (what is left under a far-row stick's end). The learned bits a rule tests are unary
+predicates in both polarities (`bit-I`, `no-bit-I`; docs/DOMAIN.md says what they mean in a real run), and
+`(differ ?a ?b)`, `(near ?l)` are static facts of every problem. Each rule of `pddl_export.lifted_rules` is one
+action schema in plain STRIPS with typing: no negative preconditions, no equality, no conditional effects, no
+quantifiers, no axioms, so that Fast Downward (LM-cut included), pyperplan and pyval take it. `at`, `level`,
+`rests` and `height` hold one value per block or location, which Fast Downward's translator finds.
 
 A cube's rule and a stick's moved within the near row are lifted over both locations (`?from`, `?to`); a stick
 moved in or out of the far row covers its row neighbours with its ends, and which of those overlap depends on
 the pair, so its rules name the two locations (`pick-release-stick-l1-l2-...`).
 
-    >>> text = domain_pddl(rules)                                           # doctest: +SKIP
-    >>> problem_pddl(rules, start_codes, goal, "p01", text_name(rules))     # doctest: +SKIP
+    >>> text = domain_pddl(rules)                                        # doctest: +SKIP
+    >>> problem_pddl(rules, start_codes, goal, "p01")                    # doctest: +SKIP
 """
 from __future__ import annotations
 
