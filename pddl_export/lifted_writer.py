@@ -106,28 +106,8 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
     new_o = level_name(o_out[2])
 
     # before: the heights of the locations o (or a rider) covers; `under`: what is left there once o is lifted
-    before = {frm: ho}
-    under = {frm: hu}
-    riders = []
-    if concrete:
-        sides = f["riders.sides"]
-        for n, hb in zip(neighbours(pick), f["beneath"]):
-            side = n - pick
-            if side in sides:
-                i = sides.index(side)
-                term, hr = f"?r{i}", level_name(f["riders.level"][i])
-                params.append((term, "block"))
-                pre += [f"(at {term} {loc_name(n)})", f"(level {term} {hr})", f"(rests {term} {ho})",
-                        f"(place {term} {place_name(f['riders.place'][i])})"]
-                if f.get("riders.kind") is not None:
-                    pre += _bit_literals(rules, term, f["riders.kind"][i])
-                riders.append((i, n, term, hr))
-                before[loc_name(n)] = hr
-            else:
-                before[loc_name(n)] = ho
-            under[loc_name(n)] = level_name(hb)
-            pre.append(f"(beneath {loc_name(n)} {level_name(hb)})")
-            eff.append(f"(not (beneath {loc_name(n)} {level_name(hb)}))")
+    before, under = {frm: ho}, {frm: hu}
+    riders = _stick_ends(rules, f, pick, ho, before, under, params, pre, eff) if concrete else []
     for loc, h in before.items():
         pre.append(f"(height {loc} {h})")
     # what the release location and (for a far-row stick) its neighbours hold once o is lifted
@@ -149,33 +129,13 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
     for loc, h in landing.items():
         after[loc] = new_o
         eff.append(f"(beneath {loc} {h})")
-    eff += _place_effect("?o", f["o.place"], o_out[1])
-    if new_o != ho:
-        eff += [f"(not (level ?o {ho}))", f"(level ?o {new_o})"]
+    eff += _replace("place", "?o", place_name(f["o.place"]), place_name(o_out[1]))
+    eff += _replace("level", "?o", ho, new_o)
     eff += _bit_effects(rules, "?o", o_out[3], f.get("o.kind"))
+    known = set(before) | set(landing) | {to}  # the locations whose heights the rule knows
     for i, n, term, hr in riders:
-        change = r_out[i]
-        shifted = n + release - pick
-        new_r = level_name(change[2])
-        if change[0] == "shift" and lands_on and shifted in neighbours(release):  # rides along
-            after[loc_name(shifted)] = new_r
-            eff += [f"(not (at {term} {loc_name(n)}))", f"(at {term} {loc_name(shifted)})"]
-            if new_o != ho:
-                eff += [f"(not (rests {term} {ho}))", f"(rests {term} {new_o})"]
-        else:  # it falls: it stays at its place's location (or the one m(z) says), on the table
-            where = change[0]
-            new_loc = {"stay": n, "shift": shifted}.get(where, where if isinstance(where, int) else n)
-            if not 0 <= new_loc < N_LOCATIONS:
-                raise ValueError(f"rule {index}: a rider ends at no location ({new_loc})")
-            if loc_name(new_loc) in before or loc_name(new_loc) in landing or loc_name(new_loc) == to:
-                after[loc_name(new_loc)] = new_r  # elsewhere the rule does not know the height it lands beside
-            eff += [f"(not (rests {term} {ho}))", f"(rests {term} {level_name(0)})"]
-            if new_loc != n:
-                eff += [f"(not (at {term} {loc_name(n)}))", f"(at {term} {loc_name(new_loc)})"]
-        eff += _place_effect(term, f["riders.place"][i], change[1])
-        if new_r != hr:
-            eff += [f"(not (level {term} {hr}))", f"(level {term} {new_r})"]
-        eff += _bit_effects(rules, term, change[3], f["riders.kind"][i] if f.get("riders.kind") else None)
+        eff += _rider_effects(rules, f, i, n, term, hr, r_out[i], (pick, release), lands_on, (ho, new_o), known,
+                              after, index)
     # the learned bits of what o leaves on top at its pick location, and of what it lands on
     for term, loc, level, kind, role in (("?u", frm, hu, u_kind, "u"), ("?v", to, hv, v_kind, "v")):
         if kind is None:
@@ -190,14 +150,11 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
         new = after.get(loc, under.get(loc, old))
         if old is None or new is None:
             raise ValueError(f"rule {index}: the height at {loc} is not known before and after the move")
-        if old != new:
-            eff += [f"(not (height {loc} {old}))", f"(height {loc} {new})"]
+        eff += _replace("height", loc, old, new)
     # beneath facts a landing re-adds where it also lifted them cancel out; keep the effects consistent
     eff = _net_effects(eff)
 
-    kind = "stick" if f["o.stick"] else "cube"
-    where = f"-{frm}-{to}" if concrete else ""
-    name = f"pick-release-{kind}{where}-{index}"
+    name = f"pick-release-{'stick' if f['o.stick'] else 'cube'}{f'-{frm}-{to}' if concrete else ''}-{index}"
     text = _schema_text(name, params, pre, eff, _comment(rule, f))
     return Schema(name, pick, release, text, tuple(params), tuple(dict.fromkeys(pre)), tuple(eff))
 
@@ -211,8 +168,63 @@ def place_name(p: int) -> str:
     return PLACES[int(p)]
 
 
-def _place_effect(term: str, old: int, new: int) -> list[str]:
-    return [] if old == new else [f"(not (place {term} {place_name(old)}))", f"(place {term} {place_name(new)})"]
+def _stick_ends(rules: LiftedRules, f: dict, pick: int, ho: str, before: dict, under: dict, params: list, pre: list,
+                eff: list) -> list[tuple]:
+    """A far-row stick's ends over its pick's neighbours: each end's rider (a parameter, with its description) or
+    the stick itself on top there, and the level beneath it. Fills before/under/params/pre/eff; returns the
+    riders as (index, location, term, level)."""
+    riders = []
+    sides = f["riders.sides"]
+    for n, hb in zip(neighbours(pick), f["beneath"]):
+        side = n - pick
+        if side in sides:
+            i = sides.index(side)
+            term, hr = f"?r{i}", level_name(f["riders.level"][i])
+            params.append((term, "block"))
+            pre += [f"(at {term} {loc_name(n)})", f"(level {term} {hr})", f"(rests {term} {ho})",
+                    f"(place {term} {place_name(f['riders.place'][i])})"]
+            if f.get("riders.kind") is not None:
+                pre += _bit_literals(rules, term, f["riders.kind"][i])
+            riders.append((i, n, term, hr))
+            before[loc_name(n)] = hr
+        else:
+            before[loc_name(n)] = ho
+        under[loc_name(n)] = level_name(hb)
+        pre.append(f"(beneath {loc_name(n)} {level_name(hb)})")
+        eff.append(f"(not (beneath {loc_name(n)} {level_name(hb)}))")
+    return riders
+
+
+def _replace(predicate: str, term: str, old: str, new: str) -> list[str]:
+    """Effects moving a one-value fluent of term from old to new (none where they are equal)."""
+    return [] if old == new else [f"(not ({predicate} {term} {old}))", f"({predicate} {term} {new})"]
+
+
+def _rider_effects(rules: LiftedRules, f: dict, i: int, n: int, term: str, hr: str, change, move: tuple[int, int],
+                   lands_on: bool, stick_levels: tuple[str, str], known: set, after: dict, index: int) -> list[str]:
+    """Effects on rider i of a far-row stick (at neighbour n, level hr): it rides along to the shifted neighbour,
+    or falls (it stays at its place's location, or the one m(z) says, on the table). Sets `after`'s height where a
+    rider ends at a location whose height the rule knows."""
+    pick, release = move
+    ho, new_o = stick_levels
+    shifted = n + release - pick
+    new_r = level_name(change[2])
+    if change[0] == "shift" and lands_on and shifted in neighbours(release):  # rides along
+        after[loc_name(shifted)] = new_r
+        eff = [f"(not (at {term} {loc_name(n)}))", f"(at {term} {loc_name(shifted)})"]
+        eff += _replace("rests", term, ho, new_o)
+    else:
+        where = change[0]
+        new_loc = {"stay": n, "shift": shifted}.get(where, where if isinstance(where, int) else n)
+        if not 0 <= new_loc < N_LOCATIONS:
+            raise ValueError(f"rule {index}: a rider ends at no location ({new_loc})")
+        if loc_name(new_loc) in known:
+            after[loc_name(new_loc)] = new_r  # elsewhere the rule does not know the height it lands beside
+        eff = [f"(not (rests {term} {ho}))", f"(rests {term} {level_name(0)})"]
+        eff += _replace("at", term, loc_name(n), loc_name(new_loc))
+    eff += _replace("place", term, place_name(f["riders.place"][i]), place_name(change[1]))
+    eff += _replace("level", term, hr, new_r)
+    return eff + _bit_effects(rules, term, change[3], f["riders.kind"][i] if f.get("riders.kind") else None)
 
 
 def _net_effects(eff: list[str]) -> list[str]:
