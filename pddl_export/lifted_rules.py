@@ -233,12 +233,7 @@ class LiftedRules:
         (else the old learned code with the kept bits set to the piece's kind)."""
         learned = self.codebook.get((piece.stick, piece.kind, piece.loc, piece.place, piece.level))
         if learned is None:
-            learned = self.layout.learned(old_code)
-            kept = self.layout.kept
-            for pos, bit in enumerate(kept):
-                mask = 1 << (self.layout.code_bits - 1 - bit)
-                value = (piece.kind >> (len(kept) - 1 - pos)) & 1
-                learned = (learned | mask) if value else (learned & ~mask)
+            learned = self.layout.with_kind(self.layout.learned(old_code), piece.kind)
         return (int(learned) << 9) | (piece.loc << 6) | (piece.place << 3) | piece.level
 
     def step_codes(self, codes: Sequence[int], action: int) -> tuple[tuple[int, ...], Rule | None]:

@@ -69,6 +69,13 @@ class CodeLayout:
             out = (out << 1) | ((learned >> (self.code_bits - 1 - b)) & 1)
         return out
 
+    def with_kind(self, learned: int, kind: int) -> int:
+        """A learned code with its kept bits set to `kind` (as `kind` packs them), the other bits as they were."""
+        for pos, bit in enumerate(self.kept):
+            mask = 1 << (self.code_bits - 1 - bit)
+            learned = (learned | mask) if (kind >> (len(self.kept) - 1 - pos)) & 1 else (learned & ~mask)
+        return learned
+
     def piece(self, code: int, stick: bool) -> "Piece":
         """One object's piece, read from its located code."""
         code = int(code)

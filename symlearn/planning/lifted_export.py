@@ -24,6 +24,7 @@ from pddl_export.lifted_rules import LiftedRules, build_codebook, distil_lifted,
 from pddl_export.lifted_scene import FIELD_BITS, CodeLayout, kept_bits
 from pddl_export.lifted_writer import domain_pddl
 from pddl_export.rules_io import PDDL_DIR
+from pddl_export.symbolic import bits_from_codes
 from symlearn.provenance import atomic_write_json, versions
 
 LIFTED_FILE = "lifted.json"
@@ -125,7 +126,7 @@ def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = 
     train = [_split(reader, d, "train") for d in sets]
     code_bits = reader.bits - FIELD_BITS
     objects = np.concatenate([s.before[s.mask] for s in train])
-    learned = (objects[:, None] >> (FIELD_BITS + np.arange(code_bits - 1, -1, -1))) & 1
+    learned = bits_from_codes(objects >> FIELD_BITS, code_bits)
     locations = (objects >> 6) & 7
     layout = CodeLayout(code_bits, kept_bits(learned, locations, cfg.min_info))
     width = max(s.mask.shape[1] for s in train)
