@@ -30,6 +30,7 @@ from pathlib import Path
 
 from symlearn.cli.args import (THREADS_HELP, add_engine_flags, int_range, non_negative_int, planner_list,
                                positive_finite_float, positive_int, set_threads, thread_count)
+from symlearn.planning.planner_catalogue import DEFAULT_PLANNER, planners_help
 from symlearn.symbolic.locations import DEFAULT_LOCATION_BITS, LOCATION_BITS
 
 
@@ -366,10 +367,12 @@ def _add_execution_flags(c: argparse.ArgumentParser) -> None:
 
 def add_plan_command(sub) -> None:
     """Add `plan` to the CLI's sub-parsers."""
-    c = sub.add_parser("plan", help="plan one problem with the learned symbols and execute it")
+    c = sub.add_parser("plan", help="plan one problem with the learned symbols and execute it",
+                       epilog=planners_help(), formatter_class=argparse.RawDescriptionHelpFormatter)
     c.add_argument("--run", required=True, help="run directory with best.pt and transition.pt")
     c.add_argument("--problem", required=True, help="problem JSON file")
-    c.add_argument("--planner", default="astar")
+    c.add_argument("--planner", default=DEFAULT_PLANNER,
+                   help=f"one planner of the list below (default {DEFAULT_PLANNER})")
     c.add_argument("--record", help="save the executed plan as this animated GIF (and a filmstrip .png beside it)")
     c.add_argument("--record-size", type=_size, default=(320, 240), help="recorded frame size WxH (default 320x240)")
     _add_execution_flags(c)
@@ -378,13 +381,14 @@ def add_plan_command(sub) -> None:
 
 def add_benchmark_command(sub) -> None:
     """Add `benchmark` to the CLI's sub-parsers."""
-    c = sub.add_parser("benchmark", help="plan and execute every problem of a directory with several planners")
+    c = sub.add_parser("benchmark", help="plan and execute every problem of a directory with several planners",
+                       epilog=planners_help(), formatter_class=argparse.RawDescriptionHelpFormatter)
     c.add_argument("--run", required=True, help="run directory with best.pt and transition.pt")
     c.add_argument("--problems", required=True,
                    help="folder of problem JSON files; several as A,B,C, or a folder whose subfolders are problem "
                         "sets (rows then carry the set's folder name)")
-    c.add_argument("--planners", type=planner_list, default=["astar", "astar-ucs"],
-                   help="comma-separated planner names")
+    c.add_argument("--planners", type=planner_list, default=[DEFAULT_PLANNER],
+                   help=f"comma-separated planners of the list below (default {DEFAULT_PLANNER})")
     c.add_argument("--out", required=True, help="benchmark JSON file")
     c.add_argument("--plots", help="folder for the plots: success and executed / shortest plan length by objects x "
                                    "shortest-plan length, success and planning time by objects x reference length")

@@ -56,6 +56,7 @@ from search.sas_planners import solve_sas
 from search.up_problem import strips_problem
 from symlearn.planning.execution import PlannerFn
 from symlearn.planning.paths import path_under
+from symlearn.planning.planner_catalogue import DESCRIPTIONS
 from symlearn.planning.recovery import roll
 
 
@@ -337,26 +338,22 @@ def _build_outcome_rules_planner(context: PlannerContext) -> PlannerFn:
     return _RulesOutcomesPlanner(context.rules, context.outcomes, context.model_hash, context.risk_weight)
 
 
-# registry name -> (engine name in search.classical / search.sas_planners / search.rules_search, task form,
-# description)
+# registry name -> (engine name in search.classical / search.sas_planners / search.rules_search, task form); the
+# descriptions are in symlearn.planning.planner_catalogue
 _RULES_PLANNERS = {
-    "fast-downward": ("fast-downward", "conditional", "Fast Downward on the conditional-effects PDDL domain"),
-    "symk": ("symk", "conditional", "SymK on the conditional-effects PDDL domain"),
-    "pyperplan": ("pyperplan", "strips", "pyperplan on the grounded STRIPS form of the problem"),
-    "fast-downward-opt": ("fast-downward-opt", "strips", "optimal Fast Downward on the grounded STRIPS form"),
-    "fast-downward-blind": ("fast-downward-blind", "conditional", "Fast Downward, blind search, on the PDDL domain"),
-    "fast-downward-sas": ("fast-downward-sas", "sas", "Fast Downward's search on a direct SAS+ task"),
-    "fast-downward-sas-opt": ("fast-downward-sas-opt", "sas", "optimal Fast Downward search on the SAS+ task"),
-    "symk-sas": ("symk-sas", "sas", "SymK's symbolic search on the same SAS+ task"),
-    "symk-sas-topk": ("symk-sas-topk", "sas",
-                      "SymK top-k plans on the SAS+ task; execution falls back to the next plan when one departs"),
-    "fast-downward-sas-ms": ("fast-downward-sas-ms", "sas",
-                             "optimal A* with merge-and-shrink on the SAS+ task without axioms"),
-    "fast-downward-sas-lama": ("fast-downward-sas-lama", "sas",
-                               "LAMA's first iteration (FF and landmarks) on the SAS+ task without axioms"),
-    "rules-astar": ("astar", "in-process", "A* over the rules in process, batched expansions, code-distance heuristic"),
-    "rules-bfs": ("bfs", "in-process",
-                  "breadth-first search over the rules in process: shortest plans, proves unreachable goals"),
+    "fast-downward": ("fast-downward", "conditional"),
+    "symk": ("symk", "conditional"),
+    "pyperplan": ("pyperplan", "strips"),
+    "fast-downward-opt": ("fast-downward-opt", "strips"),
+    "fast-downward-blind": ("fast-downward-blind", "conditional"),
+    "fast-downward-sas": ("fast-downward-sas", "sas"),
+    "fast-downward-sas-opt": ("fast-downward-sas-opt", "sas"),
+    "symk-sas": ("symk-sas", "sas"),
+    "symk-sas-topk": ("symk-sas-topk", "sas"),
+    "fast-downward-sas-ms": ("fast-downward-sas-ms", "sas"),
+    "fast-downward-sas-lama": ("fast-downward-sas-lama", "sas"),
+    "rules-astar": ("astar", "in-process"),
+    "rules-bfs": ("bfs", "in-process"),
 }
 
 
@@ -364,7 +361,7 @@ def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Pat
     """The planner function of rule-based planner `name` over the exported rules (saving its tasks in write_dir)."""
     if name not in _RULES_PLANNERS:
         raise ValueError(f"{name!r} is not a planner on the exported rules; known: {', '.join(_RULES_PLANNERS)}")
-    engine, form, _ = _RULES_PLANNERS[name]
+    engine, form = _RULES_PLANNERS[name]
     kind = _InProcessRulesPlanner if form == "in-process" else _RulesPlanner
     return kind(rules, model_hash, name, engine, form, write_dir)
 
@@ -378,12 +375,8 @@ def _build_rules_planner(name: str, context: PlannerContext) -> PlannerFn:
 
 # ------------------------------------------------------------------------------- stock planners, lifted domain
 
-# registry name -> (search.stock_planners configuration, description)
-LIFTED_PLANNERS = {
-    "fast-downward-lifted": ("fd-lama-first", "stock Fast Downward (its translator, LAMA's first iteration) on the "
-                             "lifted domain"),
-    "fast-downward-lifted-opt": ("fd-lmcut", "stock Fast Downward, optimal A* with LM-cut, on the lifted domain"),
-}
+# registry name -> search.stock_planners configuration
+LIFTED_PLANNERS = {"fast-downward-lifted": "fd-lama-first", "fast-downward-lifted-opt": "fd-lmcut"}
 
 
 def _build_lifted_planner(name: str, engine: str, context: PlannerContext) -> PlannerFn:
@@ -398,20 +391,17 @@ def _build_lifted_planner(name: str, engine: str, context: PlannerContext) -> Pl
 
 
 def _registry() -> Mapping[str, PlannerSpec]:
-    specs = [PlannerSpec("astar", "learned-net A* with the mismatch heuristic", False, lambda _: _astar),
-             PlannerSpec("astar-ucs", "learned-net uniform-cost search (shortest plans)", False, lambda _: _astar_ucs),
-             PlannerSpec(RISK_PLANNER, "learned-net A*, each action costing 1 - w log P(its prediction): "
-                         "the plans most likely to unfold as predicted", False,
+    specs = [PlannerSpec("astar", DESCRIPTIONS["astar"], False, lambda _: _astar),
+             PlannerSpec("astar-ucs", DESCRIPTIONS["astar-ucs"], False, lambda _: _astar_ucs),
+             PlannerSpec(RISK_PLANNER, DESCRIPTIONS[RISK_PLANNER], False,
                          lambda context: partial(_astar_likely, context.risk_weight)),
-             PlannerSpec(OUTCOMES_PLANNER, "learned-net A* over each action's likely outcomes (all-outcomes "
-                         "determinization), each costing 1 - w log P(that outcome)", False,
+             PlannerSpec(OUTCOMES_PLANNER, DESCRIPTIONS[OUTCOMES_PLANNER], False,
                          lambda context: partial(_astar_outcomes, context.risk_weight))]
-    specs += [PlannerSpec(n, desc, True, partial(_build_rules_planner, n)) for n, (_, _, desc) in _RULES_PLANNERS.items()]
-    specs.append(PlannerSpec(OUTCOME_RULES_PLANNER, "A* over the rules and each object's second likeliest outcome "
-                             "(the exported all-outcomes determinization), a deviation costing 1 - w log of its "
-                             "odds", True, _build_outcome_rules_planner))
-    specs += [PlannerSpec(n, desc, False, partial(_build_lifted_planner, n, engine), needs_lifted=True)
-              for n, (engine, desc) in LIFTED_PLANNERS.items()]
+    specs += [PlannerSpec(n, DESCRIPTIONS[n], True, partial(_build_rules_planner, n)) for n in _RULES_PLANNERS]
+    specs.append(PlannerSpec(OUTCOME_RULES_PLANNER, DESCRIPTIONS[OUTCOME_RULES_PLANNER], True,
+                             _build_outcome_rules_planner))
+    specs += [PlannerSpec(n, DESCRIPTIONS[n], False, partial(_build_lifted_planner, n, engine), needs_lifted=True)
+              for n, engine in LIFTED_PLANNERS.items()]
     return types.MappingProxyType({s.name: s for s in specs})
 
 
