@@ -114,7 +114,8 @@ def test_report_has_every_section_and_is_self_contained(report):
     assert all(status == "ok" for status in p.sections.values()), p.sections
     # one file: every image inlined as a base64 PNG, nothing fetched from elsewhere
     assert p.images and all(src.startswith("data:image/png;base64,") for src in p.images)
-    assert {"effect_loss", "transition_loss", "symbols", "symbol_examples", "plan_filmstrip"} <= set(p.figures)
+    assert {"effect_loss", "transition_loss", "symbols", "symbol_examples", "plan_filmstrip",
+            "table1_attention"} <= set(p.figures)
     md = (run / "report.md").read_text()
     for name in re.findall(r"\]\((report_files/[^)]+)\)", md):
         assert (run / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name

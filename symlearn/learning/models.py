@@ -191,11 +191,31 @@ class AttentiveDeepSym(nn.Module):
         codes = gumbel_sigmoid(logits, self.cfg.tau, self.training, generator) * mask[..., None]
         return codes, logits
 
+    def _tokens(self, codes: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
+        """Each object's token (B, K, D): its code next to the scene's action, the same action for every object."""
+        b, k = mask.shape
+        a = F.one_hot(actions.long(), N_ACTIONS).to(codes.dtype)  # (B, 36)
+        return self.inp(torch.cat([codes, a[:, None].expand(b, k, N_ACTIONS)], dim=-1))  # (B, K, D)
+
+    @torch.no_grad()
+    def attention_maps(self, codes: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor) -> torch.Tensor | None:
+        """How much each object attends to each other, per layer, averaged over heads: (layers, B, K, K), row i
+        the weights object i's token puts on every object's (rows sum to 1 over real objects); None without
+        attention. The same computation as decode's transformer, layer by layer (eval mode: no dropout)."""
+        if self.attn is None:
+            return None
+        tok, maps = self._tokens(codes, mask, actions), []
+        for layer in self.attn.layers:
+            x = layer.norm1(tok) if layer.norm_first else tok
+            maps.append(layer.self_attn(x, x, x, key_padding_mask=~mask, need_weights=True,
+                                        average_attn_weights=True)[1])
+            tok = layer(tok, src_key_padding_mask=~mask)
+        return torch.stack(maps)
+
     def decode(self, codes: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
         """Codes (B, K, bits), mask (B, K), action ids (B,) -> normalized effects (B, K, 3)."""
         b, k = mask.shape
-        a = F.one_hot(actions.long(), N_ACTIONS).to(codes.dtype)  # (B, 36)
-        tok = self.inp(torch.cat([codes, a[:, None].expand(b, k, N_ACTIONS)], dim=-1))  # (B, K, D)
+        tok = self._tokens(codes, mask, actions)
         if self.attn is not None:
             tok = self.attn(tok, src_key_padding_mask=~mask)  # (B, K, D)
         eff_real = self.decoder(tok[mask])  # (N, 3)

@@ -30,6 +30,7 @@ PAPER_TABLE1 = {
 MOVED_MM = 100  # an object "moved" if it went at least this far along y
 STILL_MM = 20  # and "stayed" if its predicted displacement is within this of zero
 RIDER_TOL_MM = 50  # a rider's predicted y within this of the truth
+ATTENTION_FIGURE = "table1_attention.png"  # RUN/table1_attention.png: the three cases' attention maps
 
 
 def judge_object(obj: dict) -> dict:
@@ -64,6 +65,69 @@ def predict_scene_effects(model, ck, crops: np.ndarray, origins: np.ndarray, act
     return out.effect[0].numpy() * ck.effect_std + ck.effect_mean
 
 
+@torch.no_grad()
+def scene_attention(model, crops: np.ndarray, origins: np.ndarray, action_id: int) -> np.ndarray | None:
+    """One observed scene -> each layer's attention (layers, k, k), row i the weights object i puts on each object
+    (averaged over heads); None for a model without attention."""
+    depth = torch.from_numpy(crops.astype(np.float16).astype(np.float32))[None]
+    x = model_inputs(depth, torch.from_numpy(origins.astype(np.float32))[None])
+    mask = torch.ones(1, crops.shape[0], dtype=torch.bool)
+    model.eval()
+    codes, _ = model.encode(x, mask)
+    maps = model.attention_maps(codes, mask, torch.tensor([action_id]))
+    return None if maps is None else maps[:, 0].numpy()
+
+
+def rider_attention(case: dict) -> list[dict]:
+    """For each rider of a case (a cube that truly moved with the stick, which is object 0), the weight its token
+    puts on the stick's in each layer: what attention would have to carry for the rider to move with it."""
+    maps = case.get("attention")
+    if not maps:
+        return []
+    return [{"object": i, "on_stick": [round(float(layer[i][0]), 3) for layer in maps],
+             "on_itself": [round(float(layer[i][i]), 3) for layer in maps]}
+            for i, obj in enumerate(case["objects"])
+            if i > 0 and obj["type"] == "cube" and obj["truth_mm"][1] >= MOVED_MM]
+
+
+def plot_attention(path: Path, cases: list[dict]) -> bool:
+    """The attention maps of the three cases as one PNG (a row per case, a column per layer); False when the
+    model has none (the no-attention baseline)."""
+    if not cases or not all(c.get("attention") for c in cases):
+        return False
+    import io
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from symlearn.provenance import atomic_write_bytes
+    layers = len(cases[0]["attention"])
+    fig, axes = plt.subplots(len(cases), layers, figsize=(2.6 * layers + 0.6, 2.5 * len(cases)), squeeze=False)
+    for r, case in enumerate(cases):
+        labels = [f"{o['type']} {i}" + (" (rider)" if any(x["object"] == i for x in rider_attention(case)) else "")
+                  for i, o in enumerate(case["objects"])]
+        for layer in range(layers):
+            ax = axes[r][layer]
+            w = np.asarray(case["attention"][layer], dtype=float)
+            ax.imshow(w, vmin=0, vmax=1, cmap="viridis")
+            for i in range(w.shape[0]):
+                for j in range(w.shape[1]):
+                    ax.text(j, i, f"{w[i, j]:.2f}", ha="center", va="center", fontsize=7,
+                            color="black" if w[i, j] > 0.5 else "white")
+            ax.set_xticks(range(len(labels)), labels, fontsize=6, rotation=30)
+            ax.set_yticks(range(len(labels)), labels, fontsize=6)
+            ax.set_title(f"case {r + 1}, layer {layer + 1}", fontsize=8)
+    fig.suptitle("Table I: attention of each object (row) on each object (column), averaged over heads", fontsize=9)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, dpi=110, format="png")
+    plt.close(fig)
+    atomic_write_bytes(path, buf.getvalue())
+    return True
+
+
 def table1(run_dir: Path) -> dict:
     """Run the three cases, write RUN/table1.json (with config, seed, versions, model hash) and return it."""
     from symlearn.sim.simulator import TabletopSimulator
@@ -85,10 +149,17 @@ def table1(run_dir: Path) -> dict:
                                      for t, p, g in zip(sim.types, pred, res.effect)]})
             for obj in rows[-1]["objects"]:
                 obj["criteria"] = judge_object(obj)
+            maps = scene_attention(model, obs.crops, obs.origins, sc.action.id)
+            if maps is not None:
+                rows[-1]["attention"] = np.round(maps, 3).tolist()
+                rows[-1]["rider_attention"] = rider_attention(rows[-1])
     errors = np.array([[abs(a - b) for a, b in zip(o["predicted_mm"], o["truth_mm"])] for r in rows for o in r["objects"]])
     out = {"run": str(run_dir), **stage_record(Path(run_dir), ck, {"run": str(run_dir), "cases": list(CASES)}),
            "cases": rows, "mean_abs_error_mm": dict(zip("xyz", np.round(errors.mean(0), 1).tolist())),
            "criteria": summarize_criteria(rows), "paper": PAPER_TABLE1}
+    figure = Path(run_dir) / ATTENTION_FIGURE
+    if plot_attention(figure, rows):
+        out["attention_figure"] = ATTENTION_FIGURE
     atomic_write_json(Path(run_dir) / "table1.json", out)
     return out
 
@@ -112,4 +183,11 @@ def format_table1(result: dict) -> str:
                      f"{c['objects_motion_right']} objects, {'met' if c['motion_right'] else 'not met'}; "
                      f"riders within {RIDER_TOL_MM} mm in y: {c['riders_right']}, "
                      f"{'met' if c['riders_within_50mm'] else 'not met'}")
+    for i, r in enumerate(result["cases"]):
+        for rider in r.get("rider_attention", []):
+            lines.append(f"case {i + 1}: rider {rider['object']} attends to the stick "
+                         f"{' / '.join(f'{w:.2f}' for w in rider['on_stick'])} and to itself "
+                         f"{' / '.join(f'{w:.2f}' for w in rider['on_itself'])} (layer by layer)")
+    if result.get("attention_figure"):
+        lines.append(f"attention maps: {result['attention_figure']}")
     return "\n".join(lines)

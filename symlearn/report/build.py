@@ -81,7 +81,7 @@ def build_report(run: Path, data: Path | None = None, benchmark: Path | None = N
             gif_why = g.cannot_read(gif, e)
     sections = [g.data_section(summary, shares, why or data_why),
                 g.effect_section(ev, _reason(ev_why, "symlearn evaluate")),
-                g.table1_section(t1, _reason(t1_why, "symlearn table1")),
+                g.table1_section(t1, _reason(t1_why, "symlearn table1"), run),
                 g.symbols_section(sy, run, _reason(sy_why, "symlearn symbols")),
                 g.curves_section(g.history_from_checkpoint(run), (tm or {}).get("history"), curves_why),
                 g.benchmark_section(bench, bench_why),

@@ -17,6 +17,7 @@ PAPER_EFFECT_MAE_MM = {"x": 8.6, "y": 15.0, "z": 6.0}  # the paper's test error 
 PAPER_SYMBOLS_95 = 35  # the paper: 35 symbols cover 95% of the objects
 OBJECT_ORDER = (1, 0, 2)  # Table I's columns: first cube (green), stick (orange), second cube (red)
 OBJECT_NAMES = ("first cube", "stick", "second cube")
+TABLE1_ATTENTION = "table1_attention.png"  # written by symlearn table1 (symlearn.learning.table1.ATTENTION_FIGURE)
 SYMBOL_IMAGES = (("symbols.png", "Symbol prototypes (the paper's Fig. 4)"),
                  ("symbol_examples.png", "Examples of one symbol (the paper's Fig. 5)"))
 
@@ -91,7 +92,7 @@ def _vec(v) -> str:
     return "(" + ", ".join(f"{x:.0f}" for x in v) + ")" if v is not None else "-"
 
 
-def table1_section(t1: dict | None, why: str = "") -> Section:
+def table1_section(t1: dict | None, why: str = "", run: Path | None = None) -> Section:
     """Table I: predicted and true effects in the three stick cases, ours beside the paper's, and the criteria."""
     title = "Table I: the three stick cases"
     if t1 is None:
@@ -117,7 +118,17 @@ def table1_section(t1: dict | None, why: str = "") -> Section:
         marks.append(Mark("Table I: riders' y within 50 mm of the truth", c.get("riders_right"), "all riders",
                           "|predicted y - true y| <= 50 mm", bool(c["riders_within_50mm"])))
     mae = t1.get("mean_abs_error_mm") or {}
-    return Section("table1", title, marks=marks, text=[f"mean absolute error over the cases (mm): {fmt(mae or None)}"],
+    text = [f"mean absolute error over the cases (mm): {fmt(mae or None)}"]
+    for i, case in enumerate(t1.get("cases", [])):
+        for rider in case.get("rider_attention") or []:
+            if isinstance(rider, dict) and isinstance(rider.get("on_stick"), list):
+                text.append(f"case {i + 1}: the rider (object {rider.get('object')}) puts "
+                            f"{' / '.join(fmt(w) for w in rider['on_stick'])} of its attention on the stick, "
+                            f"layer by layer")
+    figure = Path(run) / TABLE1_ATTENTION if run is not None else None
+    images = [Image("table1_attention", "Attention of each object on each object in the three cases (rows: who "
+                    "attends), per layer", figure)] if figure is not None and figure.is_file() else []
+    return Section("table1", title, marks=marks, text=text, images=images,
                    tables=[Table("Effects (mm), ours next to the paper's", header, tuple(rows), key="table1")])
 
 
