@@ -372,12 +372,12 @@ def test_plan_record_paths_that_are_not_its_own_are_refused(tiny_run, problems, 
 
 
 def test_plan_record_may_replace_its_own_gif_and_png(tmp_path):
-    from symlearn.cli.planning import _record_paths
+    from symlearn.planning.single import record_paths
 
     gif = tmp_path / "plan.gif"
     gif.write_bytes(b"GIF89a" + bytes(20))
     (tmp_path / "plan.png").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(20))
-    assert _record_paths(str(gif)) == (gif, tmp_path / "plan.png")
+    assert record_paths(gif) == (gif, tmp_path / "plan.png")
 
 
 def _bench(tiny_run, problems, out, *extra):
