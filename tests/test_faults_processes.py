@@ -189,21 +189,21 @@ def test_a_failing_pipeline_stage_prints_its_reason(tmp_path, capsys):
     out.mkdir()
     (out / "data").write_text("not a folder")  # the collect stage cannot write its data set here
     rc, _ = cli("pipeline", "--out", out, "--n", "4", "--shard-size", "4")
-    line = _one_line_error(capsys, "pipeline", "'symlearn collect' exited 2: ", str(out / "data"),
+    line = _one_line_error(capsys, "pipeline", "stage collect failed: ", str(out / "data"),
                            str(out / "logs" / "collect.log"))
-    assert rc == 2 and line.count("symlearn") == 2, line
+    assert rc == 2 and line.count("symlearn") == 1, line  # the refusal's own message, not a nested command's
 
 
 def test_a_stage_that_crashes_prints_one_line_and_keeps_the_traceback_in_its_log(tmp_path, capsys, monkeypatch):
-    import symlearn.cli.main as main_mod
+    import symlearn.sim.collect as collect_mod
 
-    def crash(args):
+    def crash(*args, **kwargs):
         raise IndexError("index 0 is out of bounds\nfor axis 0")
 
-    monkeypatch.setattr(main_mod, "cmd_collect", crash)
+    monkeypatch.setattr(collect_mod, "collect", crash)  # the library call the pipeline's collect stage makes
     out = tmp_path / "pipe"
     rc, _ = cli("pipeline", "--out", out, "--n", "4", "--shard-size", "4")
-    line = _one_line_error(capsys, "pipeline", "'symlearn collect' failed: IndexError: index 0 is out of bounds; see")
+    line = _one_line_error(capsys, "pipeline", "stage collect failed: IndexError: index 0 is out of bounds; see")
     assert rc == 2 and "for axis 0" not in line
     assert "Traceback (most recent call last)" in (out / "logs" / "collect.log").read_text()
 
