@@ -1,11 +1,15 @@
 """Every stage in order, resumable: collect, train, evaluate, table1, symbols, train-transition, export-pddl,
 problems, benchmark, report, into OUT/data, OUT/run and OUT/problems.
 
-Each stage is one or more `symlearn` command lines run in this process (symlearn.cli.main.main), their
-output kept in OUT/logs/<stage>.log. OUT/pipeline.json (written atomically after every finished stage)
-records each stage's command lines, the hashes of its inputs and of its outputs. A stage is skipped when
-its record holds the same command lines and input hashes and its outputs are still there unchanged;
-so an interrupted pipeline, run again, redoes only what did not finish (and what depends on a change).
+Each stage is a call of the library function its `symlearn` sub-command calls, with a frozen config dataclass
+built from the settings and the preset; what the stage prints, and the traceback of a crash, go to
+OUT/logs/<stage>.log. OUT/pipeline.json (written atomically after every finished stage) records each stage's
+config (as JSON), the hashes of its inputs and of its outputs. A stage is skipped when its record holds the same
+config and input hashes and its outputs are still there unchanged; so an interrupted pipeline, run again, redoes
+only what did not finish (and what depends on a change).
+
+The pipeline calls the library, never the command line: `symlearn pipeline` (symlearn.cli.pipeline) is a thin
+front end to run_pipeline, and tests/test_layout.py keeps imports going that one way.
 
     >>> run_pipeline(PipelineSettings(preset="quick", out=Path("pipe"), n=2000))   # doctest: +SKIP
     [1/10] collect ... done in 61.3 s
@@ -13,22 +17,53 @@ so an interrupted pipeline, run again, redoes only what did not finish (and what
 from __future__ import annotations
 
 import contextlib
+import dataclasses
+import json
 import time
 import traceback
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING, Any, Callable, Iterator
 
-from pddl_export.bounded_json import JsonFileError, List, Map, Num, Obj, Opt, Str, check, read_json_file
+from pddl_export.bounded_json import AnyJson, JsonFileError, Map, Num, Obj, Opt, Str, check, read_json_file
 from symlearn.folder_lock import folder_lock
 from symlearn.provenance import atomic_write_json, sha256_bytes, sha256_file
 
+if TYPE_CHECKING:  # the configs' modules load torch (and the simulator): imported where a stage is built
+    from symlearn.learning.training import TrainConfig
+    from symlearn.planning.execution import ExecutionConfig
+    from symlearn.planning.export import ExportConfig
+    from symlearn.planning.problem_generation import ProblemConfig
+    from symlearn.sim.collect import CollectConfig
+    from symlearn.symbolic.transition_model import TransitionConfig
+
 RECORD_FILE = "pipeline.json"
 RECORD_KIND = "symlearn-pipeline"
+DATA, RUN, PROBLEMS = "data", "run", "problems"  # OUT's folders
+
+
+@dataclass(frozen=True)
+class PipelinePreset:
+    """One named preset of the whole pipeline.
+
+    The networks take the named presets of TrainConfig and TransitionConfig called `models`; a size left None is
+    the default of the config (or library function) that holds it, which is the paper's. Only what no config
+    holds (how many problems, which planners) and the quick preset's smaller sizes are numbers here, so each
+    value has one definition.
+    """
+
+    models: str  # TrainConfig.from_preset and TransitionConfig.from_preset name
+    samples: int | None = None  # CollectConfig.n
+    max_objects: int | None = None  # ExportConfig.max_objects
+    fidelity_cases: int | None = None  # ExportConfig.pddl_fidelity_cases
+    min_count: int | None = None  # analyse_symbols' min_count (symbols.FREQUENT_MIN_COUNT)
+    problems: int = 20  # planning problems generated and benchmarked
+    planners: tuple[str, ...] = ("astar",)  # benchmarked planners
+
+
 PRESETS = {
-    "quick": dict(n=1000, problems=5, planners="astar", max_objects=2, fidelity_cases=100, min_count=20),
-    "paper": dict(n=12000, problems=20, planners="astar,astar-ucs,astar-outcomes,rules-outcomes", max_objects=3, fidelity_cases=500,
-                  min_count=100),
+    "quick": PipelinePreset("quick", samples=1000, max_objects=2, fidelity_cases=100, min_count=20, problems=5),
+    "paper": PipelinePreset("paper", planners=("astar", "astar-ucs", "astar-outcomes", "rules-outcomes")),
 }
 
 
@@ -57,79 +92,262 @@ class PipelineSettings:
         if self.stop_after is not None and self.stop_after not in STAGE_NAMES:
             raise ValueError(f"unknown stage {self.stop_after!r}; stages: {', '.join(STAGE_NAMES)}")
 
-    def get(self, key: str):
-        """An override when given, else the preset's value."""
-        v = getattr(self, key, None)
-        return PRESETS[self.preset][key] if v is None else v
+    @property
+    def preset_values(self) -> PipelinePreset:
+        """The preset this run starts from."""
+        return PRESETS[self.preset]
+
+
+# ------------------------------------------------------------------------------- stage configs
+# A stage whose library function takes a config dataclass records that config (CollectConfig, TrainConfig,
+# ExportConfig); the others record one of these, holding the arguments the pipeline passes.
+
+
+@dataclass(frozen=True)
+class EmptyStageConfig:
+    """The config of a stage with nothing to set: it reads its inputs and writes its outputs (evaluate, table1,
+    report)."""
+
+
+@dataclass(frozen=True)
+class SymbolsStageConfig:
+    """analyse_symbols' arguments: a symbol is frequent from min_count training objects."""
+
+    min_count: int
+
+
+@dataclass(frozen=True)
+class TransitionStageConfig:
+    """train_transition's arguments: m(z)'s config and the training seed."""
+
+    transition: TransitionConfig
+    seed: int
+
+
+@dataclass(frozen=True)
+class ProblemsStageConfig:
+    """generate_problems' arguments: n random-walk problems drawn from `seed` with `problem`'s ranges."""
+
+    n: int
+    seed: int
+    problem: ProblemConfig
+
+
+@dataclass(frozen=True)
+class BenchmarkStageConfig:
+    """The benchmark's planners and execution settings, and the planner of the recorded plan (RUN/plan.gif)."""
+
+    planners: tuple[str, ...]
+    execution: ExecutionConfig
+    plan_planner: str = "astar"  # plans the first problem, recorded as RUN/plan.gif for the report
+    # search-time inference runs the networks on small batches, many times slower on 2 threads than on 1 when
+    # another busy process shares the cores (docs/BENCHMARKS.md): the benchmark command's default
+    threads: int = 1
+
+
+def _given(**values) -> dict:
+    """The keyword arguments that are set: a None leaves the config's own default."""
+    return {k: v for k, v in values.items() if v is not None}
+
+
+def _first(*values):
+    """The first value that is not None (an override before the preset's), else None."""
+    return next((v for v in values if v is not None), None)
+
+
+def _collect_config(s: PipelineSettings) -> CollectConfig:
+    from symlearn.sim.collect import CollectConfig
+
+    return CollectConfig(seed=s.seed, shard_size=s.shard_size, **_given(n=_first(s.n, s.preset_values.samples)))
+
+
+def _train_config(s: PipelineSettings) -> TrainConfig:
+    import torch
+
+    from symlearn.learning.training import TrainConfig
+
+    # bf16 autocast on a GPU only, as the pipeline has always trained (plain float32 on a CPU)
+    return TrainConfig.from_preset(s.preset_values.models, seed=s.seed, bf16=torch.cuda.is_available(),
+                                   **_given(epochs=s.epochs))
+
+
+def _symbols_config(s: PipelineSettings) -> SymbolsStageConfig:
+    from symlearn.symbolic.symbols import FREQUENT_MIN_COUNT
+
+    return SymbolsStageConfig(min_count=_first(s.preset_values.min_count, FREQUENT_MIN_COUNT))
+
+
+def _transition_config(s: PipelineSettings) -> TransitionStageConfig:
+    from symlearn.symbolic.transition_model import TransitionConfig
+
+    cfg = TransitionConfig.from_preset(s.preset_values.models, **_given(epochs=s.transition_epochs))
+    return TransitionStageConfig(cfg, seed=s.seed)
+
+
+def _export_config(s: PipelineSettings) -> ExportConfig:
+    from symlearn.planning.export import ExportConfig
+
+    p = s.preset_values
+    return ExportConfig(seed=s.seed, **_given(max_objects=p.max_objects, pddl_fidelity_cases=p.fidelity_cases))
+
+
+def _problems_config(s: PipelineSettings) -> ProblemsStageConfig:
+    from symlearn.planning.problem_generation import ProblemConfig
+
+    return ProblemsStageConfig(n=_first(s.problems, s.preset_values.problems), seed=s.seed, problem=ProblemConfig())
+
+
+def _benchmark_config(s: PipelineSettings) -> BenchmarkStageConfig:
+    from symlearn.planning.execution import ExecutionConfig
+
+    return BenchmarkStageConfig(planners=s.preset_values.planners, execution=ExecutionConfig())
+
+
+# ------------------------------------------------------------------------------- stage calls
+# Each takes (OUT, its config, the settings); what it prints goes to the stage's log.
+
+
+def _collect(out: Path, cfg: CollectConfig, s: PipelineSettings) -> None:
+    from symlearn.data.dataset import summarize
+    from symlearn.sim.collect import collect
+
+    collect(out / DATA, cfg, workers=s.workers, show_progress=False)
+    print(json.dumps(summarize(out / DATA), indent=2, allow_nan=False))
+
+
+def _train(out: Path, cfg: TrainConfig, s: PipelineSettings) -> None:
+    from symlearn.learning.training import train
+
+    res = train(out / DATA, out / RUN, cfg, show_progress=False)
+    last = res["history"][-1] if res["history"] else {}
+    print(json.dumps({"best_val_loss": res["best_val_loss"], "last_epoch": last}, indent=2, allow_nan=False))
+
+
+def _evaluate(out: Path, cfg: EmptyStageConfig, s: PipelineSettings) -> None:
+    from symlearn.learning.evaluation import evaluate, format_table
+
+    print(format_table(evaluate(out / RUN, out / DATA)))
+
+
+def _table1(out: Path, cfg: EmptyStageConfig, s: PipelineSettings) -> None:
+    from symlearn.learning.table1 import format_table1, table1
+
+    print(format_table1(table1(out / RUN)))
+
+
+def _symbols(out: Path, cfg: SymbolsStageConfig, s: PipelineSettings) -> None:
+    from symlearn.symbolic.symbols import analyse_symbols
+
+    res = analyse_symbols(out / RUN, out / DATA, min_count=cfg.min_count)
+    print(f"{res['n_objects']} training objects, {res['n_distinct']} distinct symbols, "
+          f"{res['n_symbols_for_95pct']} cover 95%; weighted type purity {res['weighted_type_purity']}")
+
+
+def _train_transition(out: Path, cfg: TransitionStageConfig, s: PipelineSettings) -> None:
+    from symlearn.symbolic.transition_training import train_transition
+
+    m = train_transition(out / RUN, out / DATA, cfg.transition, seed=cfg.seed, show_progress=False)
+    test = m["test"]
+    print(json.dumps({"best_val_loss": m["best_val_loss"],
+                      "test": {k: test[k] for k in ("bit_accuracy", "object_accuracy", "scene_accuracy")}}, indent=2))
+
+
+def _export_pddl(out: Path, cfg: ExportConfig, s: PipelineSettings) -> None:
+    from symlearn.planning.export import export_pddl
+
+    rep = export_pddl(out / RUN, out / DATA, cfg)
+    print(f"vocabulary {rep['vocabulary_size']} codes; {rep['n_rules']} rules over {rep['n_actions_with_rules']} "
+          f"actions; fidelity (rules, every case) {rep['fidelity']:.4f}, through the PDDL {rep['pddl_fidelity']}")
+
+
+def _problems(out: Path, cfg: ProblemsStageConfig, s: PipelineSettings) -> None:
+    from symlearn.planning.problem_generation import generate_problems
+
+    # a stage runs again only when its config changed, so the old problem set is replaced, never mixed
+    paths = generate_problems(out / PROBLEMS, cfg.n, objects=cfg.problem.objects, length=cfg.problem.length,
+                              seed=cfg.seed, overwrite=True, on_locations=cfg.problem.on_locations)
+    print(f"wrote {len(paths)} problems to {out / PROBLEMS}")
+
+
+def _first_problem(out: Path) -> Path:
+    files = sorted((out / PROBLEMS).glob("*.json"))
+    if not files:
+        raise RuntimeError(f"no problems in {out / PROBLEMS}")
+    return files[0]
+
+
+@contextlib.contextmanager
+def _torch_threads(n: int) -> Iterator[None]:
+    """torch uses n CPU threads inside the block, its former count after."""
+    import torch
+
+    before = torch.get_num_threads()
+    torch.set_num_threads(n)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)
+
+
+def _benchmark(out: Path, cfg: BenchmarkStageConfig, s: PipelineSettings) -> None:
+    from symlearn.planning.benchmark import benchmark, format_table
+    from symlearn.planning.single import plan_problem
+
+    run, ex = out / RUN, cfg.execution
+    with _torch_threads(cfg.threads):
+        res = benchmark(run, out / PROBLEMS, list(cfg.planners), run / "benchmark.json", closed_loop=ex.closed_loop,
+                        timeout_s=ex.timeout_s, max_replans=ex.max_replans, show_progress=False,
+                        record_dir=run / "recordings")
+        print(format_table(res))
+        done = plan_problem(run, _first_problem(out), cfg.plan_planner, ex, record=run / "plan.gif")
+    row = done.row
+    print(f"{done.problem.name} [{cfg.plan_planner}]: found {row.found} ({row.status}), length {row.plan_length}, "
+          f"success {row.success}; wrote {done.gif} ({done.frames} frames)")
+    if row.status == "error":  # the planner could not run: not an answer about the problem
+        raise RuntimeError(f"{cfg.plan_planner} could not plan {done.problem.name}: {row.message}")
+
+
+def _report(out: Path, cfg: EmptyStageConfig, s: PipelineSettings) -> None:
+    from symlearn.report.build import build_report, write_report
+
+    rep = build_report(out / RUN, out / DATA, out / RUN / "benchmark.json")
+    html_path, md_path = write_report(rep, out / RUN)
+    for sec in rep.sections:
+        print(f"{sec.title}: {sec.status}" + (f" ({sec.note})" if sec.note else ""))
+    print(f"wrote {html_path} and {md_path}")
 
 
 @dataclass(frozen=True)
 class Stage:
-    """A named step: its command lines (built when it runs), the paths it reads and the paths it writes."""
+    """A named step: its config (a frozen dataclass built from the settings), the library call that runs it with
+    that config, and the paths it reads and writes (relative to OUT; a folder hashes all its files)."""
 
     name: str
-    commands: Callable[[PipelineSettings], list[list[str]]]
-    inputs: tuple[str, ...]  # relative to OUT; a folder hashes all its files
+    config: Callable[[PipelineSettings], Any]
+    run: Callable[[Path, Any, PipelineSettings], None]  # (OUT, config, settings)
+    inputs: tuple[str, ...]
     outputs: tuple[str, ...]
 
 
-def _opt(flag: str, v) -> list[str]:
-    return [] if v is None else [flag, str(v)]
-
-
-def _bf16() -> list[str]:
-    import torch
-
-    return [] if torch.cuda.is_available() else ["--no-bf16"]
-
-
-def _first_problem(s: PipelineSettings) -> str:
-    files = sorted((s.out / "problems").glob("*.json"))
-    if not files:
-        raise RuntimeError(f"no problems in {s.out / 'problems'}")
-    return str(files[0])
-
-
 def _stages() -> list[Stage]:
-    D, R, P = "data", "run", "problems"  # noqa: N806
-
-    def p(s: PipelineSettings, rel: str) -> str:
-        return str(s.out / rel)
-
+    D, R, P = DATA, RUN, PROBLEMS  # noqa: N806
+    empty = lambda s: EmptyStageConfig()  # noqa: E731
     return [
-        Stage("collect", lambda s: [["collect", "--out", p(s, D), "--n", str(s.get("n")), "--seed", str(s.seed),
-                                     "--workers", str(s.workers), "--shard-size", str(s.shard_size), "--quiet"]],
-              (), (f"{D}/manifest.json",)),
-        Stage("train", lambda s: [["train", "--data", p(s, D), "--out", p(s, R), "--preset", s.preset, "--seed",
-                                   str(s.seed), *_opt("--epochs", s.epochs), *_bf16(), "--quiet"]],
-              (f"{D}/manifest.json",), (f"{R}/best.pt", f"{R}/metrics.json")),
-        Stage("evaluate", lambda s: [["evaluate", "--run", p(s, R), "--data", p(s, D)]],
-              (f"{D}/manifest.json", f"{R}/best.pt"), (f"{R}/eval.json",)),
-        Stage("table1", lambda s: [["table1", "--run", p(s, R)]], (f"{R}/best.pt",), (f"{R}/table1.json",)),
-        Stage("symbols", lambda s: [["symbols", "--run", p(s, R), "--data", p(s, D), "--min-count",
-                                     str(s.get("min_count"))]],
-              (f"{D}/manifest.json", f"{R}/best.pt"), (f"{R}/symbols.json", f"{R}/symbols.png")),
-        Stage("train-transition", lambda s: [["train-transition", "--run", p(s, R), "--data", p(s, D), "--preset",
-                                              s.preset, "--seed", str(s.seed),
-                                              *_opt("--epochs", s.transition_epochs), "--quiet"]],
-              (f"{D}/manifest.json", f"{R}/best.pt"), (f"{R}/transition.pt", f"{R}/transition_metrics.json")),
-        Stage("export-pddl", lambda s: [["export-pddl", "--run", p(s, R), "--data", p(s, D), "--max-objects",
-                                         str(s.get("max_objects")), "--pddl-fidelity-cases",
-                                         str(s.get("fidelity_cases")), "--seed", str(s.seed)]],
-              (f"{D}/manifest.json", f"{R}/best.pt", f"{R}/transition.pt"),
+        Stage("collect", _collect_config, _collect, (), (f"{D}/manifest.json",)),
+        Stage("train", _train_config, _train, (f"{D}/manifest.json",), (f"{R}/best.pt", f"{R}/metrics.json")),
+        Stage("evaluate", empty, _evaluate, (f"{D}/manifest.json", f"{R}/best.pt"), (f"{R}/eval.json",)),
+        Stage("table1", empty, _table1, (f"{R}/best.pt",), (f"{R}/table1.json",)),
+        Stage("symbols", _symbols_config, _symbols, (f"{D}/manifest.json", f"{R}/best.pt"),
+              (f"{R}/symbols.json", f"{R}/symbols.png")),
+        Stage("train-transition", _transition_config, _train_transition, (f"{D}/manifest.json", f"{R}/best.pt"),
+              (f"{R}/transition.pt", f"{R}/transition_metrics.json")),
+        Stage("export-pddl", _export_config, _export_pddl, (f"{D}/manifest.json", f"{R}/best.pt", f"{R}/transition.pt"),
               (f"{R}/pddl/domain.pddl", f"{R}/pddl/rules.json")),
-        # a stage runs again only when its settings changed, so the old problem set is replaced, never mixed
-        Stage("problems", lambda s: [["problems", "--out", p(s, P), "--n", str(s.get("problems")), "--seed",
-                                      str(s.seed), "--overwrite"]], (), (P,)),
-        Stage("benchmark", lambda s: [["benchmark", "--run", p(s, R), "--problems", p(s, P), "--planners",
-                                       s.get("planners"), "--out", p(s, f"{R}/benchmark.json"), "--record",
-                                       p(s, f"{R}/recordings"), "--quiet"],
-                                      ["plan", "--run", p(s, R), "--problem", _first_problem(s), "--record",
-                                       p(s, f"{R}/plan.gif")]],
+        Stage("problems", _problems_config, _problems, (), (P,)),
+        Stage("benchmark", _benchmark_config, _benchmark,
               (f"{R}/best.pt", f"{R}/transition.pt", f"{R}/pddl/rules.json", P),
               (f"{R}/benchmark.json", f"{R}/plan.gif")),
-        Stage("report", lambda s: [["report", "--run", p(s, R), "--data", p(s, D), "--benchmark",
-                                    p(s, f"{R}/benchmark.json")]],
+        Stage("report", empty, _report,
               (f"{R}/eval.json", f"{R}/table1.json", f"{R}/symbols.json", f"{R}/transition_metrics.json",
                f"{R}/benchmark.json", f"{R}/plan.gif"), (f"{R}/report.html", f"{R}/report.md")),
     ]
@@ -137,6 +355,16 @@ def _stages() -> list[Stage]:
 
 STAGES = _stages()
 STAGE_NAMES = tuple(s.name for s in STAGES)
+
+
+def config_json(config: Any) -> dict:
+    """A stage's frozen config as the JSON object pipeline.json records (tuples as lists, as read back)."""
+    return json.loads(json.dumps(dataclasses.asdict(config), allow_nan=False))
+
+
+def stage_configs(s: PipelineSettings) -> dict[str, Any]:
+    """Every stage's config for these settings, built before any stage runs so that a bad value is refused first."""
+    return {stage.name: stage.config(s) for stage in STAGES}
 
 
 def path_hash(path: Path) -> str | None:
@@ -154,8 +382,9 @@ def _hashes(out: Path, rels: tuple[str, ...]) -> dict[str, str | None]:
 
 
 _HASHES = Map(Opt(Str(64)), 100)  # relative path -> 16 hex digits, None where missing
-# One finished stage as run_pipeline records it; is_done compares argv, inputs and outputs.
-STAGE_RECORD = Obj(optional={"argv": List(List(Str(4096), 200), 20), "inputs": _HASHES, "outputs": _HASHES,
+# One finished stage as run_pipeline records it; is_done compares config, inputs and outputs. A record from
+# before configs were recorded holds command lines ("argv") instead: it has no config, so its stage runs again.
+STAGE_RECORD = Obj(optional={"config": Map(AnyJson(), 100), "inputs": _HASHES, "outputs": _HASHES,
                              "wall_s": Opt(Num()), "finished": Str(100), "out": Str(4096)})
 RECORD_SCHEMA = Obj({"kind": Str(100), "stages": Map(STAGE_RECORD, 100)},
                     optional={"out": Str(4096), "preset": Str(100)})
@@ -180,86 +409,76 @@ def load_record(out: Path) -> dict:
     return doc
 
 
-def is_done(stage: Stage, rec: dict | None, argv: list[list[str]] | None, inputs: dict) -> bool:
-    """Whether a recorded stage can be skipped: same command lines, same inputs, outputs there and unchanged."""
-    if not rec or (argv is not None and rec.get("argv") != argv) or rec.get("inputs") != inputs:
+def is_done(stage: Stage, rec: dict | None, config: dict, inputs: dict) -> bool:
+    """Whether a recorded stage can be skipped: same config, same inputs, outputs there and unchanged."""
+    if not rec or rec.get("config") != config or rec.get("inputs") != inputs:
         return False
     outputs = rec.get("outputs") or {}
     return set(outputs) == set(stage.outputs) and all(
         h is not None and path_hash(Path(rec["out"]) / r) == h for r, h in outputs.items())
 
 
-def _run_commands(argv: list[list[str]], log: Path) -> None:
-    """Run each command line with symlearn.cli.main.main, its stdout and stderr appended to `log`."""
-    from symlearn.cli.main import main
+class StageError(RuntimeError):
+    """A stage failed; the message is one line: the stage, the reason, and the log holding the details."""
 
+
+def _reason(e: Exception) -> str:
+    """One line for the terminal: a refusal's own message (ValueError, RuntimeError, OSError: what the command
+    line prints as 'error: ...'), or a crash's exception type and first line."""
+    first = (str(e).strip().splitlines() or [""])[0]
+    return first if isinstance(e, (ValueError, RuntimeError, OSError)) else f"{type(e).__name__}: {first}"
+
+
+def _run_stage(stage: Stage, config: Any, out: Path, s: PipelineSettings, log: Path) -> None:
+    """Run one stage's library call, what it prints (and a failure's traceback) appended to `log`; a failure is
+    raised as a one-line StageError naming the log, Ctrl-C as it came (the next run resumes)."""
     log.parent.mkdir(parents=True, exist_ok=True)
     with open(log, "a") as fh, contextlib.redirect_stdout(fh), contextlib.redirect_stderr(fh):
-        for cmd in argv:
-            print(f"$ symlearn {' '.join(cmd)}", flush=True)
-            try:
-                rc = main(cmd)
-            except SystemExit as e:  # argparse refused a flag (its one line is in the log)
-                rc = e.code if isinstance(e.code, int) else 2
-            except Exception as e:  # noqa: BLE001 - a stage's bug: the traceback to its log, one line to the terminal
-                traceback.print_exc()
-                first = (str(e).strip().splitlines() or [""])[0]
-                raise RuntimeError(f"'symlearn {cmd[0]}' failed: {type(e).__name__}: {first}; see {log}") from None
-            if rc == 130:  # the command caught Ctrl-C: stop here too; the next run resumes
-                raise KeyboardInterrupt
-            if rc != 0:
-                fh.flush()
-                reason = _last_error(log, cmd[0])
-                raise RuntimeError(f"'symlearn {cmd[0]}' exited {rc}{': ' + reason if reason else ''}; see {log}")
-
-
-def _last_error(log: Path, command: str, tail_bytes: int = 65536) -> str:
-    """The last 'symlearn COMMAND: error: ...' (or 'interrupted') line in the end of a log, without its prefix; ''."""
-    with open(log, "rb") as f:
-        f.seek(max(f.seek(0, 2) - tail_bytes, 0))
-        lines = f.read().decode("utf-8", errors="replace").splitlines()
-    for line in reversed(lines):
-        for prefix in (f"symlearn {command}: error: ", f"symlearn {command}: "):
-            if line.startswith(prefix):
-                return line[len(prefix):].strip()
-        if line.startswith("symlearn: error: "):  # argparse's refusal of a flag
-            return line[len("symlearn: error: "):].strip()
-    return ""
+        print(f"== {stage.name} {time.strftime('%Y-%m-%dT%H:%M:%S')} config {json.dumps(config_json(config))}",
+              flush=True)
+        try:
+            stage.run(out, config, s)
+        except KeyboardInterrupt as e:
+            print(f"interrupted{f' ({e})' if str(e) else ''}", flush=True)
+            raise
+        except Exception as e:  # noqa: BLE001 - the traceback to its log, one line to the terminal
+            traceback.print_exc()
+            raise StageError(f"stage {stage.name} failed: {_reason(e)}; see {log}") from None
 
 
 def run_pipeline(s: PipelineSettings, echo: Callable[[str], None] = print) -> dict:
     """Run (or resume) every stage; returns the record written to OUT/pipeline.json."""
     out = Path(s.out)
+    configs = stage_configs(s)  # a value no config accepts is refused before OUT is made
     with folder_lock(out):  # one writer: a second pipeline into this folder is refused at once
-        return _run_stages(s, out, echo)
+        return _run_stages(s, configs, out, echo)
 
 
-def _run_stages(s: PipelineSettings, out: Path, echo: Callable[[str], None]) -> dict:
+def _run_stages(s: PipelineSettings, configs: dict[str, Any], out: Path, echo: Callable[[str], None]) -> dict:
     """run_pipeline's work, inside OUT's lock."""
     record = load_record(out)
     record.update(kind=RECORD_KIND, out=str(out), preset=s.preset)
     n = len(STAGES)
     for i, stage in enumerate(STAGES, 1):
         inputs = _hashes(out, stage.inputs)
+        config = config_json(configs[stage.name])
         rec = record["stages"].get(stage.name)
         prefix = f"[{i}/{n}] {stage.name} ..."
-        # the benchmark's commands name a problem file, so compare them once the problems exist
-        argv = stage.commands(s) if all(h is not None for h in inputs.values()) or not stage.inputs else None
-        if argv is not None and is_done(stage, rec and {**rec, "out": str(out)}, argv, inputs):
+        if is_done(stage, rec and {**rec, "out": str(out)}, config, inputs):
             echo(f"{prefix} skipped (done)")
         else:
-            if argv is None:
-                missing = [r for r, h in inputs.items() if h is None]
+            missing = [r for r, h in inputs.items() if h is None]
+            if missing:
                 raise RuntimeError(f"stage {stage.name} needs {out / missing[0]}, which an earlier stage did not write")
             record["stages"].pop(stage.name, None)
             t0 = time.perf_counter()
-            _run_commands(argv, out / "logs" / f"{stage.name}.log")
+            _run_stage(stage, configs[stage.name], out, s, out / "logs" / f"{stage.name}.log")
             wall = time.perf_counter() - t0
             outputs = _hashes(out, stage.outputs)
             lost = [r for r, h in outputs.items() if h is None]
             if lost:
                 raise RuntimeError(f"stage {stage.name} finished without writing {out / lost[0]}")
-            record["stages"][stage.name] = {"argv": argv, "inputs": inputs, "outputs": outputs,
+            record["stages"][stage.name] = {"config": config, "inputs": inputs, "outputs": outputs,
                                             "wall_s": round(wall, 2), "finished": time.strftime("%Y-%m-%dT%H:%M:%S")}
             atomic_write_json(out / RECORD_FILE, record)
             echo(f"{prefix} done in {wall:.1f} s")

@@ -189,21 +189,21 @@ def test_a_failing_pipeline_stage_prints_its_reason(tmp_path, capsys):
     out.mkdir()
     (out / "data").write_text("not a folder")  # the collect stage cannot write its data set here
     rc, _ = cli("pipeline", "--out", out, "--n", "4", "--shard-size", "4")
-    line = _one_line_error(capsys, "pipeline", "'symlearn collect' exited 2: ", str(out / "data"),
+    line = _one_line_error(capsys, "pipeline", "stage collect failed: ", str(out / "data"),
                            str(out / "logs" / "collect.log"))
-    assert rc == 2 and line.count("symlearn") == 2, line
+    assert rc == 2 and line.count("symlearn") == 1, line  # the refusal's own message, not a nested command's
 
 
 def test_a_stage_that_crashes_prints_one_line_and_keeps_the_traceback_in_its_log(tmp_path, capsys, monkeypatch):
-    import symlearn.cli.main as main_mod
+    import symlearn.sim.collect as collect_mod
 
-    def crash(args):
+    def crash(*args, **kwargs):
         raise IndexError("index 0 is out of bounds\nfor axis 0")
 
-    monkeypatch.setattr(main_mod, "cmd_collect", crash)
+    monkeypatch.setattr(collect_mod, "collect", crash)  # the library call the pipeline's collect stage makes
     out = tmp_path / "pipe"
     rc, _ = cli("pipeline", "--out", out, "--n", "4", "--shard-size", "4")
-    line = _one_line_error(capsys, "pipeline", "'symlearn collect' failed: IndexError: index 0 is out of bounds; see")
+    line = _one_line_error(capsys, "pipeline", "stage collect failed: IndexError: index 0 is out of bounds; see")
     assert rc == 2 and "for axis 0" not in line
     assert "Traceback (most recent call last)" in (out / "logs" / "collect.log").read_text()
 
@@ -372,12 +372,12 @@ def test_plan_record_paths_that_are_not_its_own_are_refused(tiny_run, problems, 
 
 
 def test_plan_record_may_replace_its_own_gif_and_png(tmp_path):
-    from symlearn.cli.planning import _record_paths
+    from symlearn.planning.single import record_paths
 
     gif = tmp_path / "plan.gif"
     gif.write_bytes(b"GIF89a" + bytes(20))
     (tmp_path / "plan.png").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(20))
-    assert _record_paths(str(gif)) == (gif, tmp_path / "plan.png")
+    assert record_paths(gif) == (gif, tmp_path / "plan.png")
 
 
 def _bench(tiny_run, problems, out, *extra):

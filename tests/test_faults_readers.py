@@ -481,7 +481,7 @@ def test_report_md_escapes_names_from_the_run_json(tmp_path):
 
 @pytest.mark.parametrize("stages, words", [
     ({"collect": ["argv", 1]}, ["field stages.collect", "expected an object"]),
-    ({"collect": {"argv": "collect --n 5"}}, ["field stages.collect.argv"]),
+    ({"collect": {"config": "n=5"}}, ["field stages.collect.config"]),
     ({"collect": {"inputs": {"a": 5}}}, ["field stages.collect.inputs.a"]),
 ])
 def test_pipeline_record_of_the_wrong_shape_is_refused(tmp_path, stages, words):
@@ -602,7 +602,7 @@ READERS = {  # kind -> (a valid document, where it is written under tmp, the loa
     "rules": (lambda: _small_rules("rules.json"), "run/pddl/rules.json", _load_rules_kind("rules.json")),
     "outcomes": (lambda: _small_rules("outcomes.json"), "run/pddl/outcomes.json", _load_rules_kind("outcomes.json")),
     "pipeline": (lambda: {"kind": "symlearn-pipeline", "out": "x", "preset": "quick", "stages": {
-        "collect": {"argv": [["collect", "--n", "5"]], "inputs": {}, "outputs": {"data/manifest.json": "ab" * 8},
+        "collect": {"config": {"n": 5, "exploration": {"k_values": [1, 2]}}, "inputs": {}, "outputs": {"data/manifest.json": "ab" * 8},
                     "wall_s": 1.5, "finished": "2026-01-01T00:00:00"}}}, "pipeline.json",
                  lambda p: __import__("symlearn.pipeline", fromlist=["x"]).load_record(p.parent)),
     "benchmark-row": (lambda: {"key": ["p0.json", "astar", False],

@@ -294,7 +294,10 @@ def test_pipeline_resumes_without_redoing_finished_stages(tmp_path):
     assert [p.stat().st_mtime_ns for p in kept] == mtimes
     record = json.loads((out / "pipeline.json").read_text())
     assert list(record["stages"]) == list(STAGE_NAMES)
-    assert record["stages"]["evaluate"]["argv"] == [["evaluate", "--run", str(out / "run"), "--data", str(out / "data")]]
+    assert record["stages"]["evaluate"]["config"] == {}  # nothing to set: it reads best.pt and the data set
+    train = record["stages"]["train"]["config"]  # the TrainConfig the stage ran with: the quick preset's, overridden
+    assert (train["preset"], train["epochs"], train["seed"], train["model"]["crop"]) == ("quick", 1, 5, 32)
+    assert record["stages"]["problems"]["config"]["n"] == 2
     assert parse(out / "run" / "report.html").sections["benchmark"] == "ok"
 
     (out / "run" / "report.html").unlink()  # a lost output: only its stage runs again

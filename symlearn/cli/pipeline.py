@@ -1,4 +1,5 @@
-"""`symlearn pipeline`: every stage from collection to the report, resumable (logic in symlearn.pipeline).
+"""`symlearn pipeline`: every stage from collection to the report, resumable (logic in symlearn.pipeline, which
+calls the library directly, never this command line).
 
     symlearn pipeline --preset quick --out pipe --n 2000 --seed 0
 """
@@ -8,11 +9,10 @@ import argparse
 from pathlib import Path
 
 from symlearn.cli.args import non_negative_int, positive_int
+from symlearn.pipeline import PRESETS, PipelineSettings, run_pipeline
 
 
 def cmd_pipeline(args: argparse.Namespace) -> int:
-    from symlearn.pipeline import PipelineSettings, run_pipeline
-
     s = PipelineSettings(preset=args.preset, out=Path(args.out), n=args.n, seed=args.seed, epochs=args.epochs,
                          transition_epochs=args.transition_epochs, problems=args.problems, workers=args.workers,
                          shard_size=args.shard_size, stop_after=args.stop_after)
@@ -24,7 +24,7 @@ def cmd_pipeline(args: argparse.Namespace) -> int:
 def add_pipeline_command(sub) -> None:
     """Add `pipeline` to the CLI's sub-parsers."""
     p = sub.add_parser("pipeline", help="run every stage (collect ... report) into one folder; resumes")
-    p.add_argument("--preset", default="quick", choices=["quick", "paper"])
+    p.add_argument("--preset", default="quick", choices=list(PRESETS))
     p.add_argument("--out", required=True, help="folder for data/, run/, problems/, logs/ and pipeline.json")
     # each value is checked here, before OUT is made, not first by the stage that uses it
     p.add_argument("--n", type=positive_int, help="samples to collect (preset's if unset: quick 1000, paper 12000)")

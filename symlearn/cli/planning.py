@@ -24,7 +24,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import sys
 from pathlib import Path
 
@@ -181,34 +180,20 @@ def note_rule_loading(run: Path, planners: list[str]) -> None:
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
-    from symlearn.planning.execution import ExecutionConfig, run_problem
-    from symlearn.planning.planners import make_planners
-    from symlearn.planning.paths import path_under
-    from symlearn.planning.problem import load_problem
-    from symlearn.sim.simulator import TabletopSimulator
-    from symlearn.symbolic.learned_transition import planning_models
+    from symlearn.planning.execution import ExecutionConfig
+    from symlearn.planning.single import plan_problem
 
-    gif, strip = _record_paths(args.record)  # refused before any work
     set_threads(args.threads)
-    problem = load_problem(Path(args.problem))
-    write_dir = path_under(Path(args.run) / "pddl" / "problems", problem.name)  # the name is checked at load
-    _check_writable(write_dir)
     note_rule_loading(Path(args.run), [args.planner])
-    fn = make_planners([args.planner], Path(args.run), write_dir=write_dir, risk_weight=args.risk_weight)[args.planner]
-    encoder, transition = planning_models(Path(args.run))
     cfg = ExecutionConfig(closed_loop=args.closed_loop, max_replans=args.max_replans, timeout_s=args.timeout)
-    recorder = None
-    if args.record:
-        from symlearn.planning.recording import PlanRecorder
-
-        recorder = PlanRecorder(width=args.record_size[0], height=args.record_size[1])
-    with TabletopSimulator() as sim:
-        row = run_problem(sim, encoder, transition, problem, args.planner, fn, cfg, recorder=recorder)
-    if recorder is not None:
-        print(f"wrote {recorder.save_gif(gif)} ({len(recorder.frames)} frames) and "
-              f"{recorder.save_filmstrip(strip)}")
-    if write_dir.exists():
-        print(f"wrote {write_dir / 'problem.pddl'}")
+    done = plan_problem(Path(args.run), Path(args.problem), args.planner, cfg,
+                        record=Path(args.record) if args.record else None, record_size=args.record_size,
+                        risk_weight=args.risk_weight)
+    problem, row = done.problem, done.row
+    if done.gif is not None:
+        print(f"wrote {done.gif} ({done.frames} frames) and {done.filmstrip}")
+    if done.write_dir.exists():
+        print(f"wrote {done.write_dir / 'problem.pddl'}")
     print(f"{problem.name} [{args.planner}{', closed loop' if row.closed_loop else ''}]: found {row.found} "
           f"({row.status}), length {row.plan_length} (generator {row.generator_length}), "
           f"time {row.planning_time_s:.3f} s, expansions {row.expansions}, success {row.success}, "
@@ -218,28 +203,6 @@ def cmd_plan(args: argparse.Namespace) -> int:
         print(f"symlearn plan: error: {args.planner} could not plan {problem.name}: {row.message}", file=sys.stderr)
         return 1
     return 0
-
-
-def _record_paths(record: str | None) -> tuple[Path | None, Path | None]:
-    """plan --record: the GIF and its filmstrip (.png beside it), checked: two paths, neither a folder nor a file
-    of another kind (e.g. RUN/transition.pt), so nothing is replaced that the user did not ask to replace."""
-    from symlearn.outputs import GIF_MAGIC, PNG_MAGIC, distinct_outputs, file_output
-
-    if not record:
-        return None, None
-    gif = Path(record)
-    strip = gif.with_suffix(".png")
-    distinct_outputs({"--record": gif, "its filmstrip": strip})
-    return (file_output(gif, "--record", kind="a GIF", magic=GIF_MAGIC),
-            file_output(strip, "--record's filmstrip", kind="a PNG", magic=PNG_MAGIC))
-
-
-def _check_writable(folder: Path) -> None:
-    """Refuse, before any work, a folder plan must write into (RUN/pddl/problems/NAME) that it cannot write."""
-    existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
-    if existing is not None and not (existing.is_dir() and os.access(existing, os.W_OK | os.X_OK)):
-        raise ValueError(f"cannot write the planner's tasks to {folder}: {existing} is not a writable folder "
-                         f"(a read-only run? copy it somewhere writable)")
 
 
 def cmd_benchmark(args: argparse.Namespace) -> int:

@@ -16,17 +16,12 @@ import numpy as np
 
 from pddl_export.bounded_json import JsonFileError, read_json_file
 from symlearn.provenance import sha256_bytes, sha256_file
+# the format is the writer's (collect); re-exported here, where readers have always found it
+from symlearn.sim.data_format import DATA_KIND, FORMAT_VERSION, SPLITS, DataError, check_shard_entries  # noqa: F401
 
-FORMAT_VERSION = 1
-DATA_KIND = "symlearn-interaction-data"
-SPLITS = ("train", "val", "test")
 ARRAY_NAMES = ("pre_depth", "post_depth", "pre_origin", "post_origin", "pre_pixels", "post_pixels",
                "action", "effect", "n_objects", "obj_type", "pre_pose", "post_pose", "grasped",
                "episode", "step")
-
-
-class DataError(ValueError):
-    """A data set that is missing, foreign, incomplete or corrupted."""
 
 
 @dataclass(frozen=True)
@@ -83,32 +78,6 @@ def load_manifest(root: Path, require_complete: bool = True) -> dict:
     if require_complete and not m.get("complete"):
         raise DataError(f"{root} is an unfinished collection; re-run the same 'symlearn collect' to finish it")
     return m
-
-
-def check_shard_entries(path: Path, m: dict) -> None:
-    """Refuse a manifest (read from `path`) whose `shards` list is missing or has a malformed entry."""
-    shards = m.get("shards")
-    if not isinstance(shards, list):
-        raise DataError(f"{path} has no list of shards ('shards' is {type(shards).__name__})")
-    for i, e in enumerate(shards):
-        problem = _shard_entry_problem(e)
-        if problem:
-            raise DataError(f"{path}: shard entry {i} {problem}")
-
-
-def _shard_entry_problem(e) -> str | None:
-    """What is wrong with one manifest shard entry, or None."""
-    if not isinstance(e, dict):
-        return f"is a {type(e).__name__}, not an object"
-    for key, kind in (("name", str), ("sha256", str), ("index", int), ("split", str), ("n_samples", int)):
-        if not isinstance(e.get(key), kind) or isinstance(e.get(key), bool):
-            return f"has no valid {key!r} (found {e.get(key)!r})"
-    name = e["name"]
-    if name != Path(name).name or not name.endswith(".npz") or name.startswith("."):
-        return f"names {name!r}, not a shard file in the data set folder"
-    if e["split"] not in SPLITS:
-        return f"has split {e['split']!r}, expected one of {', '.join(SPLITS)}"
-    return None
 
 
 def _load_shard(root: Path, entry: dict, verify: bool) -> dict[str, np.ndarray]:

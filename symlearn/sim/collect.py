@@ -34,8 +34,8 @@ from typing import Callable, Iterator
 import numpy as np
 
 from pddl_export.bounded_json import JsonFileError, read_json_file
+from symlearn.sim.data_format import DATA_KIND, FORMAT_VERSION, SPLITS, DataError, check_shard_entries
 from symlearn.sim.exploration import ExplorationConfig, sample_action, sample_scene_spec
-from symlearn.data.dataset import DATA_KIND, FORMAT_VERSION, SPLITS, DataError, check_shard_entries
 from symlearn.folder_lock import folder_lock
 from symlearn.provenance import atomic_write_bytes, atomic_write_json, sha256_file, versions
 from symlearn.sim.simulator import SimConfig, TabletopSimulator

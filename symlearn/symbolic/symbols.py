@@ -21,6 +21,7 @@ from symlearn.symbolic.transition_data import SymbolReader, symbol_reader
 from symlearn.world import LOCATIONS, N_LOCATIONS, OBJECT_SIZE, ObjectType
 
 MOVED_M = 0.01
+FREQUENT_MIN_COUNT = 100  # a symbol is frequent from this many training objects (analyse_symbols' default)
 
 
 def encode_codes(model: AttentiveDeepSym | SymbolReader, depth: np.ndarray, origin: np.ndarray,
@@ -39,7 +40,8 @@ def picked_objects(data: InteractionData) -> np.ndarray:
     return data.mask & (np.abs(pos[..., 0] - loc[:, None, 0]) < 0.03) & (np.abs(pos[..., 1] - loc[:, None, 1]) < half_y + 0.005)
 
 
-def analyse_symbols(run_dir: Path, data_dir: Path, symbol: str | None = None, min_count: int = 100) -> dict:
+def analyse_symbols(run_dir: Path, data_dir: Path, symbol: str | None = None,
+                    min_count: int = FREQUENT_MIN_COUNT) -> dict:
     """Write RUN/symbols.json (with config, seed, versions, input hashes), symbols.png and symbol_examples.png."""
     run_dir = Path(run_dir)
     model, ck = load_effect_model(run_dir, device=analysis_device())
