@@ -94,7 +94,7 @@ def command_problems(command: str, subcommands: dict[str, argparse.ArgumentParse
 
 def test_the_docs_hold_commands_to_check():
     found = {d.name: len(doc_commands(d.read_text(encoding="utf-8"))) for d in DOCS}
-    assert found["README.md"] >= 10 and found["RESULTS.md"] >= 50 and found["BENCHMARKS.md"] >= 10, found
+    assert found["README.md"] >= 10 and found["RESULTS.md"] >= 12 and found["BENCHMARKS.md"] >= 10, found
 
 
 @pytest.mark.parametrize("doc", DOCS, ids=lambda d: d.name)

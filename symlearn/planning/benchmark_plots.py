@@ -3,7 +3,7 @@ Markdown and plots.
 
 `symlearn benchmark` prints `format_grid` after a run and, with --plots DIR, writes `write_plots`'
 figures; on a saved result JSON the same come from this module's command line, which prints the
-Markdown tables that docs/BENCHMARKS.md holds:
+Markdown tables for the docs:
 
     python -m symlearn.planning.benchmark_plots bench.json --out plots/
     python -m symlearn.planning.benchmark_plots a.json b.json --out plots/   # planners split over processes
@@ -161,7 +161,7 @@ def markdown_shortest(shortest: dict) -> str:
 
 
 def markdown_grid(summary: dict) -> str:
-    """Markdown for docs/BENCHMARKS.md: the shortest-plan grids, then the reference-length grid per planner,
+    """Markdown for the docs: the shortest-plan grids, then the reference-length grid per planner,
     failure causes, and structure-suite tasks."""
     parts = [markdown_shortest(summary["shortest_grid"])] if summary.get("shortest_grid") else []
     for planner, by_loop in summary["grid"].items():

@@ -107,7 +107,7 @@ class TransitionConfig:
 
 
 TRANSITION_PRESETS = {
-    # copy_prior 3: on paper24 it raised closed-loop A* success from 0.81 to 0.91 (docs/BENCHMARKS.md).
+    # copy_prior 3: on paper24 it raised closed-loop A* success from 0.81 to 0.91 (an early paper24 run; git history of docs/BENCHMARKS.md).
     # attention_rounds stays 1: 3 rounds helped one effect model's rollouts and planning, not the other two
     # (docs/RESULTS.md, "More attention rounds in m(z)").
     "paper": TransitionConfig(preset="paper", copy_prior=3.0),
