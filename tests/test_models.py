@@ -159,3 +159,24 @@ def test_stability_loss_is_zero_only_for_agreeing_decisive_bits_of_still_objects
     pre = agree.clone().requires_grad_(True)
     code_stability_loss(pre, flip, still, 2.0).backward()
     assert pre.grad[0, 1].abs().sum() == 0 and pre.grad[0, 0].abs().sum() > 0  # only still objects are pushed
+
+
+def test_the_action_per_object_reaches_only_the_held_objects_token():
+    """With action_per_object the held object's token alone carries the action: without attention the others'
+    effects cannot depend on it (the DeepSym baseline then cannot know a rider moves), the held one's do; a
+    model that takes the action per object refuses a call without the held index."""
+    torch.manual_seed(0)
+    base = AttentiveDeepSym(ModelConfig.from_preset("quick", attention=False, action_per_object=True)).eval()
+    att = AttentiveDeepSym(ModelConfig.from_preset("quick", action_per_object=True)).eval()
+    codes = (torch.rand(1, 3, 8) > 0.5).float()
+    mask = torch.ones(1, 3, dtype=torch.bool)
+    held = torch.tensor([1])
+    e1, e2 = (base.decode(codes, mask, torch.tensor([a]), held) for a in (3, 20))
+    torch.testing.assert_close(e1[0, [0, 2]], e2[0, [0, 2]])  # the others do not see the action
+    assert not torch.allclose(e1[0, 1], e2[0, 1])  # the held object does
+    a1, a2 = (att.decode(codes, mask, torch.tensor([a]), held) for a in (3, 20))
+    assert not torch.allclose(a1[0, 0], a2[0, 0])  # with attention the others learn of it from the held one
+    nothing = base.decode(codes, mask, torch.tensor([3]), torch.tensor([-1]))
+    torch.testing.assert_close(nothing, base.decode(codes, mask, torch.tensor([20]), torch.tensor([-1])))
+    with pytest.raises(ValueError, match="per object"):
+        att.decode(codes, mask, torch.tensor([3]))

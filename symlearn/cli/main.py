@@ -85,6 +85,8 @@ def cmd_train(args: argparse.Namespace) -> int:
                                    distinct_margin=args.distinct_margin, bits=args.bits).items() if v is not None}
     if args.no_attention:
         over["attention"] = False
+    if args.action_per_object:
+        over["action_per_object"] = True
     if args.constant_lr:
         over["cosine_lr"] = False
     cfg = TrainConfig.from_preset(args.preset, bf16=not args.no_bf16, compile=args.compile, **over)
@@ -237,6 +239,8 @@ def add_train_command(sub) -> None:
     t.add_argument("--bits", type=positive_int,
                    help="code length of each object's symbol, 1-16 (default 8, the paper's: at most 256 symbols)")
     t.add_argument("--no-attention", action="store_true", help="the DeepSym baseline without attention")
+    t.add_argument("--action-per-object", action="store_true",
+                   help="give the action to the held object's token only (the authors' code), not to every object")
     t.add_argument("--rider-weight", type=positive_finite_float,
                    help="loss weight of riders, objects carried by the held one (default 1)")
     t.add_argument("--dynamics-weight", type=non_negative_finite_float,

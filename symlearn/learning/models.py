@@ -47,6 +47,10 @@ class ModelConfig:
     depth_ref: float = 2.0  # input depth d becomes (depth_ref - d) / depth_scale on object pixels
     depth_scale: float = 0.5
     dynamics_head: bool = False  # a head predicting each object's next code, trained jointly (TrainConfig.dynamics_weight)
+    # True: the action reaches only the held object's token (the authors' per-object action: the grasped object is
+    # marked), so whatever rides on it must learn that it moves from the others, through attention. False: the
+    # scene's action beside every object's code (the paper's text).
+    action_per_object: bool = False
 
     def __post_init__(self) -> None:
         if self.d_model % self.n_heads:
@@ -191,20 +195,28 @@ class AttentiveDeepSym(nn.Module):
         codes = gumbel_sigmoid(logits, self.cfg.tau, self.training, generator) * mask[..., None]
         return codes, logits
 
-    def _tokens(self, codes: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
-        """Each object's token (B, K, D): its code next to the scene's action, the same action for every object."""
+    def _tokens(self, codes: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor,
+                held: torch.Tensor | None = None) -> torch.Tensor:
+        """Each object's token (B, K, D): its code next to the scene's action; with action_per_object only the held
+        object's token carries the action (held (B,): its index, -1 when nothing was grasped)."""
         b, k = mask.shape
-        a = F.one_hot(actions.long(), N_ACTIONS).to(codes.dtype)  # (B, 36)
-        return self.inp(torch.cat([codes, a[:, None].expand(b, k, N_ACTIONS)], dim=-1))  # (B, K, D)
+        a = F.one_hot(actions.long(), N_ACTIONS).to(codes.dtype)[:, None].expand(b, k, N_ACTIONS)  # (B, K, 36)
+        if self.cfg.action_per_object:
+            if held is None or held.shape != actions.shape:
+                raise ValueError("this model takes the action per object: give held, the index of the held object "
+                                 "per scene (-1 for none), shaped like actions")
+            a = a * (torch.arange(k, device=codes.device)[None] == held.long()[:, None])[..., None].to(codes.dtype)
+        return self.inp(torch.cat([codes, a], dim=-1))
 
     @torch.no_grad()
-    def attention_maps(self, codes: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor) -> torch.Tensor | None:
+    def attention_maps(self, codes: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor,
+                       held: torch.Tensor | None = None) -> torch.Tensor | None:
         """How much each object attends to each other, per layer, averaged over heads: (layers, B, K, K), row i
         the weights object i's token puts on every object's (rows sum to 1 over real objects); None without
         attention. The same computation as decode's transformer, layer by layer (eval mode: no dropout)."""
         if self.attn is None:
             return None
-        tok, maps = self._tokens(codes, mask, actions), []
+        tok, maps = self._tokens(codes, mask, actions, held), []
         for layer in self.attn.layers:
             x = layer.norm1(tok) if layer.norm_first else tok
             maps.append(layer.self_attn(x, x, x, key_padding_mask=~mask, need_weights=True,
@@ -212,10 +224,12 @@ class AttentiveDeepSym(nn.Module):
             tok = layer(tok, src_key_padding_mask=~mask)
         return torch.stack(maps)
 
-    def decode(self, codes: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
-        """Codes (B, K, bits), mask (B, K), action ids (B,) -> normalized effects (B, K, 3)."""
+    def decode(self, codes: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor,
+               held: torch.Tensor | None = None) -> torch.Tensor:
+        """Codes (B, K, bits), mask (B, K), action ids (B,) [, held object per scene (B,)] -> normalized effects
+        (B, K, 3)."""
         b, k = mask.shape
-        tok = self._tokens(codes, mask, actions)
+        tok = self._tokens(codes, mask, actions, held)
         if self.attn is not None:
             tok = self.attn(tok, src_key_padding_mask=~mask)  # (B, K, D)
         eff_real = self.decoder(tok[mask])  # (N, 3)
@@ -224,7 +238,8 @@ class AttentiveDeepSym(nn.Module):
         return eff
 
     def forward(self, crops: torch.Tensor, mask: torch.Tensor, actions: torch.Tensor,
-                generator: torch.Generator | None = None, post_crops: torch.Tensor | None = None) -> EffectOutput:
+                generator: torch.Generator | None = None, post_crops: torch.Tensor | None = None,
+                held: torch.Tensor | None = None) -> EffectOutput:
         """Effects and codes; with post_crops (the same objects after the action) also the post-state codes
         and logits, and with a dynamics head its prediction of those codes."""
         if crops.dim() != 5 or crops.shape[:2] != mask.shape or crops.shape[2] != 3 or crops.shape[-1] != crops.shape[-2]:
@@ -235,7 +250,7 @@ class AttentiveDeepSym(nn.Module):
         if actions.numel() and (int(actions.min()) < 0 or int(actions.max()) >= N_ACTIONS):
             raise ValueError(f"unknown action id: expected 0..{N_ACTIONS - 1}")
         codes, logits = self.encode(crops, mask, generator)
-        effect = self.decode(codes, mask, actions)
+        effect = self.decode(codes, mask, actions, held)
         if post_crops is None:
             return EffectOutput(effect, codes, logits)
         if post_crops.shape != crops.shape:

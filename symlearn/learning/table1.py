@@ -56,17 +56,20 @@ def summarize_criteria(cases: list[dict]) -> dict:
 
 
 @torch.no_grad()
-def predict_scene_effects(model, ck, crops: np.ndarray, origins: np.ndarray, action_id: int) -> np.ndarray:
-    """One observed scene's crops (k, S, S) and origins (k, 2) -> predicted effects (k, 3) in metres."""
+def predict_scene_effects(model, ck, crops: np.ndarray, origins: np.ndarray, action_id: int,
+                          held: int = -1) -> np.ndarray:
+    """One observed scene's crops (k, S, S) and origins (k, 2) -> predicted effects (k, 3) in metres (held: the
+    index of the object the action grasps, read by models that take the action per object)."""
     depth = torch.from_numpy(crops.astype(np.float16).astype(np.float32))[None]  # as stored in the data set
     x = model_inputs(depth, torch.from_numpy(origins.astype(np.float32))[None])  # (1, k, 3, S, S)
     mask = torch.ones(1, crops.shape[0], dtype=torch.bool)
-    out = model.eval()(x, mask, torch.tensor([action_id]))
+    out = model.eval()(x, mask, torch.tensor([action_id]), held=torch.tensor([held]))
     return out.effect[0].numpy() * ck.effect_std + ck.effect_mean
 
 
 @torch.no_grad()
-def scene_attention(model, crops: np.ndarray, origins: np.ndarray, action_id: int) -> np.ndarray | None:
+def scene_attention(model, crops: np.ndarray, origins: np.ndarray, action_id: int,
+                    held: int = -1) -> np.ndarray | None:
     """One observed scene -> each layer's attention (layers, k, k), row i the weights object i puts on each object
     (averaged over heads); None for a model without attention."""
     depth = torch.from_numpy(crops.astype(np.float16).astype(np.float32))[None]
@@ -74,7 +77,7 @@ def scene_attention(model, crops: np.ndarray, origins: np.ndarray, action_id: in
     mask = torch.ones(1, crops.shape[0], dtype=torch.bool)
     model.eval()
     codes, _ = model.encode(x, mask)
-    maps = model.attention_maps(codes, mask, torch.tensor([action_id]))
+    maps = model.attention_maps(codes, mask, torch.tensor([action_id]), torch.tensor([held]))
     return None if maps is None else maps[:, 0].numpy()
 
 
@@ -139,8 +142,8 @@ def table1(run_dir: Path) -> dict:
             sc = SCENARIO_BY_NAME[name]
             sim.build(sc.spec)
             obs = sim.observe()
-            pred = predict_scene_effects(model, ck, obs.crops, obs.origins, sc.action.id)
-            res = sim.step(sc.action)
+            res = sim.step(sc.action)  # the grasped object, for models given the action per object
+            pred = predict_scene_effects(model, ck, obs.crops, obs.origins, sc.action.id, res.grasped)
             rows.append({"name": name, "description": sc.description,
                          "action": [sc.action.pick, sc.action.release],
                          "objects": [{"type": t.name.lower(),
@@ -149,7 +152,7 @@ def table1(run_dir: Path) -> dict:
                                      for t, p, g in zip(sim.types, pred, res.effect)]})
             for obj in rows[-1]["objects"]:
                 obj["criteria"] = judge_object(obj)
-            maps = scene_attention(model, obs.crops, obs.origins, sc.action.id)
+            maps = scene_attention(model, obs.crops, obs.origins, sc.action.id, res.grasped)
             if maps is not None:
                 rows[-1]["attention"] = np.round(maps, 3).tolist()
                 rows[-1]["rider_attention"] = rider_attention(rows[-1])
