@@ -1,52 +1,62 @@
-"""Solve one problem with every available planner on the exported domain and print the plans.
+"""Solve one problem with every planner the run supports and print a table of the plans, without executing them.
 
-    python examples/call_planners.py --run runs/quick --problem problems/p100/problem_0000.json
+    python examples/call_planners.py                         # pretrained/recommended, its tower_of_two problem
+    python examples/call_planners.py --run RUN --problem FILE [--timeout S]
 
-Codes come from the run's encoder (initial scene and goal scene); planners are the learned-net
-A* and the classical planners on RUN/pddl (run examples/generate_domain.py first).
+Start and goal codes come from the run's encoder on the problem's scenes (rendered in the simulator). The planners
+are every registry planner whose inputs the run holds: the learned-net searches always, the planners on the exported
+rules where RUN/pddl/rules.json exists, the stock Fast Downward ones where RUN/pddl/lifted.json does. Their task files
+go to a temporary folder, not into the run.
 """
 import argparse
+import tempfile
 from pathlib import Path
 
+from pddl_export.rules_io import RULES_FILE
 from pddl_export.symbolic import SymbolicGoal, code_str
-from symlearn.learning.checkpoint import load_effect_model
 from symlearn.planning.execution import safe_plan
 from symlearn.planning.lifted_export import LIFTED_FILE
+from symlearn.planning.planner_catalogue import FAMILIES
 from symlearn.planning.planners import PLANNERS, make_planners
 from symlearn.planning.problem import load_problem
-from symlearn.planning.scenes import goal_codes, place_scene
+from symlearn.planning.scenes import scene_codes, symbolic_goal
 from symlearn.sim.simulator import TabletopSimulator
-from symlearn.symbolic.learned_transition import LearnedTransition
-from symlearn.symbolic.transition_data import encode_observation
+from symlearn.symbolic.learned_transition import planning_models
 from symlearn.world import decode_action
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def supported(run: Path) -> list[str]:
+    """The planners whose inputs the run holds, in the order of their families."""
+    has_rules, has_lifted = (run / "pddl" / RULES_FILE).is_file(), (run / "pddl" / LIFTED_FILE).is_file()
+    names = [n for _, family, _ in FAMILIES for n in family]
+    return [n for n in names if (has_rules or not PLANNERS[n].needs_rules) and (has_lifted or not PLANNERS[n].needs_lifted)]
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--run", required=True)
-    ap.add_argument("--problem", required=True)
-    ap.add_argument("--timeout", type=float, default=30.0)
+    ap.add_argument("--run", default=str(ROOT / "pretrained" / "recommended"))
+    ap.add_argument("--problem", help="problem JSON file (default RUN/problems/tower_of_two.json)")
+    ap.add_argument("--timeout", type=float, default=10.0)
     args = ap.parse_args()
     run = Path(args.run)
-    names = list(PLANNERS)
-    if not (run / "pddl" / LIFTED_FILE).is_file():  # the lifted domain needs an m(z) on 9 location bits
-        names = [n for n in names if not PLANNERS[n].needs_lifted]
-        print(f"no {run / 'pddl' / LIFTED_FILE}: the planners on the lifted domain are left out "
-              f"(symlearn export-pddl --lifted writes it)")
-    planners = make_planners(names, run)
-    encoder, _ = load_effect_model(run)
-    transition = LearnedTransition.from_run(run)
-    problem = load_problem(Path(args.problem))
+    problem = load_problem(Path(args.problem) if args.problem else run / "problems" / "tower_of_two.json")
+    names = supported(run)
+    reader, transition = planning_models(run)
     with TabletopSimulator() as sim:
-        goal = goal_codes(sim, encoder, problem)
-        place_scene(sim, problem.initial)
-        start = encode_observation(encoder, sim.observe())
+        goal = symbolic_goal(sim, reader, problem)
+        start = scene_codes(sim, reader, problem.initial)
     bits = transition.bits
-    print(f"{problem.name}: start {[code_str(c, bits) for c in start]} -> goal {[code_str(c, bits) for c in goal]}")
-    for name, fn in planners.items():
-        res = safe_plan(name, fn, transition, start, SymbolicGoal(tuple(int(c) for c in goal)), args.timeout)
-        steps = ", ".join(f"pick {decode_action(a).pick} release {decode_action(a).release}" for a in res.plan)
-        print(f"{name:>18}: {res.status.value:<10} {res.planning_time_s:7.3f} s  [{steps}] {res.message[:80]}")
+    print(f"{problem.name} ({problem.k} objects, shortest plan {problem.optimal_length}): start "
+          f"{[code_str(c, bits) for c in start]}\n  goal {[code_str(c, bits) if c is not None else '*' for c in goal.codes]}")
+    print(f"\n{'planner':<26} {'status':<9} {'time s':>7} {'length':>6}  plan (pick -> release)")
+    with tempfile.TemporaryDirectory(prefix="call-planners-") as tmp:
+        planners = make_planners(names, run, write_dir=Path(tmp))
+        for name, fn in planners.items():
+            res = safe_plan(name, fn, transition, start, goal, args.timeout)
+            steps = ", ".join(f"{decode_action(a).pick}->{decode_action(a).release}" for a in res.plan)
+            print(f"{name:<26} {res.status.value:<9} {res.planning_time_s:7.3f} {len(res.plan):>6}  {steps}")
 
 
 if __name__ == "__main__":

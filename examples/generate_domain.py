@@ -1,28 +1,43 @@
-"""Write the PDDL domain of a trained run, without any training.
+"""Write a run's lifted PDDL domain and one problem file per problem, ready for any PDDL planner: no data, no training.
 
-    python examples/generate_domain.py --run runs/quick --data data/paper [--out runs/quick/pddl]
+    python examples/generate_domain.py                      # pretrained/recommended -> ./lifted_domain
+    python examples/generate_domain.py --run RUN --problems DIR --out OUT
 
-Needs a run with best.pt (symlearn train) and transition.pt (symlearn train-transition).
+The domain is the run's lifted rules (RUN/pddl/lifted.json, written by `symlearn export-pddl --lifted`) as typed
+STRIPS schemas; each problem's start and goal are the run's codes of its scenes, rendered in the simulator. Then
+e.g. `fast-downward.py --alias lama-first OUT/domain.pddl OUT/p01.pddl`.
 """
 import argparse
+import re
 from pathlib import Path
 
-from symlearn.planning.export import ExportConfig, export_pddl
+from pddl_export.lifted_rules import load_lifted
+from symlearn.planning.lifted_export import LIFTED_FILE, write_problem_folder
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--run", required=True)
-    ap.add_argument("--data", required=True)
-    ap.add_argument("--out")
-    ap.add_argument("--pddl-fidelity-cases", type=int, default=200)
+    ap.add_argument("--run", default=str(ROOT / "pretrained" / "recommended"))
+    ap.add_argument("--problems", help="problem folder (default RUN/problems)")
+    ap.add_argument("--out", default="lifted_domain", help="folder to write (refused if it holds other files)")
     args = ap.parse_args()
-    report = export_pddl(Path(args.run), Path(args.data), ExportConfig(pddl_fidelity_cases=args.pddl_fidelity_cases),
-                         Path(args.out) if args.out else None)
-    out = Path(args.out) if args.out else Path(args.run) / "pddl"
-    print((out / "domain.pddl").read_text()[:1500])
-    print(f"... {report['n_rules']} rules over {report['vocabulary_size']} codes, fidelity {report['fidelity']}, "
-          f"through the PDDL {report['pddl_fidelity']} ({report['pddl_fidelity_cases']} cases); wrote {out}")
+    run, out = Path(args.run), Path(args.out)
+    problems = Path(args.problems) if args.problems else run / "problems"
+    if out.exists() and any(p.suffix not in (".pddl", ".json") for p in out.iterdir()):
+        raise SystemExit(f"generate_domain.py: error: {out} holds files other than a domain folder's; give another --out")
+    rules = load_lifted(run / "pddl" / LIFTED_FILE)
+    index = write_problem_folder(run, problems, out)
+    domain = (out / "domain.pddl").read_text()
+    print(f"domain {out / 'domain.pddl'}: {len(domain) / 1000:.0f} KB, {domain.count('(:action ')} typed STRIPS "
+          f"schemas distilled from {rules.stats.get('moves')} observed moves, the same file for any number of objects")
+    print("predicates: " + " ".join(sorted(set(re.findall(r"\((bit-\d+|no-bit-\d+|[a-z]+) \?", domain)))))
+    print(f"\n{'problem':<8} {'objects':>7} {'shortest plan':>13}  source")
+    for name, p in index["problems"].items():
+        print(f"{name:<8} {p['objects']:>7} {str(p['optimal_length']):>13}  {p['file']}")
+    first = domain.index("  ; rule")
+    print("\nthe first rule:\n" + domain[first:domain.index("\n  ;", first + 1)])
 
 
 if __name__ == "__main__":

@@ -1,7 +1,6 @@
 """export-pddl on a real (tiny) run, PDDL planners in the benchmark registry, and the examples."""
 import json
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
@@ -147,33 +146,6 @@ def test_network_disagreement_detected():
 
     plan = PlanResult("x", PlanStatus.SOLVED, (3,), ((5,), (7,)), None, 0.1)
     assert not network_agrees(Const(), plan)
-
-
-def test_examples_run_end_to_end(run, tmp_path):
-    env_run, probs = str(run / "run"), run / "problems"
-    problem = sorted(probs.glob("*.json"))[0]
-    cmds = [
-        [sys.executable, "examples/generate_domain.py", "--run", env_run, "--data", str(run / "data"),
-         "--out", str(tmp_path / "pddl"), "--pddl-fidelity-cases", "20"],
-        [sys.executable, "examples/call_planners.py", "--run", env_run, "--problem", str(problem), "--timeout", "20"],
-        [sys.executable, "examples/compare_planners.py", "--run", env_run, "--problems", str(probs),
-         "--out", str(tmp_path / "cmp"), "--planners", "astar,fast-downward,pyperplan", "--timeout", "20"],
-    ]
-    outs = []
-    for cmd in cmds:
-        r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=600)
-        assert r.returncode == 0, r.stderr[-1500:]
-        outs.append(r.stdout)
-    written = rules_from_json(json.loads((tmp_path / "pddl" / "rules.json").read_text()))
-    _check_domain((tmp_path / "pddl" / "domain.pddl").read_text(), written)
-    assert "(define (domain" in outs[0]
-    assert "fast-downward" in outs[1] and "astar" in outs[1]
-    bench = json.loads((tmp_path / "cmp" / "benchmark.json").read_text())
-    assert set(bench["summary"]) == {"astar", "fast-downward", "pyperplan"}
-    import matplotlib.image
-
-    image = matplotlib.image.imread(tmp_path / "cmp" / "comparison.png")  # a readable PNG with pixels in it
-    assert image.ndim == 3 and min(image.shape[:2]) > 50 and image.std() > 0
 
 
 def test_export_writes_second_outcomes_and_rules_outcomes_plans_on_them(run):

@@ -673,12 +673,13 @@ def format_table(result: dict) -> str:
     """The benchmark summary as a text table, one row per planner."""
     cols = [("success_rate", "success"), ("success_rate_closed_loop", "closed"), ("found_rate", "found"),
             ("median_time_s", "med t (s)"), ("mean_plan_length", "plan len"), ("mean_generator_length", "gen len")]
-    head = f"{'planner':<20}" + "".join(f"{label:>11}" for _, label in cols)
+    width = max([20, *(len(p) + 2 for p in result["summary"])])  # the longest planner name still lines up
+    head = f"{'planner':<{width}}" + "".join(f"{label:>11}" for _, label in cols)
     lines = [head, "-" * len(head)]
     for planner, s in result["summary"].items():
         cells = []
         for key, _ in cols:
             v = s.get(key)
             cells.append(f"{'-':>11}" if v is None else f"{v:>11.3f}" if isinstance(v, float) else f"{v:>11}")
-        lines.append(f"{planner:<20}" + "".join(cells))
+        lines.append(f"{planner:<{width}}" + "".join(cells))
     return "\n".join(lines)

@@ -2571,9 +2571,7 @@
       (not (height l1 h3))
       (height l1 h0)
       (not (height l4 h0))
-      (height l4 h1)
-      (not (height l5 None))
-      (height l5 h3)))
+      (height l4 h1)))
   ; rule of 10 observed moves; a stick lands on its release location at level 3
   (:action pick-release-stick-l0-l4-94
     :parameters (?o - stick)
@@ -3962,9 +3960,7 @@
       (not (height l1 h3))
       (height l1 h0)
       (not (height l4 h0))
-      (height l4 h1)
-      (not (height l3 None))
-      (height l3 h1)))
+      (height l4 h1)))
   ; rule of 14 observed moves; a stick lands on its release location at level 3
   (:action pick-release-stick-l2-l4-139
     :parameters (?o - stick)

@@ -1,0 +1,61 @@
+"""The examples run as written, on the shipped run, with no data collected first: each one's defaults, from a fresh
+folder, and what it prints and writes checked against the run it reads."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+RECOMMENDED = ROOT / "pretrained" / "recommended"
+
+
+def _example(name: str, cwd: Path, *args: str) -> str:
+    r = subprocess.run([sys.executable, str(ROOT / "examples" / name), *args], cwd=cwd, capture_output=True,
+                       text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]
+    return r.stdout
+
+
+def test_generate_domain_writes_the_runs_lifted_domain_and_problems_a_parser_loads(tmp_path):
+    from pddl import parse_domain, parse_problem
+    out = _example("generate_domain.py", tmp_path)
+    folder = tmp_path / "lifted_domain"
+    assert (folder / "domain.pddl").read_text() == (RECOMMENDED / "pddl" / "lifted" / "domain.pddl").read_text()
+    domain = parse_domain(folder / "domain.pddl")
+    assert len(domain.actions) == 209 and "209 typed STRIPS schemas" in out
+    index = json.loads((folder / "index.json").read_text())
+    shipped = sorted(p.name for p in (RECOMMENDED / "problems").glob("*.json"))
+    assert sorted(p["file"] for p in index["problems"].values()) == shipped
+    for name, entry in index["problems"].items():
+        problem = parse_problem(folder / f"{name}.pddl")
+        assert len(problem.objects) == entry["objects"]
+        assert f"{name:<8} {entry['objects']:>7}" in out
+    (tmp_path / "lifted_domain" / "notes.txt").write_text("mine")  # a folder holding other files is refused
+    r = subprocess.run([sys.executable, str(ROOT / "examples" / "generate_domain.py")], cwd=tmp_path,
+                       capture_output=True, text=True, timeout=600)
+    assert r.returncode != 0 and "holds files other than" in r.stderr
+
+
+def test_call_planners_solves_the_tower_with_every_planner_the_run_supports(tmp_path):
+    out = _example("call_planners.py", tmp_path)
+    rows = {line.split()[0]: line.split() for line in out.splitlines()[4:] if line.strip()}
+    # the shipped run has m(z) and the lifted domain, no rules.json: the learned net and stock Fast Downward
+    assert set(rows) == {"astar-outcomes", "astar", "astar-likely", "astar-ucs", "fast-downward-lifted",
+                         "fast-downward-lifted-opt"}
+    for name, cells in rows.items():
+        assert cells[1] == "solved" and cells[3] == "2", (name, cells)  # the tower's shortest plan: 2 actions
+    assert not any((RECOMMENDED / "pddl").glob("problems"))  # nothing written into the shipped run
+
+
+@pytest.mark.slow
+def test_compare_planners_executes_every_plan_and_plots(tmp_path):
+    """Slow (a minute or two): every default planner on the shipped run's four problems, closed loop."""
+    import matplotlib.image
+    out = _example("compare_planners.py", tmp_path)
+    bench = json.loads((tmp_path / "compare" / "benchmark.json").read_text())
+    assert list(bench["summary"]) == ["astar-outcomes", "astar", "fast-downward-lifted", "fast-downward-lifted-opt"]
+    assert bench["summary"]["astar-outcomes"]["success_rate_closed_loop"] == 1.0
+    assert bench["n_problems"] == 4 and "astar-outcomes" in out
+    assert matplotlib.image.imread(tmp_path / "compare" / "comparison.png").std() > 0
