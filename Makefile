@@ -47,6 +47,8 @@ demo: $(VENV)/.installed
 test: $(VENV)/.installed
 	$(BIN)/python -m pytest -q
 
+# Also the tests marked slow: the paper preset's pipeline on 12,000 samples (tests/test_paper_scale.py), hours on
+# 2 CPU cores.
 test-all: $(VENV)/.installed
 	$(BIN)/python -m pytest -q -m ''
 

@@ -42,6 +42,40 @@ def cli_json(*args) -> dict:
     return json.loads(out)
 
 
+def recomputed_transition_accuracy(run: Path, data: Path, split: str = "test") -> dict[str, float]:
+    """m(z)'s one-step accuracy on a split, recomputed apart from symlearn's metrics code, for checking its reports.
+
+    The split's objects are encoded to integer codes (symlearn.symbolic.symbols.encode_codes), each sample's real
+    objects alone (no padding, no mask) go through the run's m(z) as a planner calls it (LearnedTransition on
+    codes), and the bits of its predictions are compared here with the bits of the encoded after-codes: bit,
+    object (all bits right) and scene (all objects right) accuracy, plus the copy baseline's scene accuracy.
+    """
+    import numpy as np
+
+    from pddl_export.symbolic import bits_from_codes
+    from symlearn.data.dataset import load_split
+    from symlearn.symbolic.learned_transition import planning_models
+    from symlearn.symbolic.symbols import encode_codes
+
+    reader, transition = planning_models(run)
+    d = load_split(data, split)
+    before = encode_codes(reader, d.pre_depth, d.pre_origin, d.mask)
+    after = encode_codes(reader, d.post_depth, d.post_origin, d.mask)
+    bits_ok, objects_ok, scenes_ok, copies_ok = [], [], [], []
+    for pre, post, mask, action in zip(before, after, d.mask, d.action):
+        pre, post = pre[mask], post[mask]
+        pred = transition(pre[None], np.array([int(action)]))[0]
+        ok = bits_from_codes(pred, transition.bits) == bits_from_codes(post, transition.bits)  # (k, bits)
+        bits_ok.append(ok.ravel())
+        objects_ok.append(ok.all(1))
+        scenes_ok.append(ok.all())
+        copies_ok.append((pre == post).all())
+    return {"bit_accuracy": float(np.concatenate(bits_ok).mean()),
+            "object_accuracy": float(np.concatenate(objects_ok).mean()),
+            "scene_accuracy": float(np.mean(scenes_ok)), "copy_scene_accuracy": float(np.mean(copies_ok)),
+            "n": len(scenes_ok)}
+
+
 @dataclass(frozen=True)
 class TinyData:
     """The session's tiny data set and the summary `symlearn collect` printed for it."""

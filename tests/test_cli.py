@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import torch
 
-from conftest import TINY_TRANSITION_ARGS, TINY_TRAIN_ARGS, cli, cli_json
+from conftest import TINY_TRANSITION_ARGS, TINY_TRAIN_ARGS, cli, cli_json, recomputed_transition_accuracy
 
 ROOT = Path(__file__).resolve().parents[1]
 N_ACTIONS = 36
@@ -130,7 +130,9 @@ def test_other_code_length_runs_through_the_pipeline(tiny_data, tmp_path):
     pre, post = training_codes(run, tiny_data.path)
     assert pre.max() < 16 and post.max() < 16 and (pre >= 0).sum() > 0
     t = cli_json("train-transition", "--run", run, "--data", tiny_data.path, *TINY_TRANSITION_ARGS, "--quiet")
-    assert 0 <= t["test"]["bit_accuracy"] <= 1
+    want = recomputed_transition_accuracy(run, tiny_data.path)
+    assert t["test"]["bit_accuracy"] == pytest.approx(want["bit_accuracy"], abs=1e-5)
+    assert t["test"]["scene_accuracy"] == pytest.approx(want["scene_accuracy"], abs=1e-5)
     rc, _ = cli("export-pddl", "--run", run, "--data", tiny_data.path, "--max-objects", 2, "--pddl-fidelity-cases", 20)
     rules = json.loads((run / "pddl" / "rules.json").read_text())
     rep = json.loads((run / "pddl" / "report.json").read_text())
@@ -172,13 +174,18 @@ def test_evaluate_table1_symbols(tiny_data, tiny_run, tiny_run_copy):
 
 
 def test_train_transition_output(tiny_run):
+    """The printed test accuracies are m(z)'s on the test split, as recomputed from the data and transition.pt."""
     t = tiny_run.transition
     acc = t["test"]
-    assert all(0 <= acc[k] <= 1 for k in acc)
+    want = recomputed_transition_accuracy(tiny_run.path, tiny_run.data)
+    m = json.loads((tiny_run.path / "transition_metrics.json").read_text())
+    assert want["n"] == m["test"]["n"] == m["n_samples"]["test"] == 4  # the tiny data set's 4 test samples
+    assert m["test"]["copy_baseline"]["scene_accuracy"] == pytest.approx(want["copy_scene_accuracy"], abs=1e-5)
+    for k in ("bit_accuracy", "object_accuracy", "scene_accuracy"):
+        assert acc[k] == pytest.approx(want[k], abs=1e-5), k  # the report rounds to 5 decimals
     assert acc["bit_accuracy"] >= acc["object_accuracy"]  # a right object has all its bits right
     assert list(t["rollout_scene_accuracy"]) == [str(n) for n in range(1, 9)]
     assert t["rollout_scene_accuracy"]["1"] == acc["scene_accuracy"]
-    m = json.loads((tiny_run.path / "transition_metrics.json").read_text())
     assert m["best_val_loss"] == t["best_val_loss"] and m["test"]["bit_accuracy"] == acc["bit_accuracy"]
     assert 0 < t["best_val_loss"] < 5 and len(m["history"]) == 3
 

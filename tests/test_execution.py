@@ -370,7 +370,9 @@ def test_benchmark_writes_summary_and_rows(tmp_path, sim, run_dir, problems):
         stages = [r["failure_stage"] for r in open_rows if r["failure_stage"]]
         assert s["failure_stages"] == {st: stages.count(st) for st in set(stages)}
         assert all((r["failure_stage"] is None) == r["success"] for r in saved["rows"])
-        assert all(r["plan_length"] is None or r["plan_length"] >= 0 for r in saved["rows"])
+        assert all((r["plan_length"] is None) != r["found"] for r in saved["rows"])  # a length exactly with a plan
+        lengths = [r["plan_length"] for r in open_rows if r["found"]]
+        assert s["mean_plan_length"] == (pytest.approx(np.mean(lengths), abs=1e-3) if lengths else None)
     assert {r["closed_loop"] for r in saved["rows"]} == {False, True}
     assert "astar-ucs" in bench.format_table(res)
     assert "risk_weight" not in saved  # no planner here depends on it

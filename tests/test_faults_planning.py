@@ -18,6 +18,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from conftest import cli
@@ -284,12 +285,43 @@ def test_plan_refuses_impossible_scene_with_one_line(tiny_run, problems, tmp_pat
     _one_line_error(capsys, "plan", str(path), "not a unit quaternion")
 
 
-def test_valid_problem_scenes_pass_the_reach_check(problems):
-    from symlearn.planning.problem import check_scene, load_problems
+def _moved(scene, i: int, axis: int, value: float):
+    """The scene with object i's position on `axis` (0 x, 1 y, 2 z) set to value."""
+    import dataclasses
 
-    for _, pr in load_problems(problems):
-        check_scene(pr.initial, pr.name)
-        check_scene(pr.goal, pr.name)
+    o = scene.objects[i]
+    pos = list(o.position)
+    pos[axis] = value
+    objs = list(scene.objects)
+    objs[i] = dataclasses.replace(o, position=tuple(pos))
+    return dataclasses.replace(scene, objects=tuple(objs))
+
+
+def test_valid_problem_scenes_pass_the_reach_check(problems):
+    """The simulator's generated scenes (initial and goal) pass check_scene, with room to spare: each object rests
+    on the table, more than 15 cm inside the reach box's sides. The check is no rubber stamp: the same scenes with
+    one object moved 1 um past any edge of the reach box are refused, and 1 um inside it they still pass."""
+    from symlearn.planning.problem import (REACH_CENTER_X, REACH_HALF_X, REACH_HALF_Y, REACH_Z_MAX, check_scene,
+                                           load_problems)
+    from symlearn.world import TABLE_TOP_Z
+
+    loaded = load_problems(problems)
+    assert [p.name for p, _ in loaded] == [f"problem_{i:04d}.json" for i in range(4)]
+    eps = 1e-6
+    edges = [(0, REACH_CENTER_X + REACH_HALF_X, -1.0), (0, REACH_CENTER_X - REACH_HALF_X, 1.0),
+             (1, REACH_HALF_Y, -1.0), (1, -REACH_HALF_Y, 1.0), (2, TABLE_TOP_Z, 1.0), (2, REACH_Z_MAX, -1.0)]
+    for _, pr in loaded:
+        for scene in (pr.initial, pr.goal):
+            assert scene.k == pr.k and 1 <= scene.k <= 2
+            assert check_scene(scene, pr.name) is None
+            pos = scene.positions()
+            margin = np.minimum(REACH_HALF_X - np.abs(pos[:, 0] - REACH_CENTER_X), REACH_HALF_Y - np.abs(pos[:, 1]))
+            assert (margin > 0.15).all(), pos  # the grid spans x 0.5-0.8, y -0.3-0.3: a stick's centre may lie between
+            assert ((pos[:, 2] > TABLE_TOP_Z) & (pos[:, 2] < TABLE_TOP_Z + 0.2)).all(), pos  # on the table, not flung
+            for axis, edge, inward in edges:
+                with pytest.raises(ValueError, match="out of the table's reach"):  # 1 um past the edge
+                    check_scene(_moved(scene, 0, axis, edge - inward * eps), pr.name)
+                assert check_scene(_moved(scene, 0, axis, edge + inward * eps), pr.name) is None
 
 
 # ------------------------------------------------------------------------------- 5. interrupted benchmarks

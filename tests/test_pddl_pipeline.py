@@ -102,29 +102,69 @@ def test_malformed_rules_refused(tmp_path):
         load_rules(tmp_path)
 
 
+def _one_step_task(run: Path, rules) -> tuple[np.ndarray, int, np.ndarray]:
+    """A start scene the export enumerated, an action and the successor the rules give it, which differs from it.
+
+    Every rule was distilled from a changing case of an enumerated (observed) scene, so some such scene and
+    action exist whenever the export wrote a rule; the scene with the most objects is taken first, so the
+    planners meet other objects (the rules' contexts) too. The successor is one action away: a goal made of it
+    is provably reachable, and every planner must return a plan.
+    """
+    from pddl_export.rules import apply_rules
+    from symlearn.planning.export import observed_scenes, training_codes
+
+    assert rules.n_rules >= 1, "the tiny run exported no rule: nothing to plan on"
+    scenes = observed_scenes(set(rules.vocabulary), rules.max_objects, *training_codes(run / "run", run / "data"))
+    report = json.loads((run / "run" / "pddl" / "report.json").read_text())
+    assert len(scenes) == report["n_enumerated_scenes"]  # the very scenes the rules are exact on
+    for scene in sorted(scenes, key=lambda s: (-len(s), s)):
+        start = np.array(scene, np.int64)
+        for action in rules.actions:
+            nxt = apply_rules(rules, start, action)
+            if (nxt != start).any():
+                return start, int(action), nxt
+    raise AssertionError("no rule fires on any enumerated scene, though every rule came from one")
+
+
+# planner -> whether it returns shortest plans (the goal is one action away: then exactly one action)
+PDDL_PLANNERS = {"fast-downward": False, "fast-downward-blind": True, "pyperplan": False, "fast-downward-sas": False}
+
+
 def test_pddl_planner_plans_on_exported_rules_and_agrees_with_net(run):
-    rules, model_hash = load_rules(run / "run")
-    tr = LearnedTransition.from_run(run / "run")
-    changing = [r for r in rules.rules if not r.requires and not r.at_least]
-    if not changing:
-        pytest.skip("the tiny network changes no code without context")
-    r = changing[0]
-    start = np.array([r.code_from])
-    goal_code = int(tr(start[None], np.array([r.action]))[0, 0])
+    """Fast Downward (PDDL and SAS+) and pyperplan plan to a goal one rule step from an enumerated scene.
+
+    Each plan reaches the goal under the rules, its predicted states are the network's (the rules are exact on
+    the enumerated scenes), and unified-planning's validator finds it valid on the conditional PDDL problem,
+    while it refuses the empty plan (the start is not the goal).
+    """
+    from pddl_export.rules import apply_rules
     from pddl_export.symbolic import SymbolicGoal
 
-    goal = SymbolicGoal((goal_code,))
-    for name in ("fast-downward", "pyperplan", "fast-downward-sas"):
+    rules, model_hash = load_rules(run / "run")
+    tr = LearnedTransition.from_run(run / "run")
+    start, action, successor = _one_step_task(run, rules)
+    assert tr(start[None], np.array([action]))[0].tolist() == successor.tolist()  # rules == network here
+    goal = SymbolicGoal(tuple(int(c) for c in successor))
+    assert _validate(rules, model_hash, start.tolist(), goal, ()) == "INVALID"
+    assert _validate(rules, model_hash, start.tolist(), goal, (action,)) == "VALID"
+    for name, shortest in PDDL_PLANNERS.items():
         res = make_pddl_planner(rules, model_hash, name)(tr, start, goal, 30.0)
-        assert res.status is PlanStatus.SOLVED, res.message
+        assert res.status is PlanStatus.SOLVED, (name, res.message)
+        assert (len(res.plan) == 1) if shortest else (len(res.plan) >= 1), (name, res.plan)
         write_key = "sas_write_time_s" if name.endswith("-sas") else "pddl_write_time_s"
         assert write_key in res.extra and res.extra["rules_vs_net"] is False
-        assert network_agrees(tr, res)
-        _validate(rules, model_hash, start.tolist(), goal, res.plan)
+        state = start
+        for a in res.plan:
+            state = apply_rules(rules, state, a)
+        assert state.tolist() == successor.tolist(), name  # the plan reaches the goal under the rules
+        assert res.predicted_states[0] == tuple(start.tolist()) and res.predicted_states[-1] == goal.codes
+        assert network_agrees(tr, res), name
+        assert _validate(rules, model_hash, start.tolist(), goal, res.plan) == "VALID", name
 
 
-def _validate(rules, model_hash: str, init: list[int], goal, plan: tuple[int, ...]) -> None:
-    """The plan is valid on the conditional PDDL problem (unified-planning's validator); its objects are the scene's."""
+def _validate(rules, model_hash: str, init: list[int], goal, plan: tuple[int, ...]) -> str:
+    """unified-planning's verdict (VALID / INVALID) on the plan in the conditional PDDL problem, whose objects
+    must be the scene's."""
     from unified_planning.io import PDDLReader
     from unified_planning.plans import ActionInstance, SequentialPlan
     from unified_planning.shortcuts import PlanValidator
@@ -134,7 +174,7 @@ def _validate(rules, model_hash: str, init: list[int], goal, plan: tuple[int, ..
     assert sorted(o.name for o in problem.all_objects if o.type.name == "obj") == [object_name(i) for i in range(len(init))]
     up_plan = SequentialPlan([ActionInstance(problem.action(action_name(a))) for a in plan])
     with PlanValidator(problem_kind=problem.kind, plan_kind=up_plan.kind) as validator:
-        assert validator.validate(problem, up_plan).status.name == "VALID"
+        return validator.validate(problem, up_plan).status.name
 
 
 def test_network_disagreement_detected():

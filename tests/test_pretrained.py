@@ -1,16 +1,87 @@
 """The shipped pretrained run: small, safely loadable, and it solves its problem in simulation right away."""
+from __future__ import annotations
+
 import json
 import shutil
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
+import numpy as np
 import pytest
 
 from conftest import cli
 from pddl_export.files import sha256_file
 from pddl_export.rules_io import load_rules
 
+if TYPE_CHECKING:
+    from symlearn.planning.execution import ProblemRun
+    from symlearn.planning.problem import Problem
+    from symlearn.world import Scene
+
 PRETRAINED = Path(__file__).resolve().parents[1] / "pretrained" / "quick-authors12k"
 PROBLEM = PRETRAINED / "problems" / "three_objects_two_actions.json"
+
+
+@dataclass(frozen=True)
+class Executed:
+    """What planning and executing one problem in simulation gave: the row, the scene the arm left, its codes."""
+
+    row: ProblemRun  # as `symlearn plan` prints it and `symlearn benchmark` writes it
+    problem: Problem
+    scene: Scene  # the poses after execution
+    codes: tuple[int, ...]  # the encoder's codes of the executed scene
+    goal_codes: tuple[int, ...]  # the encoder's codes of the problem's goal scene
+
+
+def _plan_and_execute(sim, tmp_path: Path, run: Path, problem_path: Path, planner: str, closed_loop: bool = False,
+                      recorder=None) -> Executed:
+    """What `symlearn plan` does, through the library calls it makes, on a copy of the run (planners write their
+    task files under it): plan, execute in the session's simulator, and read back the executed scene and codes."""
+    from symlearn.planning.execution import ExecutionConfig, run_problem
+    from symlearn.planning.planners import make_planners
+    from symlearn.planning.problem import load_problem
+    from symlearn.planning.scenes import scene_codes
+    from symlearn.symbolic.learned_transition import planning_models
+    from symlearn.symbolic.transition_data import encode_observation
+
+    copy = tmp_path / "run"
+    shutil.copytree(run, copy)
+    problem = load_problem(problem_path)
+    fn = make_planners([planner], copy, write_dir=copy / "pddl" / "problems" / problem.name)[planner]
+    encoder, transition = planning_models(copy)
+    row = run_problem(sim, encoder, transition, problem, planner, fn, ExecutionConfig(closed_loop=closed_loop),
+                      recorder=recorder)
+    scene, codes = sim.get_scene(), tuple(encode_observation(encoder, sim.observe()).tolist())
+    return Executed(row, problem, scene, codes, tuple(scene_codes(sim, encoder, problem.goal).tolist()))
+
+
+def _assert_goal_reached(ex: Executed) -> None:
+    """The row says success, and the executed scene shows it: every judged object within the 2 cm tolerance of its
+    goal position (the largest distance is the row's), and the executed scene's codes are the goal scene's."""
+    from symlearn.planning.problem import GOAL_TOLERANCE_M
+
+    row, problem = ex.row, ex.problem
+    assert row.found and row.status == "solved" and row.success and row.symbolic_match, row
+    assert row.failure_stage is None and row.failure_cause is None, row
+    judged = [i for i in range(problem.k) if i not in problem.free]
+    dist = np.linalg.norm(ex.scene.positions()[judged] - problem.goal.positions()[judged], axis=1)
+    assert dist.max() < GOAL_TOLERANCE_M, dist
+    assert row.max_distance_m == pytest.approx(dist.max(), abs=1e-5)
+    assert [ex.codes[i] for i in judged] == [ex.goal_codes[i] for i in judged]
+    assert row.executed_length is not None and row.executed_length >= row.plan_length >= 1
+
+
+def _rests_on(scene: Scene, top: int, bottom: int) -> bool:
+    """Whether object `top` stands on object `bottom`: its base within 1.5 cm of bottom's top face, its centre over
+    bottom's footprint (objects upright, sticks along y, as the simulator places them)."""
+    from symlearn.world import OBJECT_SIZE
+
+    t, b = scene.objects[top], scene.objects[bottom]
+    (tx, ty, tz), (bx, by, bz) = t.position, b.position
+    bw, bl, bh = OBJECT_SIZE[b.type]
+    base = tz - OBJECT_SIZE[t.type][2] / 2
+    return abs(base - (bz + bh / 2)) < 0.015 and abs(tx - bx) < bw / 2 and abs(ty - by) < bl / 2
 
 
 def test_pretrained_run_is_small_and_consistent():
@@ -30,29 +101,46 @@ def test_pretrained_run_is_small_and_consistent():
 
 
 @pytest.mark.parametrize("planner", ["astar", "fast-downward-sas-opt"])
-def test_pretrained_run_solves_its_problem_in_simulation(tmp_path, planner):
-    run = tmp_path / "run"  # planning writes its task files into the run: use a copy, not the repository
-    shutil.copytree(PRETRAINED, run)
-    rc, text = cli("plan", "--run", run, "--problem", PROBLEM, "--planner", planner, "--record", tmp_path / "p.gif")
-    assert rc == 0, text
-    line = [ln for ln in text.splitlines() if ln.startswith("problem_0008")][-1]
-    assert "success True" in line and "length 2" in line, line
+def test_pretrained_run_solves_its_problem_in_simulation(sim, tmp_path, planner):
+    """Open loop, a shortest (2-action) plan brings every object to its goal position and codes; 3 frames recorded."""
     from PIL import Image
-    with Image.open(tmp_path / "p.gif") as gif:
-        assert gif.n_frames == 3  # the start and one frame per action
+
+    from symlearn.planning.recording import PlanRecorder
+
+    recorder = PlanRecorder()
+    ex = _plan_and_execute(sim, tmp_path, PRETRAINED, PROBLEM, planner, recorder=recorder)
+    assert ex.problem.name == ex.row.problem == "problem_0008" and ex.row.generator_length == 2
+    _assert_goal_reached(ex)
+    assert ex.row.plan_length == ex.row.executed_length == 2 and ex.row.replans == 0 and not ex.row.closed_loop
+    assert len(recorder.frames) == 3  # the start and one frame per action
+    with Image.open(recorder.save_gif(tmp_path / "p.gif")) as gif:
+        assert gif.n_frames == 3
+
+
+# Both structures take two picks at least, and two suffice: each of the tower's cubes leaves its location (a pick
+# moves one cube), and the stick must be carried and the cube put onto it (the generator took 3 for the latter).
+STRUCTURE_MOVES = 2
+
+
+def _assert_structure(ex: Executed, name: str) -> None:
+    """The executed scene holds the structure the problem is named after, checked on the poses themselves."""
+    scene, start = ex.scene, ex.problem.initial
+    if name == "tower_of_two":  # cube 1 stands on cube 0
+        assert _rests_on(scene, 1, 0) and not _rests_on(start, 1, 0), scene
+    else:  # the cube stands on the stick, which was carried more than 20 cm from where it lay
+        assert name == "cube_on_carried_stick" and _rests_on(scene, 1, 0) and not _rests_on(start, 1, 0), scene
+        assert np.linalg.norm(scene.positions()[0] - start.positions()[0]) > 0.2, scene
 
 
 @pytest.mark.parametrize("name", ["tower_of_two", "cube_on_carried_stick"])
-def test_pretrained_run_builds_structures_in_simulation(tmp_path, name):
+def test_pretrained_run_builds_structures_in_simulation(sim, tmp_path, name):
     """Structure goals (a tower of two cubes; a cube standing on a stick carried to another location), built by a
     plan that Fast Downward finds on the shipped rules and the simulated arm executes."""
-    run = tmp_path / "run"
-    shutil.copytree(PRETRAINED, run)
-    problem = PRETRAINED / "problems" / f"{name}.json"
-    rc, text = cli("plan", "--run", run, "--problem", problem, "--planner", "fast-downward-sas-opt", "--closed-loop")
-    assert rc == 0, text
-    line = [ln for ln in text.splitlines() if ln.startswith(name)][-1]
-    assert "success True" in line and "failure None" in line, line
+    ex = _plan_and_execute(sim, tmp_path, PRETRAINED, PRETRAINED / "problems" / f"{name}.json",
+                           "fast-downward-sas-opt", closed_loop=True)
+    _assert_goal_reached(ex)
+    assert ex.row.plan_length == STRUCTURE_MOVES and ex.row.closed_loop  # an optimal planner: the fewest moves
+    _assert_structure(ex, name)
 
 
 def test_plan_sets_torch_threads_one_by_default(tmp_path):
@@ -92,14 +180,13 @@ def test_stability_run_is_small_consistent_and_steadier():
 
 
 @pytest.mark.parametrize("name", ["tower_of_two", "cube_on_carried_stick"])
-def test_stability_run_builds_structures_with_the_in_process_rule_search(tmp_path, name):
-    run = tmp_path / "run"
-    shutil.copytree(STABLE, run)
-    rc, text = cli("plan", "--run", run, "--problem", PRETRAINED / "problems" / f"{name}.json", "--planner", "rules-bfs",
-                   "--closed-loop")
-    assert rc == 0, text
-    line = [ln for ln in text.splitlines() if ln.startswith(name)][-1]
-    assert "success True" in line and "failure None" in line, line
+def test_stability_run_builds_structures_with_the_in_process_rule_search(sim, tmp_path, name):
+    """The second run's rules, searched breadth first in process (shortest plans), build both structures."""
+    ex = _plan_and_execute(sim, tmp_path, STABLE, PRETRAINED / "problems" / f"{name}.json", "rules-bfs",
+                           closed_loop=True)
+    _assert_goal_reached(ex)
+    assert ex.row.plan_length == STRUCTURE_MOVES  # breadth first: the fewest moves
+    _assert_structure(ex, name)
 
 
 LOCATED = PRETRAINED.parent / "quick-stab12k-located"
@@ -126,11 +213,10 @@ def test_located_run_shares_the_effect_model_and_reads_12_bit_codes(sim):
 
 
 @pytest.mark.parametrize("planner", ["astar-outcomes", "rules-outcomes"])
-def test_located_run_builds_a_structure_in_simulation(tmp_path, planner):
-    run = tmp_path / "run"
-    shutil.copytree(LOCATED, run)
-    rc, text = cli("plan", "--run", run, "--problem", PRETRAINED / "problems" / "cube_on_carried_stick.json",
-                   "--planner", planner, "--closed-loop")
-    assert rc == 0, text
-    line = [ln for ln in text.splitlines() if ln.startswith("cube_on_carried_stick")][-1]
-    assert "success True" in line and "failure None" in line, line
+def test_located_run_builds_a_structure_in_simulation(sim, tmp_path, planner):
+    """The third run (12-bit codes with location bits) puts the cube on the carried stick, through both
+    all-outcomes planners (network and exported rules)."""
+    ex = _plan_and_execute(sim, tmp_path, LOCATED, PRETRAINED / "problems" / "cube_on_carried_stick.json", planner,
+                           closed_loop=True)
+    _assert_goal_reached(ex)
+    _assert_structure(ex, "cube_on_carried_stick")
