@@ -20,29 +20,14 @@ $(VENV)/.installed: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q -e '.[dev,ray]'
 	touch $@
 
-# The whole pipeline at the quick preset on a small data set (about 5 minutes on 2 cores with the install: 4:45
-# from a fresh clone on 2026-12-02), ending with the
-# learned-net A* next to Fast Downward and SymK on the exported rules (their SAS+ route; the PDDL route through
-# unified-planning takes seconds per task and runs in `make test` and examples/) and the in-process rule searches
-# (rules-bfs, rules-outcomes), the same problems on the
-# shipped pretrained run (copied to runs/pretrained), and RUN/report.html.
+# The recommended recipe at the demo preset (symlearn/pipeline.py): a paper-style data set and a 1-5-object one,
+# the stability-trained effect model, m(z) on 9 location bits, the lifted PDDL domain, problems by shortest-plan
+# length, and astar-outcomes next to stock Fast Downward on the lifted domain, closed loop; it ends with
+# runs/demo/run/report.html. 6:04 after the install on 2 cores shared with other jobs (load 4-5, 2026-12-02):
+# closed loop on 18 problems of 1-3 objects, astar-outcomes solved 0.44 and fast-downward-lifted 0.33. Run again,
+# it skips what is done (runs/demo/pipeline.json).
 demo: $(VENV)/.installed
-	$(BIN)/symlearn scenarios
-	$(BIN)/symlearn collect --out data/demo --n 3000 --workers 2 --seed 0 --quiet
-	$(BIN)/symlearn train --data data/demo --out runs/demo --preset quick --epochs 30 --quiet
-	$(BIN)/symlearn evaluate --run runs/demo --data data/demo
-	$(BIN)/symlearn table1 --run runs/demo
-	$(BIN)/symlearn symbols --run runs/demo --data data/demo --min-count 20
-	$(BIN)/symlearn train-transition --run runs/demo --data data/demo --preset quick --epochs 20 --quiet
-	$(BIN)/symlearn export-pddl --run runs/demo --data data/demo --max-objects 2 --min-count 5 --pddl-fidelity-cases 0
-	$(BIN)/symlearn problems --out problems/demo --n 10 --objects 1-3 --length 1-2 --seed 0
-	$(BIN)/symlearn benchmark --run runs/demo --problems problems/demo --planners astar,astar-outcomes,fast-downward-sas-opt,symk-sas,rules-bfs,rules-outcomes --closed-loop \
-		--out runs/demo/benchmark.json --quiet
-	$(BIN)/symlearn plan --run runs/demo --problem problems/demo/problem_0000.json --planner astar --record runs/demo/plan.gif
-	rm -rf runs/pretrained && cp -r pretrained/quick-authors12k runs/pretrained
-	$(BIN)/symlearn benchmark --run runs/pretrained --problems problems/demo --planners astar,astar-outcomes,fast-downward-sas-opt,rules-bfs,rules-outcomes --closed-loop \
-		--out runs/pretrained/benchmark.json --quiet
-	$(BIN)/symlearn report --run runs/demo --data data/demo --benchmark runs/demo/benchmark.json --recording runs/demo/plan.gif
+	$(BIN)/symlearn pipeline --preset demo --out runs/demo
 
 test: $(VENV)/.installed
 	$(BIN)/python -m pytest -q
@@ -56,4 +41,4 @@ bench: $(VENV)/.installed
 	$(BIN)/python bench/collect.py --out bench/results/collect.json
 
 clean:
-	rm -rf $(VENV) data/demo runs/demo runs/pretrained problems/demo .pytest_cache
+	rm -rf $(VENV) runs/demo .pytest_cache

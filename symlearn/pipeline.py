@@ -1,5 +1,14 @@
-"""Every stage in order, resumable: collect, train, evaluate, table1, symbols, train-transition, export-pddl,
-problems, benchmark, report, into OUT/data, OUT/run and OUT/problems.
+"""Every stage in order, resumable: collect (and collect-extra), train, evaluate, table1, symbols,
+train-transition, export-pddl, problems, benchmark, report, into OUT/data (OUT/data_extra), OUT/run and
+OUT/problems.
+
+The presets (PRESETS): `recommended`, the default, is the recipe that plans best (its run is shipped as
+pretrained/recommended, whose README gives the commands): the paper-size data set plus a set of 1-5-object
+scenes that only m(z) and the export read, the quick effect model with the stability loss, m(z) on 9 location
+bits, the lifted PDDL domain, problems stratified by shortest-plan length, astar-outcomes and stock Fast Downward
+on the lifted domain, closed loop. `demo` is the same recipe at a small scale (minutes on 2 cores: `make demo`);
+`paper` is the paper-faithful setup (its model sizes, learned codes only, the rules export, random-walk problems,
+open loop).
 
 Each stage is a call of the library function its `symlearn` sub-command calls, with a frozen config dataclass
 built from the settings and the preset; what the stage prints, and the traceback of a crash, go to
@@ -11,8 +20,8 @@ only what did not finish (and what depends on a change).
 The pipeline calls the library, never the command line: `symlearn pipeline` (symlearn.cli.pipeline) is a thin
 front end to run_pipeline, and tests/test_layout.py keeps imports going that one way.
 
-    >>> run_pipeline(PipelineSettings(preset="quick", out=Path("pipe"), n=2000))   # doctest: +SKIP
-    [1/10] collect ... done in 61.3 s
+    >>> run_pipeline(PipelineSettings(preset="demo", out=Path("pipe")))   # doctest: +SKIP
+    [1/11] collect ... done in 61.3 s
 """
 from __future__ import annotations
 
@@ -27,57 +36,94 @@ from typing import TYPE_CHECKING, Any, Callable, Iterator
 
 from pddl_export.bounded_json import AnyJson, JsonFileError, Map, Num, Obj, Opt, Str, check, read_json_file
 from symlearn.folder_lock import folder_lock
+from symlearn.planning.planner_catalogue import DEFAULT_PLANNER
 from symlearn.provenance import atomic_write_json, sha256_bytes, sha256_file
 
 if TYPE_CHECKING:  # the configs' modules load torch (and the simulator): imported where a stage is built
     from symlearn.learning.training import TrainConfig
     from symlearn.planning.execution import ExecutionConfig
     from symlearn.planning.export import ExportConfig
+    from symlearn.planning.lifted_export import LiftedConfig
     from symlearn.planning.problem_generation import ProblemConfig
     from symlearn.sim.collect import CollectConfig
     from symlearn.symbolic.transition_model import TransitionConfig
 
 RECORD_FILE = "pipeline.json"
 RECORD_KIND = "symlearn-pipeline"
-DATA, RUN, PROBLEMS = "data", "run", "problems"  # OUT's folders
+DATA, DATA_EXTRA, RUN, PROBLEMS = "data", "data_extra", "run", "problems"  # OUT's folders
+# The extra set is drawn from seed + 2, as the recipe's data/k15 (seed 2) beside the paper-size set (seed 0).
+EXTRA_SEED_OFFSET = 2
 
 
 @dataclass(frozen=True)
 class PipelinePreset:
     """One named preset of the whole pipeline.
 
-    The networks take the named presets of TrainConfig and TransitionConfig called `models`; a size left None is
-    the default of the config (or library function) that holds it, which is the paper's. Only what no config
-    holds (how many problems, which planners) and the quick preset's smaller sizes are numbers here, so each
-    value has one definition.
+    The networks take the named presets of TrainConfig and TransitionConfig called `models`; a value left None is
+    the default of the config (or library function) that holds it. Only what no config holds (the recipe's
+    stability weight, which data sets and problems, which planners) and a small preset's smaller sizes are
+    numbers here, and `demo` is `recommended` with smaller sizes, so each value has one definition.
     """
 
     models: str  # TrainConfig.from_preset and TransitionConfig.from_preset name
-    samples: int | None = None  # CollectConfig.n
+    samples: int | None = None  # CollectConfig.n of the main set (the paper's exploration: 1-3 objects)
+    # a second set of scenes with this range of objects, read by m(z) and the export only (not the effect model)
+    extra_objects: tuple[int, int] | None = None
+    extra_samples: int | None = None  # its CollectConfig.n
+    epochs: int | None = None  # TrainConfig.epochs
+    transition_epochs: int | None = None  # TransitionConfig.epochs
+    stability_weight: float | None = None  # TrainConfig.stability_weight
+    min_count: int | None = None  # analyse_symbols' min_count (symbols.FREQUENT_MIN_COUNT)
+    # the lifted domain (export_lifted; m(z) then reads lifted_scene.FIELD_BITS location bits) instead of the
+    # rules export (export_pddl) with these sizes
+    lifted: bool = False
     max_objects: int | None = None  # ExportConfig.max_objects
     fidelity_cases: int | None = None  # ExportConfig.pddl_fidelity_cases
-    min_count: int | None = None  # analyse_symbols' min_count (symbols.FREQUENT_MIN_COUNT)
-    problems: int = 20  # planning problems generated and benchmarked
-    planners: tuple[str, ...] = ("astar",)  # benchmarked planners
+    # problems stratified by shortest-plan length (generate_stratified; `problems` per cell) instead of
+    # random walks (generate_problems, ProblemConfig's ranges)
+    stratified: bool = False
+    problem_objects: tuple[int, int] | None = None  # stratified: the object range (stratified.OBJECTS if None)
+    problems: int | None = None  # problems (per cell when stratified); None: N_PROBLEMS, stratified PER_CELL
+    planners: tuple[str, ...] = ("astar",)  # benchmarked planners; the first plans the recorded RUN/plan.gif
+    closed_loop: bool = False  # ExecutionConfig.closed_loop
+    timeout_s: float | None = None  # ExecutionConfig.timeout_s
 
+    @property
+    def stage_names(self) -> tuple[str, ...]:
+        """The stages this preset runs, in order."""
+        return tuple(stage.name for stage in pipeline_stages(self))
+
+
+# The recipe that plans best (pretrained/recommended/README.md), at full scale: 12,000 samples of the
+# paper's exploration and 12,000 of 1-5 objects, the quick models, 10 problems per cell of 1-5 objects.
+RECOMMENDED = PipelinePreset(
+    "quick", extra_objects=(1, 5), stability_weight=0.1, lifted=True, stratified=True,
+    planners=(DEFAULT_PLANNER, "fast-downward-lifted"), closed_loop=True, timeout_s=10.0)
 
 PRESETS = {
-    "quick": PipelinePreset("quick", samples=1000, max_objects=2, fidelity_cases=100, min_count=20, problems=5),
+    "recommended": RECOMMENDED,
+    # the recipe in minutes on 2 busy cores (`make demo`): fewer samples and epochs, 2 problems per cell of 1-3
+    # objects; symbols need fewer training objects to count as frequent
+    "demo": dataclasses.replace(RECOMMENDED, samples=1500, extra_samples=750, epochs=10, transition_epochs=20,
+                                min_count=20, problem_objects=(1, 3), problems=2),
+    # the paper-faithful setup: the paper's model sizes, learned codes only (no location bits), the rules export,
+    # random-walk problems planned open loop
     "paper": PipelinePreset("paper", planners=("astar", "astar-ucs", "astar-outcomes", "rules-outcomes")),
 }
+DEFAULT_PRESET = "recommended"
 
 
 @dataclass(frozen=True)
 class PipelineSettings:
     """What the pipeline runs: a preset, the output folder, and the overrides of the preset."""
 
-    preset: str
     out: Path
-    n: int | None = None
+    preset: str = DEFAULT_PRESET
+    n: int | None = None  # samples of each collected set (the main one and the extra one)
     seed: int = 0
     epochs: int | None = None
     transition_epochs: int | None = None
-    problems: int | None = None
+    problems: int | None = None  # problems, per cell with a stratified preset
     workers: int = 1
     shard_size: int = 250
     stop_after: str | None = None  # stop after this stage (tests simulate an interruption with it)
@@ -89,8 +135,9 @@ class PipelineSettings:
             v, least = getattr(self, name), 0 if name == "seed" else 1
             if v is not None and not (isinstance(v, int) and not isinstance(v, bool) and v >= least):
                 raise ValueError(f"--{name.replace('_', '-')} {v!r} must be an integer of at least {least}")
-        if self.stop_after is not None and self.stop_after not in STAGE_NAMES:
-            raise ValueError(f"unknown stage {self.stop_after!r}; stages: {', '.join(STAGE_NAMES)}")
+        names = self.preset_values.stage_names
+        if self.stop_after is not None and self.stop_after not in names:
+            raise ValueError(f"unknown stage {self.stop_after!r}; stages: {', '.join(names)}")
 
     @property
     def preset_values(self) -> PipelinePreset:
@@ -118,10 +165,21 @@ class SymbolsStageConfig:
 
 @dataclass(frozen=True)
 class TransitionStageConfig:
-    """train_transition's arguments: m(z)'s config and the training seed."""
+    """train_transition's arguments: m(z)'s config, the training seed, and the extra data sets (OUT's folders)
+    whose train and val splits join the main set's."""
 
     transition: TransitionConfig
     seed: int
+    extra_data: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class LiftedStageConfig:
+    """export_lifted's arguments: its config, and the extra data sets (OUT's folders) whose scenes m(z) is asked
+    about beside the main set's."""
+
+    lifted: LiftedConfig
+    extra_data: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -134,12 +192,21 @@ class ProblemsStageConfig:
 
 
 @dataclass(frozen=True)
+class StratifiedStageConfig:
+    """generate_stratified's arguments: n problems per cell of `objects` x shortest-plan length, from `seed`."""
+
+    n: int
+    seed: int
+    objects: tuple[int, int]
+
+
+@dataclass(frozen=True)
 class BenchmarkStageConfig:
-    """The benchmark's planners and execution settings, and the planner of the recorded plan (RUN/plan.gif)."""
+    """The benchmark's planners and execution settings; the first planner plans the first problem, recorded as
+    RUN/plan.gif for the report."""
 
     planners: tuple[str, ...]
     execution: ExecutionConfig
-    plan_planner: str = "astar"  # plans the first problem, recorded as RUN/plan.gif for the report
     # search-time inference runs the networks on small batches, many times slower on 2 threads than on 1 when
     # another busy process shares the cores (docs/BENCHMARKS.md): the benchmark command's default
     threads: int = 1
@@ -155,10 +222,25 @@ def _first(*values):
     return next((v for v in values if v is not None), None)
 
 
+def _extra_data(s: PipelineSettings) -> tuple[str, ...]:
+    """OUT's folders of the extra data sets this preset collects."""
+    return (DATA_EXTRA,) if s.preset_values.extra_objects else ()
+
+
 def _collect_config(s: PipelineSettings) -> CollectConfig:
     from symlearn.sim.collect import CollectConfig
 
     return CollectConfig(seed=s.seed, shard_size=s.shard_size, **_given(n=_first(s.n, s.preset_values.samples)))
+
+
+def _collect_extra_config(s: PipelineSettings) -> CollectConfig:
+    from symlearn.sim.collect import CollectConfig
+    from symlearn.sim.exploration import ExplorationConfig
+
+    p = s.preset_values
+    return CollectConfig(seed=s.seed + EXTRA_SEED_OFFSET, shard_size=s.shard_size,
+                         exploration=ExplorationConfig.with_k_range(*p.extra_objects),
+                         **_given(n=_first(s.n, p.extra_samples)))
 
 
 def _train_config(s: PipelineSettings) -> TrainConfig:
@@ -166,9 +248,10 @@ def _train_config(s: PipelineSettings) -> TrainConfig:
 
     from symlearn.learning.training import TrainConfig
 
+    p = s.preset_values
     # bf16 autocast on a GPU only, as the pipeline has always trained (plain float32 on a CPU)
-    return TrainConfig.from_preset(s.preset_values.models, seed=s.seed, bf16=torch.cuda.is_available(),
-                                   **_given(epochs=s.epochs))
+    return TrainConfig.from_preset(p.models, seed=s.seed, bf16=torch.cuda.is_available(),
+                                   **_given(epochs=_first(s.epochs, p.epochs), stability_weight=p.stability_weight))
 
 
 def _symbols_config(s: PipelineSettings) -> SymbolsStageConfig:
@@ -178,10 +261,13 @@ def _symbols_config(s: PipelineSettings) -> SymbolsStageConfig:
 
 
 def _transition_config(s: PipelineSettings) -> TransitionStageConfig:
+    from pddl_export.lifted_scene import FIELD_BITS
     from symlearn.symbolic.transition_model import TransitionConfig
 
-    cfg = TransitionConfig.from_preset(s.preset_values.models, **_given(epochs=s.transition_epochs))
-    return TransitionStageConfig(cfg, seed=s.seed)
+    p = s.preset_values
+    cfg = TransitionConfig.from_preset(p.models, **_given(epochs=_first(s.transition_epochs, p.transition_epochs),
+                                                          location_bits=FIELD_BITS if p.lifted else None))
+    return TransitionStageConfig(cfg, seed=s.seed, extra_data=_extra_data(s))
 
 
 def _export_config(s: PipelineSettings) -> ExportConfig:
@@ -191,28 +277,50 @@ def _export_config(s: PipelineSettings) -> ExportConfig:
     return ExportConfig(seed=s.seed, **_given(max_objects=p.max_objects, pddl_fidelity_cases=p.fidelity_cases))
 
 
-def _problems_config(s: PipelineSettings) -> ProblemsStageConfig:
-    from symlearn.planning.problem_generation import ProblemConfig
+def _lifted_config(s: PipelineSettings) -> LiftedStageConfig:
+    from symlearn.planning.lifted_export import LiftedConfig
 
-    return ProblemsStageConfig(n=_first(s.problems, s.preset_values.problems), seed=s.seed, problem=ProblemConfig())
+    return LiftedStageConfig(LiftedConfig(), extra_data=_extra_data(s))
+
+
+def _problems_config(s: PipelineSettings) -> ProblemsStageConfig:
+    from symlearn.planning.problem_generation import N_PROBLEMS, ProblemConfig
+
+    n = _first(s.problems, s.preset_values.problems, N_PROBLEMS)
+    return ProblemsStageConfig(n=n, seed=s.seed, problem=ProblemConfig())
+
+
+def _stratified_config(s: PipelineSettings) -> StratifiedStageConfig:
+    from symlearn.planning.stratified import OBJECTS, PER_CELL
+
+    p = s.preset_values
+    return StratifiedStageConfig(n=_first(s.problems, p.problems, PER_CELL), seed=s.seed,
+                                 objects=_first(p.problem_objects, OBJECTS))
 
 
 def _benchmark_config(s: PipelineSettings) -> BenchmarkStageConfig:
     from symlearn.planning.execution import ExecutionConfig
 
-    return BenchmarkStageConfig(planners=s.preset_values.planners, execution=ExecutionConfig())
+    p = s.preset_values
+    return BenchmarkStageConfig(planners=p.planners,
+                                execution=ExecutionConfig(closed_loop=p.closed_loop, **_given(timeout_s=p.timeout_s)))
 
 
 # ------------------------------------------------------------------------------- stage calls
 # Each takes (OUT, its config, the settings); what it prints goes to the stage's log.
 
 
-def _collect(out: Path, cfg: CollectConfig, s: PipelineSettings) -> None:
-    from symlearn.data.dataset import summarize
-    from symlearn.sim.collect import collect
+def _collect_into(folder: str) -> Callable[[Path, CollectConfig, PipelineSettings], None]:
+    """The call of a collect stage writing OUT/folder."""
 
-    collect(out / DATA, cfg, workers=s.workers, show_progress=False)
-    print(json.dumps(summarize(out / DATA), indent=2, allow_nan=False))
+    def run(out: Path, cfg: CollectConfig, s: PipelineSettings) -> None:
+        from symlearn.data.dataset import summarize
+        from symlearn.sim.collect import collect
+
+        collect(out / folder, cfg, workers=s.workers, show_progress=False)
+        print(json.dumps(summarize(out / folder), indent=2, allow_nan=False))
+
+    return run
 
 
 def _train(out: Path, cfg: TrainConfig, s: PipelineSettings) -> None:
@@ -246,7 +354,8 @@ def _symbols(out: Path, cfg: SymbolsStageConfig, s: PipelineSettings) -> None:
 def _train_transition(out: Path, cfg: TransitionStageConfig, s: PipelineSettings) -> None:
     from symlearn.symbolic.transition_training import train_transition
 
-    m = train_transition(out / RUN, out / DATA, cfg.transition, seed=cfg.seed, show_progress=False)
+    m = train_transition(out / RUN, out / DATA, cfg.transition, seed=cfg.seed, show_progress=False,
+                         extra_data=tuple(out / d for d in cfg.extra_data))
     test = m["test"]
     print(json.dumps({"best_val_loss": m["best_val_loss"],
                       "test": {k: test[k] for k in ("bit_accuracy", "object_accuracy", "scene_accuracy")}}, indent=2))
@@ -260,12 +369,35 @@ def _export_pddl(out: Path, cfg: ExportConfig, s: PipelineSettings) -> None:
           f"actions; fidelity (rules, every case) {rep['fidelity']:.4f}, through the PDDL {rep['pddl_fidelity']}")
 
 
+def _export_lifted(out: Path, cfg: LiftedStageConfig, s: PipelineSettings) -> None:
+    from symlearn.planning.lifted_export import export_lifted
+
+    rep = export_lifted(out / RUN, out / DATA, tuple(out / d for d in cfg.extra_data), cfg.lifted)
+    print(f"kept learned bits {rep['kept_bits']}; {rep['moves']} moves of m(z) on observed scenes -> "
+          f"{rep['rules']} lifted rules ({rep['domain_bytes']} bytes of PDDL)")
+    for data, checks in rep["checks_test_split"].items():
+        for group, c in checks.items():
+            print(f"  {data} test split, {group} objects ({c['cases']} steps): fidelity to m(z) "
+                  f"{c['fidelity_to_net']:.3f}, accuracy {c['accuracy_rules']:.3f} (m(z) {c['accuracy_net']:.3f})")
+
+
 def _problems(out: Path, cfg: ProblemsStageConfig, s: PipelineSettings) -> None:
     from symlearn.planning.problem_generation import generate_problems
 
     # a stage runs again only when its config changed, so the old problem set is replaced, never mixed
     paths = generate_problems(out / PROBLEMS, cfg.n, objects=cfg.problem.objects, length=cfg.problem.length,
                               seed=cfg.seed, overwrite=True, on_locations=cfg.problem.on_locations)
+    print(f"wrote {len(paths)} problems to {out / PROBLEMS}")
+
+
+def _stratified(out: Path, cfg: StratifiedStageConfig, s: PipelineSettings) -> None:
+    from symlearn.planning.stratified import generate_stratified
+
+    paths, cells = generate_stratified(out / PROBLEMS, cfg.n, objects=cfg.objects, seed=cfg.seed, overwrite=True,
+                                       progress=lambda line: print(line, flush=True))
+    print("cells (objects, shortest-plan length: problems written/asked):")
+    for c in cells:
+        print("  " + c.line())
     print(f"wrote {len(paths)} problems to {out / PROBLEMS}")
 
 
@@ -299,12 +431,13 @@ def _benchmark(out: Path, cfg: BenchmarkStageConfig, s: PipelineSettings) -> Non
                         timeout_s=ex.timeout_s, max_replans=ex.max_replans, show_progress=False,
                         record_dir=run / "recordings")
         print(format_table(res))
-        done = plan_problem(run, _first_problem(out), cfg.plan_planner, ex, record=run / "plan.gif")
+        planner = cfg.planners[0]
+        done = plan_problem(run, _first_problem(out), planner, ex, record=run / "plan.gif")
     row = done.row
-    print(f"{done.problem.name} [{cfg.plan_planner}]: found {row.found} ({row.status}), length {row.plan_length}, "
+    print(f"{done.problem.name} [{planner}]: found {row.found} ({row.status}), length {row.plan_length}, "
           f"success {row.success}; wrote {done.gif} ({done.frames} frames)")
     if row.status == "error":  # the planner could not run: not an answer about the problem
-        raise RuntimeError(f"{cfg.plan_planner} could not plan {done.problem.name}: {row.message}")
+        raise RuntimeError(f"{planner} could not plan {done.problem.name}: {row.message}")
 
 
 def _report(out: Path, cfg: EmptyStageConfig, s: PipelineSettings) -> None:
@@ -329,32 +462,40 @@ class Stage:
     outputs: tuple[str, ...]
 
 
-def _stages() -> list[Stage]:
-    D, R, P = DATA, RUN, PROBLEMS  # noqa: N806
+def pipeline_stages(p: PipelinePreset) -> list[Stage]:
+    """The stages a preset runs, in order: the extra collection only with extra data, the lifted export or the
+    rules export, stratified or random-walk problems."""
+    D, X, R, P = DATA, DATA_EXTRA, RUN, PROBLEMS  # noqa: N806
     empty = lambda s: EmptyStageConfig()  # noqa: E731
+    data = (f"{D}/manifest.json",)
+    extra = (f"{X}/manifest.json",) if p.extra_objects else ()  # read by m(z) and the export only
+    nets = (f"{R}/best.pt", f"{R}/transition.pt")
+    if p.lifted:
+        domain = f"{R}/pddl/lifted.json"
+        export = Stage("export-pddl", _lifted_config, _export_lifted, data + extra + nets,
+                       (f"{R}/pddl/lifted/domain.pddl", domain))
+    else:
+        domain = f"{R}/pddl/rules.json"
+        export = Stage("export-pddl", _export_config, _export_pddl, data + nets, (f"{R}/pddl/domain.pddl", domain))
+    problems = (Stage("problems", _stratified_config, _stratified, (), (P,)) if p.stratified
+                else Stage("problems", _problems_config, _problems, (), (P,)))
+    collect_extra = [Stage("collect-extra", _collect_extra_config, _collect_into(X), (), extra)] if extra else []
     return [
-        Stage("collect", _collect_config, _collect, (), (f"{D}/manifest.json",)),
-        Stage("train", _train_config, _train, (f"{D}/manifest.json",), (f"{R}/best.pt", f"{R}/metrics.json")),
-        Stage("evaluate", empty, _evaluate, (f"{D}/manifest.json", f"{R}/best.pt"), (f"{R}/eval.json",)),
+        Stage("collect", _collect_config, _collect_into(D), (), data),
+        *collect_extra,
+        Stage("train", _train_config, _train, data, (f"{R}/best.pt", f"{R}/metrics.json")),
+        Stage("evaluate", empty, _evaluate, data + (f"{R}/best.pt",), (f"{R}/eval.json",)),
         Stage("table1", empty, _table1, (f"{R}/best.pt",), (f"{R}/table1.json",)),
-        Stage("symbols", _symbols_config, _symbols, (f"{D}/manifest.json", f"{R}/best.pt"),
-              (f"{R}/symbols.json", f"{R}/symbols.png")),
-        Stage("train-transition", _transition_config, _train_transition, (f"{D}/manifest.json", f"{R}/best.pt"),
+        Stage("symbols", _symbols_config, _symbols, data + (f"{R}/best.pt",), (f"{R}/symbols.json", f"{R}/symbols.png")),
+        Stage("train-transition", _transition_config, _train_transition, data + extra + (f"{R}/best.pt",),
               (f"{R}/transition.pt", f"{R}/transition_metrics.json")),
-        Stage("export-pddl", _export_config, _export_pddl, (f"{D}/manifest.json", f"{R}/best.pt", f"{R}/transition.pt"),
-              (f"{R}/pddl/domain.pddl", f"{R}/pddl/rules.json")),
-        Stage("problems", _problems_config, _problems, (), (P,)),
-        Stage("benchmark", _benchmark_config, _benchmark,
-              (f"{R}/best.pt", f"{R}/transition.pt", f"{R}/pddl/rules.json", P),
-              (f"{R}/benchmark.json", f"{R}/plan.gif")),
+        export,
+        problems,
+        Stage("benchmark", _benchmark_config, _benchmark, nets + (domain, P), (f"{R}/benchmark.json", f"{R}/plan.gif")),
         Stage("report", empty, _report,
               (f"{R}/eval.json", f"{R}/table1.json", f"{R}/symbols.json", f"{R}/transition_metrics.json",
                f"{R}/benchmark.json", f"{R}/plan.gif"), (f"{R}/report.html", f"{R}/report.md")),
     ]
-
-
-STAGES = _stages()
-STAGE_NAMES = tuple(s.name for s in STAGES)
 
 
 def config_json(config: Any) -> dict:
@@ -364,7 +505,7 @@ def config_json(config: Any) -> dict:
 
 def stage_configs(s: PipelineSettings) -> dict[str, Any]:
     """Every stage's config for these settings, built before any stage runs so that a bad value is refused first."""
-    return {stage.name: stage.config(s) for stage in STAGES}
+    return {stage.name: stage.config(s) for stage in pipeline_stages(s.preset_values)}
 
 
 def path_hash(path: Path) -> str | None:
@@ -458,8 +599,11 @@ def _run_stages(s: PipelineSettings, configs: dict[str, Any], out: Path, echo: C
     """run_pipeline's work, inside OUT's lock."""
     record = load_record(out)
     record.update(kind=RECORD_KIND, out=str(out), preset=s.preset)
-    n = len(STAGES)
-    for i, stage in enumerate(STAGES, 1):
+    stages = pipeline_stages(s.preset_values)
+    for name in set(record["stages"]) - set(configs):  # a stage of another preset: its files stay, its record goes
+        record["stages"].pop(name)
+    n = len(stages)
+    for i, stage in enumerate(stages, 1):
         inputs = _hashes(out, stage.inputs)
         config = config_json(configs[stage.name])
         rec = record["stages"].get(stage.name)

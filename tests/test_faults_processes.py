@@ -180,7 +180,7 @@ def test_pipeline_settings_refuse_bad_values_before_any_folder(tmp_path, kw):
     from symlearn.pipeline import PipelineSettings
 
     with pytest.raises(ValueError, match="must be an integer of at least"):
-        PipelineSettings(preset="quick", out=tmp_path / "pipe", **kw)
+        PipelineSettings(preset="demo", out=tmp_path / "pipe", **kw)
     assert not (tmp_path / "pipe").exists()
 
 

@@ -266,48 +266,104 @@ def test_plan_and_benchmark_recordings(report):
 
 # ------------------------------------------------------------------------------------------ pipeline
 
-PIPE_ARGS = ("--preset", "quick", "--n", 48, "--shard-size", 4, "--epochs", 1, "--transition-epochs", 2,
-             "--problems", 2, "--seed", 5)
-STAGE_LINE = re.compile(r"^\[(\d+)/10\] (\S+) \.\.\. (skipped \(done\)|done in [\d.]+ s)$", re.M)
+# The demo preset at a test's size: 48 samples per set, one epoch, 1-object problems, 2 s per planner call.
+PIPE_ARGS = ("--preset", "tiny", "--n", 48, "--shard-size", 4, "--epochs", 1, "--transition-epochs", 2,
+             "--problems", 1, "--seed", 5)
+STAGE_LINE = re.compile(r"^\[(\d+)/(\d+)\] (\S+) \.\.\. (skipped \(done\)|done in [\d.]+ s)$", re.M)
+
+
+@pytest.fixture
+def tiny_preset(monkeypatch):
+    """`--preset tiny`: the demo preset with 1-object problems and a short planner timeout, for this file only."""
+    import dataclasses
+
+    from symlearn.pipeline import PRESETS
+
+    tiny = dataclasses.replace(PRESETS["demo"], problem_objects=(1, 1), timeout_s=2.0)
+    monkeypatch.setitem(PRESETS, "tiny", tiny)
+    return tiny
 
 
 def _stages(out: str) -> dict[str, str]:
-    return {m.group(2): "skipped" if m.group(3).startswith("skipped") else "done" for m in STAGE_LINE.finditer(out)}
+    return {m.group(3): "skipped" if m.group(4).startswith("skipped") else "done" for m in STAGE_LINE.finditer(out)}
 
 
-def test_pipeline_resumes_without_redoing_finished_stages(tmp_path):
-    from symlearn.pipeline import STAGE_NAMES
-
+def test_pipeline_resumes_without_redoing_finished_stages(tmp_path, tiny_preset):
+    names = tiny_preset.stage_names
     out = tmp_path / "pipe"
     rc, text = cli("pipeline", "--out", out, *PIPE_ARGS, "--stop-after", "symbols")
     assert rc == 0, text
-    first = list(STAGE_NAMES[:5])
+    first = names[:names.index("symbols") + 1]
     assert _stages(text) == dict.fromkeys(first, "done")
-    kept = [out / "data" / "manifest.json", out / "run" / "best.pt", out / "run" / "eval.json",
-            out / "run" / "table1.json", out / "run" / "symbols.json"]
+    kept = [out / "data" / "manifest.json", out / "data_extra" / "manifest.json", out / "run" / "best.pt",
+            out / "run" / "eval.json", out / "run" / "table1.json", out / "run" / "symbols.json"]
     mtimes = [p.stat().st_mtime_ns for p in kept]
     assert not (out / "run" / "transition.pt").exists()
 
     rc, text = cli("pipeline", "--out", out, *PIPE_ARGS)
     assert rc == 0, text
-    assert _stages(text) == {**dict.fromkeys(first, "skipped"), **dict.fromkeys(STAGE_NAMES[5:], "done")}
+    assert _stages(text) == {**dict.fromkeys(first, "skipped"), **dict.fromkeys(names[len(first):], "done")}
     assert [p.stat().st_mtime_ns for p in kept] == mtimes
     record = json.loads((out / "pipeline.json").read_text())
-    assert list(record["stages"]) == list(STAGE_NAMES)
-    assert record["stages"]["evaluate"]["config"] == {}  # nothing to set: it reads best.pt and the data set
-    train = record["stages"]["train"]["config"]  # the TrainConfig the stage ran with: the quick preset's, overridden
+    assert list(record["stages"]) == list(names)
+    configs = {name: rec["config"] for name, rec in record["stages"].items()}
+    assert configs["evaluate"] == {}  # nothing to set: it reads best.pt and the data set
+    train = configs["train"]  # the TrainConfig the stage ran with: the recipe's, overridden
     assert (train["preset"], train["epochs"], train["seed"], train["model"]["crop"]) == ("quick", 1, 5, 32)
-    assert record["stages"]["problems"]["config"]["n"] == 2
+    assert train["stability_weight"] == 0.1
+    assert configs["collect-extra"]["exploration"]["k_values"] == [1, 2, 3, 4, 5]
+    assert configs["train-transition"]["transition"]["location_bits"] == 9
+    assert configs["problems"] == {"n": 1, "seed": 5, "objects": [1, 1]}
+    assert (out / "run" / "pddl" / "lifted" / "domain.pddl").is_file()
+    bench = json.loads((out / "run" / "benchmark.json").read_text())
+    assert {(r["planner"], r["closed_loop"]) for r in bench["rows"]} == {  # --closed-loop runs both loops
+        (p, loop) for p in ("astar-outcomes", "fast-downward-lifted") for loop in (False, True)}
     assert parse(out / "run" / "report.html").sections["benchmark"] == "ok"
 
     (out / "run" / "report.html").unlink()  # a lost output: only its stage runs again
     rc, text = cli("pipeline", "--out", out, *PIPE_ARGS)
-    assert rc == 0 and _stages(text) == {**dict.fromkeys(STAGE_NAMES[:9], "skipped"), "report": "done"}
+    assert rc == 0 and _stages(text) == {**dict.fromkeys(names[:-1], "skipped"), "report": "done"}
 
     # other settings for a stage: it and what depends on its outputs run again; collect stays
-    rc, text = cli("pipeline", "--out", out, *PIPE_ARGS[:-2], "--seed", 5, "--problems", 3, "--stop-after", "problems")
-    assert rc == 0 and _stages(text) == {**dict.fromkeys(STAGE_NAMES[:7], "skipped"), "problems": "done"}
-    assert len(list((out / "problems").glob("*.json"))) == 3
+    n_problems = len(list((out / "problems").glob("*.json")))
+    rc, text = cli("pipeline", "--out", out, *PIPE_ARGS[:-4], "--seed", 5, "--problems", 2, "--stop-after", "problems")
+    assert rc == 0 and _stages(text) == {**dict.fromkeys(names[:names.index("problems")], "skipped"), "problems": "done"}
+    assert len(list((out / "problems").glob("*.json"))) > n_problems
+
+
+def test_the_default_preset_is_the_recommended_recipe(tmp_path):
+    """`symlearn pipeline --out X` runs the recipe that plans best, at full scale; demo is it at a small scale."""
+    import dataclasses
+
+    from symlearn.cli.main import build_parser
+    from symlearn.pipeline import PRESETS, PipelineSettings, config_json, stage_configs
+
+    assert build_parser().parse_args(["pipeline", "--out", "x"]).preset == "recommended"
+    s = PipelineSettings(out=tmp_path / "pipe")
+    configs = {name: config_json(cfg) for name, cfg in stage_configs(s).items()}
+    assert s.preset == "recommended" and not (tmp_path / "pipe").exists()
+    assert list(configs) == ["collect", "collect-extra", "train", "evaluate", "table1", "symbols", "train-transition",
+                             "export-pddl", "problems", "benchmark", "report"]
+    main, extra = configs["collect"], configs["collect-extra"]
+    assert (main["n"], main["seed"], main["exploration"]["k_values"]) == (12000, 0, [1, 2, 3])
+    assert (extra["n"], extra["seed"], extra["exploration"]["k_values"]) == (12000, 2, [1, 2, 3, 4, 5])
+    train = configs["train"]
+    assert (train["preset"], train["epochs"], train["stability_weight"]) == ("quick", 40, 0.1)
+    transition = configs["train-transition"]
+    assert (transition["transition"]["preset"], transition["transition"]["location_bits"]) == ("quick", 9)
+    assert transition["extra_data"] == ["data_extra"]
+    assert set(configs["export-pddl"]) == {"lifted", "extra_data"} and configs["export-pddl"]["extra_data"] == [
+        "data_extra"]
+    assert configs["problems"] == {"n": 10, "seed": 0, "objects": [1, 5]}  # stratified by shortest-plan length
+    bench = configs["benchmark"]
+    assert bench["planners"] == ["astar-outcomes", "fast-downward-lifted"] and bench["threads"] == 1
+    assert (bench["execution"]["closed_loop"], bench["execution"]["timeout_s"]) == (True, 10.0)
+    sizes = dict.fromkeys(("samples", "extra_samples", "epochs", "transition_epochs", "min_count", "problem_objects",
+                           "problems"))
+    assert dataclasses.replace(PRESETS["demo"], **sizes) == PRESETS["recommended"]  # the recipe, smaller
+    paper = PipelineSettings(out=tmp_path / "paper", preset="paper")
+    assert "collect-extra" not in paper.preset_values.stage_names
+    assert config_json(stage_configs(paper)["train-transition"])["transition"]["location_bits"] == 0
 
 
 @pytest.mark.parametrize("setup,args,message", [
@@ -321,7 +377,7 @@ def test_pipeline_refusals_exit_2_with_one_line(setup, args, message, tmp_path, 
         out.mkdir()
         (out / "pipeline.json").write_text('{"kind": "other"}')
     try:
-        rc, _ = cli("pipeline", "--out", out, "--preset", "quick", *args)
+        rc, _ = cli("pipeline", "--out", out, "--preset", "demo", *args)
     except SystemExit as e:  # a flag's value refused by argparse
         rc = e.code
     err = capsys.readouterr().err.strip().splitlines()

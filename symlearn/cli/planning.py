@@ -75,7 +75,7 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
 
 
 def cmd_problems(args: argparse.Namespace) -> int:
-    from symlearn.planning.problem_generation import generate_problems
+    from symlearn.planning.problem_generation import N_PROBLEMS, generate_problems
 
     if args.exclude and not args.stratify:
         raise ValueError("--exclude applies to --stratify sets only")
@@ -88,7 +88,7 @@ def cmd_problems(args: argparse.Namespace) -> int:
         return _cmd_structure_problems(args)
     if args.stratify:
         return _cmd_stratified(args)
-    args.n, args.objects = args.n or 20, args.objects or (1, 3)
+    args.n, args.objects = args.n or N_PROBLEMS, args.objects or (1, 3)
     args.length, args.seed = args.length or (1, 4), 0 if args.seed is None else args.seed
     per = " per cell" if args.stratify_reference else ""
     placed = ", goals on the table locations" if args.on_locations else ""
@@ -103,14 +103,14 @@ def cmd_problems(args: argparse.Namespace) -> int:
 
 def _cmd_stratified(args: argparse.Namespace) -> int:
     """`problems --stratify`: --n problems per cell of objects x shortest-plan length, and per off-location cell."""
-    from symlearn.planning.stratified import generate_stratified
+    from symlearn.planning.stratified import OBJECTS, PER_CELL, generate_stratified
 
     given = [f for f, v in (("--length", args.length), ("--on-locations", args.on_locations or None),
                             ("--stratify-reference", args.stratify_reference or None)) if v is not None]
     if given:
         raise ValueError(f"--stratify draws walks of every length and keeps off-location goals in their own "
                          f"cells; {', '.join(given)} do not apply")
-    n, objects, seed = args.n or 10, args.objects or (1, 5), 0 if args.seed is None else args.seed
+    n, objects, seed = args.n or PER_CELL, args.objects or OBJECTS, 0 if args.seed is None else args.seed
     exclude = tuple(Path(x) for x in (args.exclude or "").split(",") if x.strip())
     print(f"problems: {n} problems per cell of objects {objects[0]}-{objects[1]} x shortest-plan length, "
           f"seed {seed}" + (f", none of {', '.join(map(str, exclude))}" if exclude else "") + f" -> {args.out}",

@@ -29,6 +29,7 @@ from symlearn.world import Action, Scene, decode_action
 HORIZON_BUCKETS = ((1, 2), (3, 4), (5, 6), (7, 8))  # reference-length buckets of the depth benchmark
 MOVE_EPS_M = 0.01  # an action "changes something" when some object moves farther than this
 MAX_ACTION_DRAWS = 10_000  # draws of a random action before _changing_action gives up
+N_PROBLEMS = 20  # random-walk problems drawn unless asked otherwise (`symlearn problems`, the paper pipeline)
 
 
 @dataclass(frozen=True)

@@ -50,6 +50,8 @@ OFF_WALK_LENGTH = (1, 8)  # walk lengths drawn for the off-location cell
 SOURCES = ("walk", "structure", "aimed")
 AIMED_WALK = "aimed-walk"  # the task of a walk aimed at a state of the model
 AIMED_START_WALK = 8  # an aimed walk starts after 0..8 random actions from the dropped scene
+PER_CELL = 10  # problems per cell unless asked otherwise (`problems --stratify`, the recommended pipeline)
+OBJECTS = (1, 5)  # the object range stratified unless asked otherwise: every scene size the data sets hold
 
 
 @dataclass(frozen=True)
@@ -192,7 +194,7 @@ class CellReport:
         return head + (f" ({self.why})" if self.why else "")
 
 
-def generate_stratified(out_dir: Path, n: int, objects: tuple[int, int] = (1, 5), seed: int = 0, sim=None,
+def generate_stratified(out_dir: Path, n: int, objects: tuple[int, int] = OBJECTS, seed: int = 0, sim=None,
                         overwrite: bool = False, exclude: tuple[Path, ...] = (),
                         progress=None) -> tuple[list[Path], list[CellReport]]:
     """Write n problems per cell (module doc) to out_dir; returns the paths and a report per cell.
