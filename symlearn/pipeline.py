@@ -4,7 +4,8 @@ OUT/problems.
 
 The presets (PRESETS): `recommended`, the default, is the recipe that plans best (its run is shipped as
 pretrained/recommended, whose README gives the commands): the paper-size data set plus a set of 1-5-object
-scenes that only m(z) and the export read, the quick effect model with the stability loss, m(z) on 9 location
+scenes that only m(z) and the export read, the quick effect model with the stability loss and the action on the
+held object's token only, m(z) on 9 location
 bits, the lifted PDDL domain, problems stratified by shortest-plan length, astar-outcomes and stock Fast Downward
 on the lifted domain, closed loop. `demo` is the same recipe at a small scale (minutes on 2 cores: `make demo`);
 `paper` is the paper-faithful setup (its model sizes, learned codes only, the rules export, random-walk problems,
@@ -73,10 +74,12 @@ class PipelinePreset:
     epochs: int | None = None  # TrainConfig.epochs
     transition_epochs: int | None = None  # TransitionConfig.epochs
     stability_weight: float | None = None  # TrainConfig.stability_weight
+    action_per_object: bool = False  # ModelConfig.action_per_object: the action on the held object's token only
     min_count: int | None = None  # analyse_symbols' min_count (symbols.FREQUENT_MIN_COUNT)
     # the lifted domain (export_lifted; m(z) then reads lifted_scene.FIELD_BITS location bits) instead of the
     # rules export (export_pddl) with these sizes
     lifted: bool = False
+    lifted_min_count: int | None = None  # LiftedConfig.min_count (its default if None)
     max_objects: int | None = None  # ExportConfig.max_objects
     fidelity_cases: int | None = None  # ExportConfig.pddl_fidelity_cases
     # problems stratified by shortest-plan length (generate_stratified; `problems` per cell) instead of
@@ -97,15 +100,15 @@ class PipelinePreset:
 # The recipe that plans best (pretrained/recommended/README.md), at full scale: 12,000 samples of the
 # paper's exploration and 12,000 of 1-5 objects, the quick models, 10 problems per cell of 1-5 objects.
 RECOMMENDED = PipelinePreset(
-    "quick", extra_objects=(1, 5), stability_weight=0.1, lifted=True, stratified=True,
+    "quick", extra_objects=(1, 5), stability_weight=0.1, action_per_object=True, lifted=True, stratified=True,
     planners=(DEFAULT_PLANNER, "fast-downward-lifted"), closed_loop=True, timeout_s=10.0)
 
 PRESETS = {
     "recommended": RECOMMENDED,
     # the recipe in minutes on 2 busy cores (`make demo`): fewer samples and epochs, 2 problems per cell of 1-3
-    # objects; symbols need fewer training objects to count as frequent
+    # objects; symbols need fewer training objects to count as frequent, rules fewer answers of m(z)
     "demo": dataclasses.replace(RECOMMENDED, samples=1500, extra_samples=750, epochs=10, transition_epochs=20,
-                                min_count=20, problem_objects=(1, 3), problems=2),
+                                min_count=20, lifted_min_count=3, problem_objects=(1, 3), problems=2),
     # the paper-faithful setup: the paper's model sizes, learned codes only (no location bits), the rules export,
     # random-walk problems planned open loop
     "paper": PipelinePreset("paper", planners=("astar", "astar-ucs", "astar-outcomes", "rules-outcomes")),
@@ -251,7 +254,8 @@ def _train_config(s: PipelineSettings) -> TrainConfig:
     p = s.preset_values
     # bf16 autocast on a GPU only, as the pipeline has always trained (plain float32 on a CPU)
     return TrainConfig.from_preset(p.models, seed=s.seed, bf16=torch.cuda.is_available(),
-                                   **_given(epochs=_first(s.epochs, p.epochs), stability_weight=p.stability_weight))
+                                   **_given(epochs=_first(s.epochs, p.epochs), stability_weight=p.stability_weight,
+                                            action_per_object=p.action_per_object or None))
 
 
 def _symbols_config(s: PipelineSettings) -> SymbolsStageConfig:
@@ -280,7 +284,8 @@ def _export_config(s: PipelineSettings) -> ExportConfig:
 def _lifted_config(s: PipelineSettings) -> LiftedStageConfig:
     from symlearn.planning.lifted_export import LiftedConfig
 
-    return LiftedStageConfig(LiftedConfig(), extra_data=_extra_data(s))
+    return LiftedStageConfig(LiftedConfig(**_given(min_count=s.preset_values.lifted_min_count)),
+                             extra_data=_extra_data(s))
 
 
 def _problems_config(s: PipelineSettings) -> ProblemsStageConfig:

@@ -310,7 +310,7 @@ def test_pipeline_resumes_without_redoing_finished_stages(tmp_path, tiny_preset)
     assert configs["evaluate"] == {}  # nothing to set: it reads best.pt and the data set
     train = configs["train"]  # the TrainConfig the stage ran with: the recipe's, overridden
     assert (train["preset"], train["epochs"], train["seed"], train["model"]["crop"]) == ("quick", 1, 5, 32)
-    assert train["stability_weight"] == 0.1
+    assert train["stability_weight"] == 0.1 and train["model"]["action_per_object"]
     assert configs["collect-extra"]["exploration"]["k_values"] == [1, 2, 3, 4, 5]
     assert configs["train-transition"]["transition"]["location_bits"] == 9
     assert configs["problems"] == {"n": 1, "seed": 5, "objects": [1, 1]}
@@ -349,6 +349,7 @@ def test_the_default_preset_is_the_recommended_recipe(tmp_path):
     assert (extra["n"], extra["seed"], extra["exploration"]["k_values"]) == (12000, 2, [1, 2, 3, 4, 5])
     train = configs["train"]
     assert (train["preset"], train["epochs"], train["stability_weight"]) == ("quick", 40, 0.1)
+    assert train["model"]["action_per_object"]  # the held object's token alone carries the action (Table I)
     transition = configs["train-transition"]
     assert (transition["transition"]["preset"], transition["transition"]["location_bits"]) == ("quick", 9)
     assert transition["extra_data"] == ["data_extra"]
@@ -358,8 +359,8 @@ def test_the_default_preset_is_the_recommended_recipe(tmp_path):
     bench = configs["benchmark"]
     assert bench["planners"] == ["astar-outcomes", "fast-downward-lifted"] and bench["threads"] == 1
     assert (bench["execution"]["closed_loop"], bench["execution"]["timeout_s"]) == (True, 10.0)
-    sizes = dict.fromkeys(("samples", "extra_samples", "epochs", "transition_epochs", "min_count", "problem_objects",
-                           "problems"))
+    sizes = dict.fromkeys(("samples", "extra_samples", "epochs", "transition_epochs", "min_count", "lifted_min_count",
+                           "problem_objects", "problems"))
     assert dataclasses.replace(PRESETS["demo"], **sizes) == PRESETS["recommended"]  # the recipe, smaller
     paper = PipelineSettings(out=tmp_path / "paper", preset="paper")
     assert "collect-extra" not in paper.preset_values.stage_names
