@@ -284,15 +284,17 @@ def observed_moves(rules_like: LiftedRules, before: np.ndarray, after: np.ndarra
 
 
 def distil_lifted(layout: CodeLayout, stick_of: dict, moves: Sequence[tuple[dict, Outcome]], min_count: int = 3,
-                  model_hash: str = "") -> LiftedRules:
+                  model_hash: str = "", rider_min_count: int | None = None) -> LiftedRules:
     """Rules from observed (signature, outcome) moves: each full description's majority outcome (seen at least
-    min_count times), kept at the coarsest key under which all descriptions agree."""
+    min_count times; rider_min_count times where the outcome moves riders, which are rare in any data), kept at the
+    coarsest key under which all descriptions agree."""
     full = len(REFINEMENTS)
     tally: dict = defaultdict(Counter)
     for sig, out in moves:
         tally[key_of(sig, full)][out] += 1
     majority = {k: c.most_common(1)[0] for k, c in tally.items()}
-    majority = {k: (out, n) for k, (out, n) in majority.items() if n >= min_count}
+    rider_min = min_count if rider_min_count is None else rider_min_count
+    majority = {k: (out, n) for k, (out, n) in majority.items() if n >= (rider_min if len(out) > 3 else min_count)}
     sigs = {k: dict(k) for k in majority}
     groups: dict = defaultdict(set)
     support: Counter = Counter()

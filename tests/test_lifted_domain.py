@@ -8,12 +8,13 @@ level. Rules distilled from its moves must reproduce held-out moves exactly, and
 from __future__ import annotations
 
 import itertools
+from collections import Counter
 
 import numpy as np
 import pytest
 
-from pddl_export.lifted_rules import LiftedRules, distil_lifted, load_lifted, observed_moves, participants, \
-    stick_reader
+from pddl_export.lifted_rules import REFINEMENTS, LiftedRules, distil_lifted, key_of, load_lifted, observed_moves, \
+    participants, stick_reader
 from pddl_export.lifted_scene import CodeLayout, Piece, kept_bits, read_scene
 from pddl_export.lifted_writer import domain_pddl, object_name, plan_actions, problem_pddl
 from pddl_export.symbolic import SymbolicGoal
@@ -276,3 +277,20 @@ def test_moves_the_world_model_never_makes_still_write_a_domain_fast_downward_re
     goal = SymbolicGoal(((1 << 9) | (4 << 6) | 1, None, None))  # the stick at 4
     res = solve_texts(text, problem_pddl(rules, start, goal, "p"), "fd-blind", 60)
     assert res.status.value == "solved", res.message
+
+
+def test_moves_that_carry_riders_need_fewer_answers_than_others():
+    """distil_lifted keeps a description seen min_count times, or rider_min_count times when its outcome moves
+    riders: riders are rare, and a domain without them could not say that a stick carries what stands on it."""
+    before, actions, after, mask, stick = _arrays(world_moves(1500, seed=0))
+    objs = before[mask]
+    layout = CodeLayout(8, kept_bits((objs[:, None] >> (9 + np.arange(7, -1, -1))) & 1, (objs >> 6) & 7))
+    stick_of = stick_reader(before, mask, stick, layout)
+    moves, _ = observed_moves(LiftedRules(layout, stick_of), before, after, actions, mask)
+    counts = Counter(key_of(sig, len(REFINEMENTS)) for sig, out in moves if len(out) > 3)
+    assert counts, "the stacking world's walks carry riders"
+    high = max(counts.values()) + 1  # above every rider description's count
+    riders = lambda rules: [r for r in rules.rules if len(r.outcome) > 3]  # noqa: E731
+    assert not riders(distil_lifted(layout, stick_of, moves, min_count=high))
+    kept = distil_lifted(layout, stick_of, moves, min_count=high, rider_min_count=1)
+    assert riders(kept) and all(len(r.outcome) > 3 or r.support >= high for r in kept.rules)
