@@ -1,4 +1,4 @@
-"""What every output records beside itself: versions, hashes, and atomic writes of JSON."""
+"""What every output records beside itself: versions, hashes, and atomic writes of JSON (and of figures)."""
 from __future__ import annotations
 
 import os
@@ -10,6 +10,15 @@ from pddl_export.files import (atomic_write_bytes, atomic_write_json, atomic_wri
                                 sha256_bytes, sha256_file)
 
 _PACKAGES = ("symlearn", "numpy", "pybullet", "torch", "unified-planning")
+
+
+def atomic_write_png(fig, path, dpi: int) -> None:
+    """A matplotlib figure as PNG, written through the one atomic writer (no stray temp file on failure)."""
+    import io
+
+    buf = io.BytesIO()
+    fig.savefig(buf, dpi=dpi, format="png")
+    atomic_write_bytes(path, buf.getvalue())
 
 
 def versions() -> dict[str, str]:

@@ -13,7 +13,7 @@ import torch
 
 from symlearn.data.model_input import model_inputs
 from symlearn.learning.checkpoint import load_effect_model, stage_record
-from symlearn.provenance import atomic_write_json
+from symlearn.provenance import atomic_write_json, atomic_write_png
 from symlearn.sim.scenarios import SCENARIO_BY_NAME
 
 CASES = ("table1_case1", "table1_case2", "table1_case3")
@@ -56,29 +56,21 @@ def summarize_criteria(cases: list[dict]) -> dict:
 
 
 @torch.no_grad()
-def predict_scene_effects(model, ck, crops: np.ndarray, origins: np.ndarray, action_id: int,
-                          held: int = -1) -> np.ndarray:
-    """One observed scene's crops (k, S, S) and origins (k, 2) -> predicted effects (k, 3) in metres (held: the
-    index of the object the action grasps, read by models that take the action per object)."""
+def predict_scene(model, ck, crops: np.ndarray, origins: np.ndarray, action_id: int,
+                  held: int = -1) -> tuple[np.ndarray, np.ndarray | None]:
+    """One observed scene's crops (k, S, S) and origins (k, 2) -> predicted effects (k, 3) in metres, and each
+    layer's attention (layers, k, k), row i the weights object i puts on each object (averaged over heads; None for
+    a model without attention). held: the index of the object the action grasps, read by models that take the
+    action per object. The scene is encoded once for both."""
     depth = torch.from_numpy(crops.astype(np.float16).astype(np.float32))[None]  # as stored in the data set
     x = model_inputs(depth, torch.from_numpy(origins.astype(np.float32))[None])  # (1, k, 3, S, S)
     mask = torch.ones(1, crops.shape[0], dtype=torch.bool)
-    out = model.eval()(x, mask, torch.tensor([action_id]), held=torch.tensor([held]))
-    return out.effect[0].numpy() * ck.effect_std + ck.effect_mean
-
-
-@torch.no_grad()
-def scene_attention(model, crops: np.ndarray, origins: np.ndarray, action_id: int,
-                    held: int = -1) -> np.ndarray | None:
-    """One observed scene -> each layer's attention (layers, k, k), row i the weights object i puts on each object
-    (averaged over heads); None for a model without attention."""
-    depth = torch.from_numpy(crops.astype(np.float16).astype(np.float32))[None]
-    x = model_inputs(depth, torch.from_numpy(origins.astype(np.float32))[None])
-    mask = torch.ones(1, crops.shape[0], dtype=torch.bool)
+    actions, held_t = torch.tensor([action_id]), torch.tensor([held])
     model.eval()
     codes, _ = model.encode(x, mask)
-    maps = model.attention_maps(codes, mask, torch.tensor([action_id]), torch.tensor([held]))
-    return None if maps is None else maps[:, 0].numpy()
+    effects = model.decode(codes, mask, actions, held_t)[0].numpy() * ck.effect_std + ck.effect_mean
+    maps = model.attention_maps(codes, mask, actions, held_t)
+    return effects, None if maps is None else maps[:, 0].numpy()
 
 
 def rider_attention(case: dict) -> list[dict]:
@@ -98,14 +90,11 @@ def plot_attention(path: Path, cases: list[dict]) -> bool:
     model has none (the no-attention baseline)."""
     if not cases or not all(c.get("attention") for c in cases):
         return False
-    import io
-
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from symlearn.provenance import atomic_write_bytes
     layers = len(cases[0]["attention"])
     fig, axes = plt.subplots(len(cases), layers, figsize=(2.6 * layers + 0.6, 2.5 * len(cases)), squeeze=False)
     for r, case in enumerate(cases):
@@ -124,10 +113,8 @@ def plot_attention(path: Path, cases: list[dict]) -> bool:
             ax.set_title(f"case {r + 1}, layer {layer + 1}", fontsize=8)
     fig.suptitle("Table I: attention of each object (row) on each object (column), averaged over heads", fontsize=9)
     fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, dpi=110, format="png")
+    atomic_write_png(fig, path, dpi=110)
     plt.close(fig)
-    atomic_write_bytes(path, buf.getvalue())
     return True
 
 
@@ -143,7 +130,7 @@ def table1(run_dir: Path) -> dict:
             sim.build(sc.spec)
             obs = sim.observe()
             res = sim.step(sc.action)  # the grasped object, for models given the action per object
-            pred = predict_scene_effects(model, ck, obs.crops, obs.origins, sc.action.id, res.grasped)
+            pred, maps = predict_scene(model, ck, obs.crops, obs.origins, sc.action.id, res.grasped)
             rows.append({"name": name, "description": sc.description,
                          "action": [sc.action.pick, sc.action.release],
                          "objects": [{"type": t.name.lower(),
@@ -152,7 +139,6 @@ def table1(run_dir: Path) -> dict:
                                      for t, p, g in zip(sim.types, pred, res.effect)]})
             for obj in rows[-1]["objects"]:
                 obj["criteria"] = judge_object(obj)
-            maps = scene_attention(model, obs.crops, obs.origins, sc.action.id, res.grasped)
             if maps is not None:
                 rows[-1]["attention"] = np.round(maps, 3).tolist()
                 rows[-1]["rider_attention"] = rider_attention(rows[-1])

@@ -149,11 +149,11 @@ class SplitTensors:
     action: torch.Tensor  # (N,) int64
     effect: torch.Tensor  # (N, K, 3) float32, normalized
     n_objects: torch.Tensor  # (N,) int64
+    held: torch.Tensor  # (N,) int64, the object the suction tool held (-1: none), for the action per object
     weight: torch.Tensor | None = None  # (N, K) float32 loss weight per object
     post_depth: torch.Tensor | None = None  # (N, K, S, S) float16, the same objects after the action
     post_origin: torch.Tensor | None = None  # (N, K, 2) float32
     still: torch.Tensor | None = None  # (N, K) bool, objects the action left in place (with the post crops)
-    held: torch.Tensor | None = None  # (N,) int64, the object the suction tool held (-1: none)
 
     def __len__(self) -> int:
         return int(self.action.shape[0])
@@ -177,9 +177,9 @@ class SplitTensors:
         idx = idx.to(self.post_depth.device)
         return model_inputs(self.post_depth[idx].float(), self.post_origin[idx], image_size)
 
-    def held_of(self, idx: torch.Tensor) -> torch.Tensor | None:
+    def held_of(self, idx: torch.Tensor) -> torch.Tensor:
         """The held object's index of rows idx (for models that take the action per object)."""
-        return None if self.held is None else self.held[idx.to(self.held.device)]
+        return self.held[idx.to(self.held.device)]
 
     def weights(self, idx: torch.Tensor) -> torch.Tensor | None:
         """Loss weights of rows idx, or None when every object weighs 1."""
@@ -235,10 +235,9 @@ def predict_effects(model: AttentiveDeepSym, split: SplitTensors, batch_size: in
     for i in range(0, len(split), batch_size):
         idx = torch.arange(i, min(i + batch_size, len(split)))
         crops, mask, act, _ = split.batch(idx)
-        held = split.held_of(idx)
         with torch.autocast(device.type, dtype=torch.bfloat16, enabled=bf16):
             outs.append(model(crops.to(device), mask.to(device), act.to(device),
-                              held=None if held is None else held.to(device)).effect.float().cpu())
+                              held=split.held_of(idx).to(device)).effect.float().cpu())
     return torch.cat(outs)
 
 
@@ -395,9 +394,8 @@ def _train_epoch(loop: _Loop, tr: SplitTensors, epoch: int) -> tuple[float, int,
         post = tr.post_crops(idx).to(loop.device) if cfg.uses_post_crops else None
         weight = tr.weights(idx)
         with _autocast(cfg, loop.device):
-            held = tr.held_of(idx)
             out = loop.step_fn(crops, mask, act, generator=loop.noise_gen, post_crops=post,
-                               held=None if held is None else held.to(loop.device))
+                               held=tr.held_of(idx).to(loop.device))
         loss = masked_mse(out.effect.float(), eff, mask, None if weight is None else weight.to(loop.device))
         if cfg.dynamics_weight > 0:
             loss = loss + cfg.dynamics_weight * code_prediction_loss(out.next_logits.float(), out.next_codes.float(), mask)

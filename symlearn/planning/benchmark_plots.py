@@ -11,7 +11,6 @@ Markdown tables for the docs:
 from __future__ import annotations
 
 import argparse
-import io
 import math
 from pathlib import Path
 
@@ -19,7 +18,7 @@ from pddl_export.bounded_json import JsonFileError, MiB, read_json_file
 from symlearn.planning.benchmark import (LENGTH_BUCKETS, LOOPS, SHORTEST_BUCKETS, summary_failure_causes,
                                          summary_grid, summary_shortest_grid, summary_tasks)
 from symlearn.planning.execution import ProblemRun
-from symlearn.provenance import atomic_write_bytes
+from symlearn.provenance import atomic_write_png
 
 MAIN_BUCKETS = LENGTH_BUCKETS[:4]  # always shown; "9+" and "?" only when some row falls there
 DPI = 100
@@ -228,9 +227,7 @@ def _figure(grid: dict, key: str, ylabel: str, log: bool, loops: tuple[str, ...]
 
 
 def _save(fig, path: Path) -> Path:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=DPI)
-    atomic_write_bytes(path, buf.getvalue())
+    atomic_write_png(fig, path, DPI)
     return path
 
 

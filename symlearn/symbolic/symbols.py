@@ -7,7 +7,6 @@ location lands on actually moved).
 """
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +15,7 @@ from pddl_export.symbolic import code_str, codes_from_bits
 from symlearn.data.dataset import InteractionData, data_fingerprint, load_split
 from symlearn.learning.checkpoint import analysis_device, load_effect_model, stage_record
 from symlearn.learning.models import AttentiveDeepSym
-from symlearn.provenance import atomic_write_bytes, atomic_write_json
+from symlearn.provenance import atomic_write_json, atomic_write_png
 from symlearn.symbolic.transition_data import SymbolReader, symbol_reader
 from symlearn.world import LOCATIONS, N_LOCATIONS, OBJECT_SIZE, ObjectType
 
@@ -118,7 +117,7 @@ def _plot_prototypes(path: Path, data, codes, frequent, bits) -> None:
         ax.set_title(f"{r['code']}\nn={r['count']} x={r['mean_x_px']:.0f} y={r['mean_y_px']:.0f}", fontsize=7)
     fig.suptitle("Average depth crop per frequent symbol (height above the far plane)")
     fig.tight_layout()
-    _save_png(fig, path, dpi=110)
+    atomic_write_png(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -140,12 +139,6 @@ def _plot_examples(path: Path, data, codes, symbol: str, bits: int, n: int = 12)
         ax.set_title(f"{t}, {data.pre_pixels[i, k]} px", fontsize=8)
     fig.suptitle(f"Examples of symbol {symbol} ({len(np.argwhere(codes == int(symbol, 2)))} objects)")
     fig.tight_layout()
-    _save_png(fig, path, dpi=100)
+    atomic_write_png(fig, path, dpi=100)
     plt.close(fig)
 
-
-def _save_png(fig, path: Path, dpi: int) -> None:
-    """A matplotlib figure as PNG, written through the one atomic writer (no stray temp file on failure)."""
-    buf = io.BytesIO()
-    fig.savefig(buf, dpi=dpi, format="png")
-    atomic_write_bytes(path, buf.getvalue())
