@@ -3,7 +3,7 @@
     python examples/generate_domain.py                      # pretrained/recommended -> ./lifted_domain
     python examples/generate_domain.py --run RUN --problems DIR --out OUT
 
-The domain is the run's lifted rules (RUN/pddl/lifted.json, written by `symlearn export-pddl --lifted`) as typed
+The domain is the run's lifted rules (RUN/pddl/lifted.json, written by `symlearn export-pddl`) as typed
 STRIPS schemas; each problem's start and goal are the run's codes of its scenes, rendered in the simulator. Then
 e.g. `fast-downward.py --alias lama-first OUT/domain.pddl OUT/p01.pddl`.
 """

@@ -33,7 +33,7 @@ def check_engine(engine: str, address: str | None = None) -> None:
     if engine not in ENGINES:
         raise EngineError(f"unknown engine {engine!r}; known: {', '.join(ENGINES)}")
     if address is not None and engine != "ray":
-        raise EngineError(f"--address {address!r} joins a Ray cluster; it needs --engine ray")
+        raise EngineError(f"address {address!r} joins a Ray cluster; it needs the ray engine (--ray ADDRESS)")
     if engine == "ray":
         import_ray()
 
@@ -43,7 +43,7 @@ def import_ray():
     try:
         import ray
     except ImportError:
-        raise EngineError(f"--engine ray needs Ray, which is not installed; {INSTALL_HINT}") from None
+        raise EngineError(f"--ray needs Ray, which is not installed; {INSTALL_HINT}") from None
     return ray
 
 

@@ -33,7 +33,7 @@ import time
 import traceback
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Iterator
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping
 
 from pddl_export.bounded_json import AnyJson, JsonFileError, Map, Num, Obj, Opt, Str, check, read_json_file
 from symlearn.folder_lock import folder_lock
@@ -73,8 +73,6 @@ class PipelinePreset:
     extra_samples: int | None = None  # its CollectConfig.n
     epochs: int | None = None  # TrainConfig.epochs
     transition_epochs: int | None = None  # TransitionConfig.epochs
-    stability_weight: float | None = None  # TrainConfig.stability_weight
-    action_per_object: bool = False  # ModelConfig.action_per_object: the action on the held object's token only
     min_count: int | None = None  # analyse_symbols' min_count (symbols.FREQUENT_MIN_COUNT)
     # the lifted domain (export_lifted; m(z) then reads lifted_scene.FIELD_BITS location bits) instead of the
     # rules export (export_pddl) with these sizes
@@ -99,8 +97,10 @@ class PipelinePreset:
 
 # The recipe that plans best (pretrained/recommended/README.md), at full scale: 12,000 samples of the
 # paper's exploration and 12,000 of 1-5 objects, the quick models, 10 problems per cell of 1-5 objects.
+# The networks' presets of that name hold the effect model's and m(z)'s settings (TRAIN_PRESETS, TRANSITION_PRESETS);
+# its execution is execution.RECOMMENDED_EXECUTION, what plan and benchmark do by default (a test keeps them equal).
 RECOMMENDED = PipelinePreset(
-    "quick", extra_objects=(1, 5), stability_weight=0.1, action_per_object=True, lifted=True, stratified=True,
+    "recommended", extra_objects=(1, 5), lifted=True, stratified=True,
     planners=(DEFAULT_PLANNER, "fast-downward-lifted"), closed_loop=True, timeout_s=10.0)
 
 PRESETS = {
@@ -128,19 +128,25 @@ class PipelineSettings:
     transition_epochs: int | None = None
     problems: int | None = None  # problems, per cell with a stratified preset
     workers: int = 1
-    shard_size: int = 250
+    # the tables of a settings file (symlearn.config_file.read_config_file), over the preset's values and under the
+    # fields above: {"train": {"batch_size": 32}, "collect": {"shard_size": 100}, ...}
+    overrides: Mapping[str, Mapping[str, Any]] = dataclasses.field(default_factory=dict)
     stop_after: str | None = None  # stop after this stage (tests simulate an interruption with it)
 
     def __post_init__(self) -> None:
         if self.preset not in PRESETS:
             raise ValueError(f"unknown preset {self.preset!r}; known: {', '.join(PRESETS)}")
-        for name in ("n", "epochs", "transition_epochs", "problems", "workers", "shard_size", "seed"):
+        for name in ("n", "epochs", "transition_epochs", "problems", "workers", "seed"):
             v, least = getattr(self, name), 0 if name == "seed" else 1
             if v is not None and not (isinstance(v, int) and not isinstance(v, bool) and v >= least):
                 raise ValueError(f"--{name.replace('_', '-')} {v!r} must be an integer of at least {least}")
         names = self.preset_values.stage_names
         if self.stop_after is not None and self.stop_after not in names:
             raise ValueError(f"unknown stage {self.stop_after!r}; stages: {', '.join(names)}")
+
+    def table(self, name: str) -> Mapping[str, Any]:
+        """The settings file's table `name` (symlearn.config_file.TABLES), {} where it has none."""
+        return self.overrides.get(name, {})
 
     @property
     def preset_values(self) -> PipelinePreset:
@@ -231,31 +237,35 @@ def _extra_data(s: PipelineSettings) -> tuple[str, ...]:
 
 
 def _collect_config(s: PipelineSettings) -> CollectConfig:
+    from symlearn.config_file import replace_nested
     from symlearn.sim.collect import CollectConfig
 
-    return CollectConfig(seed=s.seed, shard_size=s.shard_size, **_given(n=_first(s.n, s.preset_values.samples)))
+    cfg = replace_nested(CollectConfig(**_given(n=s.preset_values.samples)), s.table("collect"))
+    return dataclasses.replace(cfg, seed=s.seed, **_given(n=s.n))
 
 
 def _collect_extra_config(s: PipelineSettings) -> CollectConfig:
     from symlearn.sim.collect import CollectConfig
     from symlearn.sim.exploration import ExplorationConfig
 
+    from symlearn.config_file import replace_nested
+
     p = s.preset_values
-    return CollectConfig(seed=s.seed + EXTRA_SEED_OFFSET, shard_size=s.shard_size,
-                         exploration=ExplorationConfig.with_k_range(*p.extra_objects),
-                         **_given(n=_first(s.n, p.extra_samples)))
+    cfg = replace_nested(CollectConfig(**_given(n=p.extra_samples)), s.table("collect"))
+    return dataclasses.replace(cfg, seed=s.seed + EXTRA_SEED_OFFSET, **_given(n=s.n),
+                               exploration=ExplorationConfig.with_k_range(*p.extra_objects))
 
 
 def _train_config(s: PipelineSettings) -> TrainConfig:
     import torch
 
+    from symlearn.config_file import flat_overrides
     from symlearn.learning.training import TrainConfig
 
     p = s.preset_values
     # bf16 autocast on a GPU only, as the pipeline has always trained (plain float32 on a CPU)
-    return TrainConfig.from_preset(p.models, seed=s.seed, bf16=torch.cuda.is_available(),
-                                   **_given(epochs=_first(s.epochs, p.epochs), stability_weight=p.stability_weight,
-                                            action_per_object=p.action_per_object or None))
+    values = {"bf16": torch.cuda.is_available(), **_given(epochs=p.epochs), **flat_overrides(s.table("train"))}
+    return TrainConfig.from_preset(p.models, **{**values, "seed": s.seed, **_given(epochs=s.epochs)})
 
 
 def _symbols_config(s: PipelineSettings) -> SymbolsStageConfig:
@@ -269,30 +279,38 @@ def _transition_config(s: PipelineSettings) -> TransitionStageConfig:
     from symlearn.symbolic.transition_model import TransitionConfig
 
     p = s.preset_values
-    cfg = TransitionConfig.from_preset(p.models, **_given(epochs=_first(s.transition_epochs, p.transition_epochs),
-                                                          location_bits=FIELD_BITS if p.lifted else None))
+    values = {**_given(epochs=p.transition_epochs, location_bits=FIELD_BITS if p.lifted else None),
+              **s.table("transition"), **_given(epochs=s.transition_epochs)}
+    cfg = TransitionConfig.from_preset(p.models, **values)
     return TransitionStageConfig(cfg, seed=s.seed, extra_data=_extra_data(s))
 
 
 def _export_config(s: PipelineSettings) -> ExportConfig:
     from symlearn.planning.export import ExportConfig
 
+    from symlearn.config_file import replace_nested
+
     p = s.preset_values
-    return ExportConfig(seed=s.seed, **_given(max_objects=p.max_objects, pddl_fidelity_cases=p.fidelity_cases))
+    cfg = ExportConfig(seed=s.seed, **_given(max_objects=p.max_objects, pddl_fidelity_cases=p.fidelity_cases))
+    return replace_nested(cfg, s.table("export"))
 
 
 def _lifted_config(s: PipelineSettings) -> LiftedStageConfig:
     from symlearn.planning.lifted_export import LiftedConfig
 
-    return LiftedStageConfig(LiftedConfig(**_given(min_count=s.preset_values.lifted_min_count)),
-                             extra_data=_extra_data(s))
+    from symlearn.config_file import replace_nested
+
+    cfg = replace_nested(LiftedConfig(**_given(min_count=s.preset_values.lifted_min_count)), s.table("lifted"))
+    return LiftedStageConfig(cfg, extra_data=_extra_data(s))
 
 
 def _problems_config(s: PipelineSettings) -> ProblemsStageConfig:
     from symlearn.planning.problem_generation import N_PROBLEMS, ProblemConfig
 
+    from symlearn.config_file import replace_nested
+
     n = _first(s.problems, s.preset_values.problems, N_PROBLEMS)
-    return ProblemsStageConfig(n=n, seed=s.seed, problem=ProblemConfig())
+    return ProblemsStageConfig(n=n, seed=s.seed, problem=replace_nested(ProblemConfig(), s.table("problems")))
 
 
 def _stratified_config(s: PipelineSettings) -> StratifiedStageConfig:
@@ -306,9 +324,11 @@ def _stratified_config(s: PipelineSettings) -> StratifiedStageConfig:
 def _benchmark_config(s: PipelineSettings) -> BenchmarkStageConfig:
     from symlearn.planning.execution import ExecutionConfig
 
+    from symlearn.config_file import replace_nested
+
     p = s.preset_values
-    return BenchmarkStageConfig(planners=p.planners,
-                                execution=ExecutionConfig(closed_loop=p.closed_loop, **_given(timeout_s=p.timeout_s)))
+    ex = ExecutionConfig(closed_loop=p.closed_loop, **_given(timeout_s=p.timeout_s))
+    return BenchmarkStageConfig(planners=p.planners, execution=replace_nested(ex, s.table("execution")))
 
 
 # ------------------------------------------------------------------------------- stage calls
@@ -434,10 +454,10 @@ def _benchmark(out: Path, cfg: BenchmarkStageConfig, s: PipelineSettings) -> Non
     with _torch_threads(cfg.threads):
         res = benchmark(run, out / PROBLEMS, list(cfg.planners), run / "benchmark.json", closed_loop=ex.closed_loop,
                         timeout_s=ex.timeout_s, max_replans=ex.max_replans, show_progress=False,
-                        record_dir=run / "recordings")
+                        record_dir=run / "recordings", risk_weight=ex.risk_weight)
         print(format_table(res))
         planner = cfg.planners[0]
-        done = plan_problem(run, _first_problem(out), planner, ex, record=run / "plan.gif")
+        done = plan_problem(run, _first_problem(out), planner, ex, record=run / "plan.gif", risk_weight=ex.risk_weight)
     row = done.row
     print(f"{done.problem.name} [{planner}]: found {row.found} ({row.status}), length {row.plan_length}, "
           f"success {row.success}; wrote {done.gif} ({done.frames} frames)")

@@ -12,17 +12,37 @@ import contextlib
 import io
 import json
 import shutil
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
+# The tiny run: a one-epoch quick effect model, a 3-epoch quick transition model, rules for scenes of <= 2 objects
+# (the levers that are not flags are in tests/tiny.toml).
+TINY_CONFIG = Path(__file__).resolve().parent / "tiny.toml"
+TINY_TABLES = tomllib.loads(TINY_CONFIG.read_text())
 # The tiny data set: 48 samples in 12 shards (40 train, 4 val, 4 test).
-TINY_DATA_ARGS = ("--n", "48", "--seed", "5", "--shard-size", "4")
-# The tiny run: a one-epoch quick effect model, a 3-epoch quick transition model, rules for scenes of <= 2 objects.
-TINY_TRAIN_ARGS = ("--preset", "quick", "--epochs", "1", "--batch-size", "8", "--no-bf16")
-TINY_TRANSITION_ARGS = ("--preset", "quick", "--epochs", "3", "--seed", "0")
-TINY_EXPORT_ARGS = ("--max-objects", "2", "--pddl-fidelity-cases", "60")
+TINY_DATA_ARGS = ("--n", "48", "--seed", "5", "--config", str(TINY_CONFIG))
+TINY_TRAIN_ARGS = ("--preset", "quick", "--epochs", "1", "--config", str(TINY_CONFIG))
+TINY_TRANSITION_ARGS = ("--preset", "quick", "--seed", "0", "--config", str(TINY_CONFIG))
+TINY_EXPORT_ARGS = ("--rules", "--config", str(TINY_CONFIG))
+
+
+def write_config(path: Path, tables: dict) -> Path:
+    """A settings file (--config) at `path` holding `tables` ({table: {key: value}}, a dict value a sub-table) over
+    the tiny run's (TINY_TABLES); returns the path."""
+    merged = {t: dict(v) for t, v in TINY_TABLES.items()}
+    for table, values in tables.items():
+        merged.setdefault(table, {}).update(values)
+
+    def lines(name: str, values: dict) -> list[str]:
+        plain = [f"{k} = {json.dumps(v)}" for k, v in values.items() if not isinstance(v, dict)]
+        subs = [line for k, v in values.items() if isinstance(v, dict) for line in lines(f"{name}.{k}", v)]
+        return [f"[{name}]", *plain, *subs]
+
+    path.write_text("\n".join(line for t, v in merged.items() for line in lines(t, v)) + "\n")
+    return path
 
 
 def cli(*args) -> tuple[int, str]:
@@ -117,7 +137,7 @@ def tiny_data(tmp_path_factory) -> TinyData:
 def tiny_k45(tmp_path_factory) -> Path:
     """A 16-sample data set of 4-5-object scenes (4 shards), collected once per session (read only)."""
     path = tmp_path_factory.mktemp("tiny_k45") / "k45"
-    cli_json("collect", "--out", path, "--n", "16", "--objects", "4-5", "--seed", "5", "--shard-size", "4", "--quiet")
+    cli_json("collect", "--out", path, "--n", "16", "--objects", "4-5", "--seed", "5", "--config", TINY_CONFIG, "--quiet")
     return path
 
 

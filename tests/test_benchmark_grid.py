@@ -6,6 +6,7 @@ hand; the plots are read back as images; a benchmark over two problem sets runs 
 from __future__ import annotations
 
 import json
+import re
 import shutil
 from pathlib import Path
 
@@ -15,7 +16,7 @@ import pytest
 from conftest import cli
 from symlearn.planning.benchmark import (length_bucket, load_sets, problem_sets, summary_failure_causes,
                                          summary_grid, summary_tasks)
-from symlearn.planning.benchmark_plots import (DPI, PANEL_IN, PLOT_FILES, format_grid, grid_of, main,
+from symlearn.planning.benchmark_plots import (DPI, PANEL_IN, PLOT_FILES, format_grid, grid_of,
                                                markdown_grid, write_plots)
 from symlearn.planning.execution import ProblemRun
 
@@ -134,14 +135,14 @@ def test_module_main_renders_a_saved_result_even_without_a_grid(tmp_path, capsys
     """An older result JSON holds rows only: the grid is recomputed from them, the same as a new one's."""
     old = tmp_path / "old.json"
     old.write_text(json.dumps({"rows": [r.to_json() for r in ROWS]}))
-    assert main([str(old), "--out", str(tmp_path / "plots")]) == 0
-    printed = capsys.readouterr().out
+    rc, printed = cli("plots", old, "--out", tmp_path / "plots")
+    assert rc == 0
     want = markdown_grid(grid_of({"rows": [r.to_json() for r in ROWS]}))
     assert want in printed and all((tmp_path / "plots" / f).stat().st_size > 0 for f in PLOT_FILES)
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({"rows": []}))
-    with pytest.raises(SystemExit, match="neither a grid nor rows"):
-        main([str(bad), "--out", str(tmp_path / "p2")])
+    assert cli("plots", bad, "--out", tmp_path / "p2")[0] == 2
+    assert "neither a grid nor rows" in capsys.readouterr().err
 
 
 def test_results_split_by_planner_merge_into_one(tmp_path, capsys):
@@ -154,17 +155,18 @@ def test_results_split_by_planner_merge_into_one(tmp_path, capsys):
     a.write_text(json.dumps({**settings, "planners": ["astar"], "rows": astar}))
     b.write_text(json.dumps({**settings, "planners": ["symk-sas"], "rows": symk}))
     merged = tmp_path / "merged.json"
-    assert main([str(a), str(b), "--out", str(tmp_path / "plots"), "--merged", str(merged)]) == 0
+    rc, printed = cli("plots", a, b, "--out", tmp_path / "plots", "--merged", merged)
+    assert rc == 0
     m = json.loads(merged.read_text())
     assert m["planners"] == ["astar", "symk-sas"] and len(m["rows"]) == len(ROWS)
     assert m["grid"] == json.loads(json.dumps(summary_grid(ROWS)))
-    assert markdown_grid(grid_of(m)) in capsys.readouterr().out
+    assert markdown_grid(grid_of(m)) in printed
     b.write_text(json.dumps({**settings, "timeout_s": 30, "planners": ["symk-sas"], "rows": symk}))
-    with pytest.raises(SystemExit, match="other settings .*timeout_s"):
-        main([str(a), str(b), "--out", str(tmp_path / "p2")])
+    assert cli("plots", a, b, "--out", tmp_path / "p2")[0] == 2
+    assert re.search("other settings .*timeout_s", capsys.readouterr().err)
     b.write_text(json.dumps({**settings, "planners": ["astar"], "rows": astar[:1]}))
-    with pytest.raises(SystemExit, match="both hold the row"):
-        main([str(a), str(b), "--out", str(tmp_path / "p3")])
+    assert cli("plots", a, b, "--out", tmp_path / "p3")[0] == 2
+    assert "both hold the row" in capsys.readouterr().err
 
 
 def _sets(tmp_path: Path) -> Path:
@@ -197,20 +199,23 @@ def test_several_sets_give_unique_prefixed_keys(tmp_path):
 def test_benchmark_over_two_sets_end_to_end(tiny_run_copy, tmp_path):
     """Two generated sets with the same file names: every row is kept apart, summarized and plotted."""
     for name, seed in (("a", 0), ("b", 1)):
-        rc, _ = cli("problems", "--out", tmp_path / "sets" / name, "--n", 2, "--objects", "1-2", "--length", "1-2",
-                    "--seed", seed)
+        rc, _ = cli("problems", "--kind", "walks", "--out", tmp_path / "sets" / name, "--n", 2, "--objects", "1-2",
+                    "--length", "1-2", "--seed", seed)
         assert rc == 0
     out, plots = tmp_path / "bench.json", tmp_path / "plots"
     rc, text = cli("benchmark", "--run", tiny_run_copy, "--problems", tmp_path / "sets", "--planners", "astar",
-                   "--timeout", 5, "--out", out, "--plots", plots, "--quiet")
+                   "--timeout", 5, "--out", out)
     assert rc == 0 and "astar: success open/closed (n)" in text
+    assert cli("plots", out, "--out", plots)[0] == 0
     b = json.loads(out.read_text())
-    names = [r["problem"] for r in b["rows"]]
+    names = [r["problem"] for r in b["rows"] if not r["closed_loop"]]  # each problem open, then closed loop
     assert names == ["a/problem_0000", "a/problem_0001", "b/problem_0000", "b/problem_0001"]
     assert b["n_problems"] == 4 and [Path(p).name for p in b["problems"]] == ["a", "b"]
     cells = [c for objs in b["grid"]["astar"].values() for cs in objs.values() for c in cs.values()]
-    assert sum(c["n"] for c in cells) == 4
-    assert sum(b["failure_causes"]["astar"]["open"].values()) == sum(not r["success"] for r in b["rows"])
+    assert sum(c["n"] for c in cells) == 8  # 4 problems, open and closed loop
+    for loop in ("open", "closed"):
+        rows = [r for r in b["rows"] if r["closed_loop"] == (loop == "closed")]
+        assert sum(b["failure_causes"]["astar"][loop].values()) == sum(not r["success"] for r in rows)
     assert all((plots / f).stat().st_size > 0 for f in PLOT_FILES)
     assert not (tmp_path / "bench.json.rows.jsonl").exists()
 

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import torch
 
-from conftest import TINY_TRANSITION_ARGS, TINY_TRAIN_ARGS, cli, cli_json, recomputed_transition_accuracy
+from conftest import TINY_TRANSITION_ARGS, cli, cli_json, recomputed_transition_accuracy, write_config
 
 ROOT = Path(__file__).resolve().parents[1]
 N_ACTIONS = 36
@@ -49,7 +49,8 @@ def _plan(run: Path, problem: Path, planner: str, *extra) -> dict:
 def problems(tmp_path_factory) -> Path:
     """Three problems of 1-2 objects, 1-2 generator actions."""
     out = tmp_path_factory.mktemp("cli_problems") / "p"
-    rc, text = cli("problems", "--out", out, "--n", 3, "--objects", "1-2", "--length", "1-2", "--seed", 0)
+    rc, text = cli("problems", "--kind", "walks", "--out", out, "--n", 3, "--objects", "1-2", "--length", "1-2",
+                   "--seed", 0)
     assert rc == 0 and f"wrote 3 problems to {out}" in text
     return out
 
@@ -96,12 +97,13 @@ def test_train_output_matches_run_files(tiny_run):
 
 
 def test_train_bf16_path(tiny_data, tiny_run, tmp_path):
-    """bf16 autocast (the default without --no-bf16): finite falling loss, float32 weights, a loadable checkpoint."""
+    """bf16 autocast (the default without bf16 = false): finite falling loss, float32 weights, a loadable checkpoint."""
     from symlearn.learning.checkpoint import load_checkpoint
 
     run = tmp_path / "bf16"
+    (tmp_path / "b8.toml").write_text("[train]\nbatch_size = 8\n")
     out = cli_json("train", "--data", tiny_data.path, "--out", run, "--preset", "quick", "--epochs", 3,
-                   "--batch-size", 8, "--quiet")
+                   "--config", tmp_path / "b8.toml", "--quiet")
     cfg = json.loads((run / "config.json").read_text())["train_config"]
     assert cfg["bf16"] is True
     hist = json.loads((run / "metrics.json").read_text())["history"]
@@ -125,7 +127,9 @@ def test_other_code_length_runs_through_the_pipeline(tiny_data, tmp_path):
     from symlearn.planning.export import training_codes
 
     run = tmp_path / "b4"
-    cli_json("train", "--data", tiny_data.path, "--out", run, *TINY_TRAIN_ARGS, "--bits", 4, "--quiet")
+    bits4 = write_config(tmp_path / "bits4.toml", {"train": {"model": {"bits": 4}}, "export": {"pddl_fidelity_cases": 20}})
+    cli_json("train", "--data", tiny_data.path, "--out", run, "--preset", "quick", "--epochs", 1, "--config", bits4,
+             "--quiet")
     assert json.loads((run / "config.json").read_text())["train_config"]["model"]["bits"] == 4
     pre, post = training_codes(run, tiny_data.path)
     assert pre.max() < 16 and post.max() < 16 and (pre >= 0).sum() > 0
@@ -133,7 +137,7 @@ def test_other_code_length_runs_through_the_pipeline(tiny_data, tmp_path):
     want = recomputed_transition_accuracy(run, tiny_data.path)
     assert t["test"]["bit_accuracy"] == pytest.approx(want["bit_accuracy"], abs=1e-5)
     assert t["test"]["scene_accuracy"] == pytest.approx(want["scene_accuracy"], abs=1e-5)
-    rc, _ = cli("export-pddl", "--run", run, "--data", tiny_data.path, "--max-objects", 2, "--pddl-fidelity-cases", 20)
+    rc, _ = cli("export-pddl", "--run", run, "--data", tiny_data.path, "--rules", "--config", bits4)
     rules = json.loads((run / "pddl" / "rules.json").read_text())
     rep = json.loads((run / "pddl" / "report.json").read_text())
     assert rc == 0 and rules["bits"] == 4 and rep["fidelity"] == 1.0 and rep["pddl_fidelity"] == 1.0
@@ -206,8 +210,9 @@ def test_export_pddl_report(tiny_run):
 
 def test_export_pddl_all_scenes(tiny_data, tiny_run, tmp_path):
     out = tmp_path / "all"
-    rc, text = cli("export-pddl", "--run", tiny_run.path, "--data", tiny_data.path, "--out", out, "--scenes", "all",
-                   "--max-objects", 2, "--pddl-fidelity-cases", 20)
+    config = write_config(tmp_path / "all.toml", {"export": {"scenes": "all", "pddl_fidelity_cases": 20}})
+    rc, text = cli("export-pddl", "--run", tiny_run.path, "--data", tiny_data.path, "--out", out, "--rules", "--config",
+                   config)
     assert rc == 0 and f"wrote {out / 'domain.pddl'}" in text
     rep = json.loads((out / "report.json").read_text())
     v = rep["vocabulary_size"]
@@ -216,7 +221,7 @@ def test_export_pddl_all_scenes(tiny_data, tiny_run, tmp_path):
     assert rep["n_enumerated_cases"] == N_ACTIONS * rep["n_enumerated_scenes"]
     assert rep["n_enumerated_scenes"] >= tiny_run.export_report["n_enumerated_scenes"]
     assert rep["fidelity"] == 1.0 and rep["pddl_fidelity"] == 1.0 and rep["pddl_fidelity_cases"] == 20
-    # flags left unset keep ExportConfig's defaults; the given ones are recorded
+    # settings left unset keep ExportConfig's defaults; the given ones are recorded
     from symlearn.planning.export import ExportConfig
     want = dataclasses.asdict(ExportConfig(scenes="all", max_objects=2, pddl_fidelity_cases=20))
     assert rep["config"] == want
@@ -236,18 +241,20 @@ def test_problems_files(problems, tmp_path):
         moved = np.abs(np.array([o["position"] for o in p["goal"]["objects"]])
                        - np.array([o["position"] for o in p["initial"]["objects"]])).max()
         assert moved > 0.01  # every generator action changes something
-    rc, _ = cli("problems", "--out", tmp_path / "again", "--n", 3, "--objects", "1-2", "--length", "1-2", "--seed", 0)
+    rc, _ = cli("problems", "--kind", "walks", "--out", tmp_path / "again", "--n", 3, "--objects", "1-2", "--length",
+                "1-2", "--seed", 0)
     assert rc == 0 and all(f.read_bytes() == (tmp_path / "again" / f.name).read_bytes() for f in files)  # seeded
 
 
-def test_plan_with_astar_and_sas_planner(tiny_run_copy, problems):
+def test_plan_with_astar_and_sas_planner(tiny_run_copy, problems, tmp_path):
     problem = problems / "problem_0000.json"
     gen = len(json.loads(problem.read_text())["actions"])
     row = _plan(tiny_run_copy, problem, "astar")
     assert row["planner"] == "astar" and int(row["gen"]) == gen and row["failure"] in FAILURE_STAGES
     assert (row["success"] == "True") == (row["failure"] is None)
     assert (row["found"] == "True") == (row["length"] is not None) == (row["failure"] not in ("no_plan", "timeout"))
-    row = _plan(tiny_run_copy, problem, "fast-downward-sas", "--closed-loop", "--max-replans", 1)
+    one_replan = write_config(tmp_path / "replan1.toml", {"execution": {"max_replans": 1}})
+    row = _plan(tiny_run_copy, problem, "fast-downward-sas", "--config", one_replan)
     assert row["closed"] and int(row["replans"]) <= 1 and row["failure"] != "rules_vs_net"  # the rules are exact
     written = tiny_run_copy / "pddl" / "problems" / "problem_0000"
     model_hash = json.loads((tiny_run_copy / "pddl" / "rules.json").read_text())["model_hash"]
@@ -256,8 +263,9 @@ def test_plan_with_astar_and_sas_planner(tiny_run_copy, problems):
 
 def test_benchmark_rows_and_summary(tiny_run_copy, problems, tmp_path):
     out = tmp_path / "bench.json"
+    one_replan = write_config(tmp_path / "replan1.toml", {"execution": {"max_replans": 1}})
     rc, text = cli("benchmark", "--run", tiny_run_copy, "--problems", problems, "--planners", "astar,fast-downward-sas",
-                   "--closed-loop", "--max-replans", 1, "--timeout", 10, "--out", out, "--quiet")
+                   "--config", one_replan, "--timeout", 10, "--out", out)
     assert rc == 0 and f"wrote {out}" in text
     b = json.loads(out.read_text())
     files = sorted(problems.glob("*.json"))
@@ -300,7 +308,8 @@ def _bit_flip_rules(rules_file: Path, problem: Path) -> None:
 
 
 def test_plan_from_tampered_rules_fails_at_rules_vs_net(tiny_run_copy, tmp_path):
-    rc, _ = cli("problems", "--out", tmp_path / "p", "--n", 2, "--objects", "1-1", "--length", "1-2", "--seed", 0)
+    rc, _ = cli("problems", "--kind", "walks", "--out", tmp_path / "p", "--n", 2, "--objects", "1-1", "--length", "1-2",
+                "--seed", 0)
     assert rc == 0
     stages = []
     for problem in sorted((tmp_path / "p").glob("*.json")):
@@ -319,9 +328,16 @@ def test_plan_from_tampered_rules_fails_at_rules_vs_net(tiny_run_copy, tmp_path)
 
 @pytest.mark.parametrize("args, message", [
     (["plan", "--run", "{run}", "--problem", "{problem}", "--planner", "nope"], "unknown planner 'nope'; known: "),
-    (["export-pddl", "--run", "{run}", "--data", "{data}", "--max-objects", "9"], "max_objects=9 must lie in 1..5"),
-    (["export-pddl", "--run", "{run}", "--data", "{data}", "--outcome-min-ratio", "0"],
+    (["export-pddl", "--run", "{run}", "--data", "{data}", "--rules", "--config", "{max9}"],
+     "max_objects=9 must lie in 1..5"),
+    (["export-pddl", "--run", "{run}", "--data", "{data}", "--rules", "--config", "{ratio0}"],
      "outcome_min_ratio=0.0 must lie in (0, 1]"),
+    (["export-pddl", "--run", "{run}", "--data", "{data}", "--config", "{typo}"],
+     "typo.toml: [lifted] has no setting 'min_cont'; settings: min_count, rider_min_count, min_info"),
+    (["plan", "--run", "{run}", "--problem", "{problem}", "--config", "{wrongtype}"],
+     "wrongtype.toml: [execution] closed_loop must be a bool, not 'yes'"),
+    (["train", "--data", "{data}", "--out", "{empty}/r", "--config", "{table}"],
+     "table.toml: unknown table [planner]; tables: collect, train, transition, export, lifted, problems, execution"),
     (["benchmark", "--run", "{empty}", "--problems", "{problems}", "--planners", "rules-outcomes", "--out", "{empty}/b.json"],
      "no exported rules at"),
     (["benchmark", "--run", "{empty}", "--problems", "{problems}", "--planners", "fast-downward-sas", "--out", "{empty}/b.json"],
@@ -330,8 +346,13 @@ def test_plan_from_tampered_rules_fails_at_rules_vs_net(tiny_run_copy, tmp_path)
 def test_refusals_exit_2_with_one_line(args, message, tiny_data, tiny_run, problems, tmp_path, capsys):
     empty = tmp_path / "empty"
     empty.mkdir()
+    files = {"max9": "[export]\nmax_objects = 9\n", "ratio0": "[export]\noutcome_min_ratio = 0\n",
+             "typo": "[lifted]\nmin_cont = 3\n", "wrongtype": "[execution]\nclosed_loop = 'yes'\n",
+             "table": "[planner]\nname = 'astar'\n"}
+    for name, text in files.items():
+        (tmp_path / f"{name}.toml").write_text(text)
     fill = dict(run=tiny_run.path, data=tiny_data.path, problems=problems, problem=problems / "problem_0000.json",
-                empty=empty)
+                empty=empty, **{name: tmp_path / f"{name}.toml" for name in files})
     rc, out = cli(*[a.format(**fill) for a in args])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and out == ""

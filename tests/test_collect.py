@@ -125,8 +125,9 @@ def test_bad_exploration_settings_refused(kw, msg):
 
 def test_cli_collect_and_refusals(tmp_path):
     out = tmp_path / "cli"
+    (tmp_path / "shards.toml").write_text("[collect]\nshard_size = 1\n")
     run = [sys.executable, "-m", "symlearn.cli.main", "collect", "--out", str(out), "--n", "12",
-           "--shard-size", "1", "--objects", "4-5", "--quiet"]
+           "--config", str(tmp_path / "shards.toml"), "--objects", "4-5", "--quiet"]
     r = subprocess.run(run, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     summary = json.loads(r.stdout)

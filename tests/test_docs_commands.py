@@ -2,9 +2,9 @@
 
 Commands are read from fenced blocks (backslash continuations joined) and from inline code that starts with
 `symlearn ` or `python bench/`. Each flag must be one its sub-command (or bench script) defines, each value of a
-flag with choices one of them, each planner of `--planners` a registered one. Placeholders (COPY, RUN, S, {7,9},
-`...`) and the flags' required-ness are not judged: docs often show a fragment such as `train-transition
---modes 4`.
+flag with choices one of them, each planner of `--planners` a registered one. Placeholders (COPY, RUN, S,
+{walks,structures}, `...`) and the flags' required-ness are not judged: docs often show a fragment such as
+`problems --kind walks`.
 """
 from __future__ import annotations
 
@@ -107,7 +107,8 @@ def test_every_documented_command_is_accepted(doc):
 
 @pytest.mark.parametrize("command, expected", [
     ("symlearn benchmark --run R --problems P --planners astar,astar-magic", "unknown planner 'astar-magic'"),
-    ("symlearn train-transition --run R --location-bits 8", "--location-bits 8: not one of"),
+    ("symlearn problems --out P --kind deep", "--kind deep: not one of"),
+    ("symlearn train-transition --run R --location-bits 9", "unknown flag --location-bits"),
     ("symlearn train --data D --out R --preset huge", "--preset huge: not one of"),
     ("symlearn train --data D --out R --epoch 3", "unknown flag --epoch"),
     ("symlearn teach --run R", "no sub-command 'teach'"),
@@ -120,8 +121,8 @@ def test_the_check_refuses_what_the_code_would(command, expected):
 
 def test_the_check_accepts_placeholders_and_fragments():
     subs = _subcommands()
-    for command in ("symlearn train-transition --location-bits {7,9} [--modes 4]",
-                    "symlearn train-transition --run COPY --location-bits 9 --seed S",
-                    "symlearn benchmark --run COPY --problems A,B --planners P --closed-loop",
+    for command in ("symlearn problems --kind {walks,structures} [--n 4]",
+                    "symlearn train-transition --run COPY --config C.toml --seed S",
+                    "symlearn benchmark --run COPY --problems A,B --planners P --timeout 10",
                     "python bench/sas_body.py --run COPY --objects 2,3,4,5 --baseline-max-objects 4 --out x.json"):
         assert command_problems(command, subs) == [], command

@@ -470,50 +470,66 @@ def test_failure_stage_values_are_the_json_strings():
     assert bench.summarize_rows([row])["astar"]["failure_stages"] == {"timeout": 1}
 
 
-def test_cli_parses_planning_commands():
+def test_cli_parses_planning_commands(tmp_path):
+    from symlearn.cli.planning import execution_config
+    from symlearn.config_file import ConfigFileError, read_config_file
+    from symlearn.planning.execution import RECOMMENDED_EXECUTION
+    from symlearn.symbolic.transition_model import TransitionConfig
+
     p = argparse.ArgumentParser(prog="symlearn")
     sub = p.add_subparsers(dest="command", required=True)
     add_planning_commands(sub)
     a = p.parse_args(["problems", "--out", "x", "--n", "3", "--objects", "4-5", "--length", "2", "--seed", "1"])
-    assert (a.objects, a.length, a.n) == ((4, 5), (2, 2), 3) and a.func.__name__ == "cmd_problems"
-    a = p.parse_args(["benchmark", "--run", "r", "--problems", "d", "--planners", "astar,astar-ucs", "--out", "o",
-                      "--closed-loop"])
-    assert a.planners == ["astar", "astar-ucs"] and a.closed_loop and a.func.__name__ == "cmd_benchmark"
+    assert (a.objects, a.length, a.n, a.kind) == ((4, 5), (2, 2), 3, None) and a.func.__name__ == "cmd_problems"
+    a = p.parse_args(["benchmark", "--run", "r", "--problems", "d", "--planners", "astar,astar-ucs", "--out", "o"])
+    assert a.planners == ["astar", "astar-ucs"] and a.func.__name__ == "cmd_benchmark"
+    assert execution_config(a) == RECOMMENDED_EXECUTION and RECOMMENDED_EXECUTION.closed_loop  # the recipe's
     a = p.parse_args(["plan", "--run", "r", "--problem", "f.json", "--planner", "astar-ucs", "--timeout", "5"])
-    assert a.planner == "astar-ucs" and a.timeout == 5.0 and not a.closed_loop and a.func.__name__ == "cmd_plan"
-    assert a.risk_weight == 1.0
-    a = p.parse_args(["plan", "--run", "r", "--problem", "f.json", "--planner", "astar-likely", "--risk-weight", "2"])
-    assert a.planner == "astar-likely" and a.risk_weight == 2.0
+    assert a.planner == "astar-ucs" and a.func.__name__ == "cmd_plan"
+    assert execution_config(a) == dataclasses.replace(RECOMMENDED_EXECUTION, timeout_s=5.0)
+    config = tmp_path / "open.toml"
+    config.write_text("[execution]\nclosed_loop = false\nrisk_weight = 2\ntimeout_s = 30\n")
+    a = p.parse_args(["plan", "--run", "r", "--problem", "f.json", "--config", str(config), "--timeout", "7"])
+    got = execution_config(a)  # the file over the recipe, the flag over the file
+    assert (got.closed_loop, got.risk_weight, got.timeout_s, got.max_replans) == (False, 2.0, 7.0, 3)
     for bad in ("0", "-1", "nan"):
-        with pytest.raises(SystemExit):
-            p.parse_args(["benchmark", "--run", "r", "--problems", "d", "--out", "o", "--risk-weight", bad])
-    a = p.parse_args(["train-transition", "--run", "r", "--data", "d", "--preset", "quick", "--epochs", "4"])
-    assert (a.preset, a.epochs, a.seed) == ("quick", 4, 0) and a.func.__name__ == "cmd_train_transition"
-    assert a.location_bits is None  # the learned codes alone
-    base = ["train-transition", "--run", "r", "--data", "d"]
-    assert p.parse_args([*base, "--location-bits"]).location_bits == 7  # the flag alone: location, off, height
-    assert [p.parse_args([*base, "--location-bits", n]).location_bits for n in "45679"] == [4, 5, 6, 7, 9]
-    for bad in ("3", "8", "10"):
-        with pytest.raises(SystemExit):
-            p.parse_args([*base, "--location-bits", bad])
-    assert p.parse_args(base).modes is None and p.parse_args([*base, "--modes", "4"]).modes == 4
-    with pytest.raises(SystemExit):
-        p.parse_args([*base, "--modes", "0"])
+        config.write_text(f"[execution]\nrisk_weight = {bad}\n")
+        with pytest.raises((ValueError, ConfigFileError)):
+            execution_config(p.parse_args(["plan", "--run", "r", "--problem", "f", "--config", str(config)]))
+    a = p.parse_args(["train-transition", "--run", "r", "--data", "d", "--preset", "quick"])
+    assert (a.preset, a.seed, a.config) == ("quick", 0, None) and a.func.__name__ == "cmd_train_transition"
+    assert p.parse_args(["train-transition", "--run", "r", "--data", "d"]).preset == "recommended"
+    assert TransitionConfig.from_preset("recommended").location_bits == 9  # what the lifted domain reads
+    for n in (4, 5, 6, 7, 9):
+        config.write_text(f"[transition]\nlocation_bits = {n}\nmodes = 4\n")
+        assert TransitionConfig.from_preset("quick", **read_config_file(config)["transition"]).location_bits == n
+    for bad in (3, 8, 10):
+        config.write_text(f"[transition]\nlocation_bits = {bad}\n")
+        with pytest.raises(ValueError, match="location_bits"):
+            TransitionConfig.from_preset("quick", **read_config_file(config)["transition"])
+    config.write_text("[transition]\nmodes = 0\n")
+    with pytest.raises(ValueError, match="modes=0"):
+        TransitionConfig.from_preset("quick", **read_config_file(config)["transition"])
 
 
 def test_cli_problems_command(tmp_path):
     p = argparse.ArgumentParser(prog="symlearn")
     add_planning_commands(p.add_subparsers(dest="command", required=True))
-    args = p.parse_args(["problems", "--out", str(tmp_path / "pp"), "--n", "1", "--objects", "1-2", "--seed", "2"])
+    args = p.parse_args(["problems", "--kind", "walks", "--out", str(tmp_path / "pp"), "--n", "1", "--objects", "1-2",
+                         "--seed", "2"])
     assert args.func(args) == 0
     assert load_problem(tmp_path / "pp" / "problem_0000.json").k in (1, 2)
     args = p.parse_args(["problems", "--out", str(tmp_path / "on"), "--n", "2", "--objects", "1-2", "--seed", "2",
-                         "--length", "2-3", "--on-locations"])
-    assert args.on_locations and args.func(args) == 0
+                         "--length", "2-3", "--kind", "located-walks"])
+    assert args.func(args) == 0
     assert [load_problem(f).goal_off_locations for f in sorted((tmp_path / "on").glob("*.json"))] == [0, 0]
-    args = p.parse_args(["problems", "--out", str(tmp_path / "s"), "--suite", "structures", "--on-locations"])
-    with pytest.raises(ValueError, match="--on-locations applies to random-walk problems only"):
+    args = p.parse_args(["problems", "--out", str(tmp_path / "s"), "--kind", "structures", "--exclude", "x"])
+    with pytest.raises(ValueError, match="--exclude does not apply to --kind structures"):
         args.func(args)
+    args = p.parse_args(["problems", "--out", str(tmp_path / "t"), "--length", "1-2"])  # the default: stratified
+    with pytest.raises(ValueError, match="--length does not apply to --kind stratified"):
+        args.func(args)
+    assert not (tmp_path / "s").exists() and not (tmp_path / "t").exists()
 
 
 # ------------------------------------------------------------------------------- recovery and attribution

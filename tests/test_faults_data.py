@@ -21,7 +21,8 @@ from conftest import cli
 
 REPO = Path(__file__).resolve().parents[1]
 # 24 shards of 2 samples: long enough for a kill to land in the middle with two workers.
-COLLECT_ARGS = ("--n", "48", "--shard-size", "2", "--seed", "7", "--quiet")
+FAULTS_CONFIG = Path(__file__).resolve().parent / "faults.toml"  # shards of 2; small training runs
+COLLECT_ARGS = ("--n", "48", "--config", str(FAULTS_CONFIG), "--seed", "7", "--quiet")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -156,8 +157,7 @@ def test_sigkill_of_collect_parent_stops_workers_and_resume_removes_temp_files(t
 # ----------------------------------------------------------------------------------------------
 # 2. damaged manifests and checkpoints: one line naming the file, no traceback
 
-RUN_ARGS = ("--preset", "quick", "--epochs", "1", "--batch-size", "8", "--max-train-samples", "16", "--no-bf16",
-            "--quiet")
+RUN_ARGS = ("--preset", "quick", "--epochs", "1", "--config", FAULTS_CONFIG, "--quiet")
 
 
 def _error_line(capsys, command: str, rc: int) -> str:
@@ -258,11 +258,11 @@ def test_damaged_checkpoint_is_one_line_error(effect_run, tmp_path, capsys, dama
 # ----------------------------------------------------------------------------------------------
 # 3. bad flag values: refused by argparse (exit code 2, one line) before anything is written
 
-BAD_TRAIN_FLAGS = [("--epochs", "0"), ("--epochs", "-1"), ("--batch-size", "0"), ("--batch-size", "-2"),
-                   ("--max-train-samples", "0"), ("--max-train-samples", "-5"), ("--lr", "inf"), ("--lr", "nan"),
-                   ("--lr", "0"), ("--lr", "-1e-3"), ("--seed", "-1"), ("--threads", "0"), ("--epochs", "1.5")]
-BAD_COLLECT_FLAGS = [("--seed", "-1"), ("--n", "0"), ("--n", "-12"), ("--workers", "0"), ("--shard-size", "0"),
-                     ("--shard-size", "-2")]
+BAD_TRAIN_FLAGS = [("--epochs", "0"), ("--epochs", "-1"), ("--seed", "-1"), ("--threads", "0"), ("--epochs", "1.5")]
+BAD_TRAIN_SETTINGS = [("batch_size", "0"), ("batch_size", "-2"), ("max_train_samples", "0"), ("max_train_samples", "-5"),
+                      ("lr", "inf"), ("lr", "nan"), ("lr", "0"), ("lr", "-1e-3"), ("batch_size", "1.5"),
+                      ("lr", "'fast'")]
+BAD_COLLECT_FLAGS = [("--seed", "-1"), ("--n", "0"), ("--n", "-12"), ("--workers", "0")]
 
 
 def _argparse_refusal(capsys, args: list) -> str:
@@ -282,10 +282,21 @@ def test_bad_train_flag_refused(tiny_data, tmp_path, capsys, flag, value):
     assert not run.exists()
 
 
+@pytest.mark.parametrize("key,value", BAD_TRAIN_SETTINGS, ids=[f"{k}={v}" for k, v in BAD_TRAIN_SETTINGS])
+def test_bad_train_setting_refused(tiny_data, tmp_path, capsys, key, value):
+    """A bad value in --config's [train] table: one line naming the setting, before any folder is made."""
+    run, config = tmp_path / "run", tmp_path / "bad.toml"
+    config.write_text(f"[train]\n{key} = {value}\n")
+    rc, _ = cli("train", "--data", tiny_data.path, "--out", run, "--preset", "quick", "--config", config, "--quiet")
+    line = _error_line(capsys, "train", rc)
+    assert key in line, line
+    assert not run.exists()
+
+
 @pytest.mark.parametrize("flag,value", BAD_COLLECT_FLAGS, ids=[f"{f}={v}" for f, v in BAD_COLLECT_FLAGS])
 def test_bad_collect_flag_refused(tmp_path, capsys, flag, value):
     out = tmp_path / "data"
-    args = {"--n": "24", "--shard-size": "2", "--seed": "0", **{flag: value}}
+    args = {"--n": "24", "--config": str(FAULTS_CONFIG), "--seed": "0", **{flag: value}}
     line = _argparse_refusal(capsys, ["collect", "--out", out, "--quiet", *[x for kv in args.items() for x in kv]])
     assert line.startswith("symlearn collect: error: argument") and flag in line and repr(value) in line, line
     assert not out.exists()  # so a later `--seed 0` in this folder is not blocked by a manifest of seed -1
@@ -328,8 +339,9 @@ def test_manifest_not_an_object_is_one_line_error(data_copy, tmp_path, capsys, c
 
 def test_diverging_training_is_refused_and_leaves_no_run_folder(tiny_data, tmp_path, capsys):
     run = tmp_path / "run"
+    (tmp_path / "lr.toml").write_text("[train]\nbatch_size = 4\nmax_train_samples = 16\nbf16 = false\nlr = 1e30\n")
     rc, out = cli("train", "--data", tiny_data.path, "--out", run, "--preset", "quick", "--epochs", "1",
-                  "--batch-size", "4", "--max-train-samples", "16", "--no-bf16", "--lr", "1e30", "--quiet")
+                  "--config", tmp_path / "lr.toml", "--quiet")
     line = _error_line(capsys, "train", rc)
     assert "loss became" in line and "lower the learning rate" in line, line
     assert out == "" and not run.exists()
@@ -360,7 +372,7 @@ def test_collect_into_a_run_folder_refused(effect_run, tmp_path, capsys):
     run = tmp_path / "run"
     shutil.copytree(effect_run, run)
     before = {p.name: p.stat().st_mtime_ns for p in run.iterdir()}
-    rc, _ = cli("collect", "--out", run, "--n", "24", "--shard-size", "2", "--quiet")
+    rc, _ = cli("collect", "--out", run, "--n", "24", "--config", FAULTS_CONFIG, "--quiet")
     line = _error_line(capsys, "collect", rc)
     assert f"{run} is a training run folder" in line, line
     assert {p.name: p.stat().st_mtime_ns for p in run.iterdir()} == before

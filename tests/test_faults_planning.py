@@ -129,8 +129,9 @@ def test_rules_from_a_retrained_transition_are_refused(tiny_run, tiny_run_copy, 
     import hashlib
 
     rules = json.loads((tiny_run_copy / "pddl" / "rules.json").read_text())
+    (tmp_path / "e1.toml").write_text("[transition]\nepochs = 1\n")
     rc, _ = cli("train-transition", "--run", tiny_run_copy, "--data", tiny_run.data, "--preset", "quick",
-                "--epochs", "1", "--seed", "1", "--quiet")
+                "--config", tmp_path / "e1.toml", "--seed", "1", "--quiet")
     assert rc == 0
     capsys.readouterr()
     new_hash = hashlib.sha256((tiny_run_copy / "transition.pt").read_bytes()).hexdigest()[:16]
@@ -143,7 +144,7 @@ def test_rules_from_a_retrained_transition_are_refused(tiny_run, tiny_run_copy, 
     assert not (tiny_run_copy / "pddl" / "problems").exists()
     out_file = tmp_path / "b.json"
     rc, out = cli("benchmark", "--run", tiny_run_copy, "--problems", problems, "--planners", "astar,symk-sas",
-                  "--out", out_file, "--quiet")
+                  "--out", out_file)
     assert rc == 2 and not out_file.exists() and not (tmp_path / "b.json.rows.jsonl").exists()
     _one_line_error(capsys, "benchmark", "was exported from another transition.pt")
     # the network planners do not read the rules; and rules re-stamped with the current hash are accepted
@@ -218,7 +219,7 @@ def test_problems_refuse_a_folder_without_manifest(tmp_path, capsys):
     out = tmp_path / "p"
     out.mkdir()
     (out / "problem_0000.json").write_text("{}")
-    rc, _ = cli("problems", "--out", out, "--n", 1, "--seed", 0)
+    rc, _ = cli("problems", "--kind", "walks", "--out", out, "--n", 1, "--seed", 0)
     assert rc == 2
     _one_line_error(capsys, "problems", "files but no problem manifest", "--overwrite")
     assert _contents(out) == {"problem_0000.json": "{}"}
@@ -229,7 +230,7 @@ def test_problems_refuse_a_folder_without_manifest(tmp_path, capsys):
 def test_problems_bad_settings_create_nothing(tmp_path, capsys, args):
     out = tmp_path / "p"
     try:
-        rc, _ = cli("problems", "--out", out, *args)
+        rc, _ = cli("problems", "--kind", "walks", "--out", out, *args)
     except SystemExit as e:  # an argparse type error
         rc = e.code
     assert rc == 2 and not out.exists()
@@ -395,7 +396,7 @@ def _untimed(obj):
 def uninterrupted(tiny_run, problems, tmp_path_factory) -> dict:
     out = tmp_path_factory.mktemp("bench_ref") / "b.json"
     rc, _ = cli("benchmark", "--run", tiny_run.path, "--problems", problems, "--planners", "astar",
-                "--timeout", "10", "--closed-loop", "--out", out, "--quiet")
+                "--timeout", "10", "--out", out)
     assert rc == 0
     return json.loads(out.read_text())
 
@@ -404,7 +405,7 @@ def uninterrupted(tiny_run, problems, tmp_path_factory) -> dict:
 def test_benchmark_killed_mid_run_resumes_to_the_same_result(tiny_run, problems, uninterrupted, tmp_path, sig):
     out = tmp_path / "b.json"
     rows_file = tmp_path / "b.json.rows.jsonl"
-    cmd = _bench_cmd(tiny_run.path, problems, out, "--closed-loop", "--quiet")
+    cmd = _bench_cmd(tiny_run.path, problems, out)
     proc = subprocess.Popen(cmd, cwd=ROOT, env=_subprocess_env(), start_new_session=True,
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 240
@@ -421,11 +422,13 @@ def test_benchmark_killed_mid_run_resumes_to_the_same_result(tiny_run, problems,
     assert 2 <= finished < 8 and not out.exists()
     assert not [p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
     # another setting cannot resume this run
-    r = subprocess.run(_bench_cmd(tiny_run.path, problems, out, "--quiet"), cwd=ROOT, env=_subprocess_env(),
+    open_loop = tmp_path / "open.toml"
+    open_loop.write_text("[execution]\nclosed_loop = false\n")
+    r = subprocess.run(_bench_cmd(tiny_run.path, problems, out, "--config", str(open_loop)), cwd=ROOT, env=_subprocess_env(),
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 2 and "other settings (differing: closed_loop)" in r.stderr
     assert r.stderr.strip().count("\n") == 0 and _rows_done(rows_file) == finished
-    r = subprocess.run(cmd[:-1], cwd=ROOT, env=_subprocess_env(), capture_output=True, text=True, timeout=300)
+    r = subprocess.run(cmd, cwd=ROOT, env=_subprocess_env(), capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr[-2000:]
     assert f"[{finished + 1}/8]" in r.stdout and f"[{finished}/8]" not in r.stdout  # finished rows skipped
     resumed = json.loads(out.read_text(), parse_constant=lambda c: pytest.fail(f"non-strict JSON {c}"))

@@ -164,7 +164,7 @@ def test_benchmark_never_records_a_planner_killed_by_a_signal(tiny_run, problems
 # ------------------------------------------------------------------------------- 10. pipeline errors reach the terminal
 
 
-@pytest.mark.parametrize("flag, value", [("--workers", "0"), ("--shard-size", "0"), ("--seed", "-1"), ("--n", "0"),
+@pytest.mark.parametrize("flag, value", [("--workers", "0"), ("--epochs", "0"), ("--seed", "-1"), ("--n", "0"),
                                          ("--problems", "-2"), ("--workers", "two")])
 def test_pipeline_bad_flag_is_one_line_and_leaves_nothing(tmp_path, capsys, flag, value):
     out = tmp_path / "pipe"
@@ -175,7 +175,7 @@ def test_pipeline_bad_flag_is_one_line_and_leaves_nothing(tmp_path, capsys, flag
     assert not out.exists()
 
 
-@pytest.mark.parametrize("kw", [dict(workers=0), dict(shard_size=0), dict(seed=-1), dict(workers=1.5), dict(n=0)])
+@pytest.mark.parametrize("kw", [dict(workers=0), dict(epochs=0), dict(seed=-1), dict(workers=1.5), dict(n=0)])
 def test_pipeline_settings_refuse_bad_values_before_any_folder(tmp_path, kw):
     from symlearn.pipeline import PipelineSettings
 
@@ -188,7 +188,7 @@ def test_a_failing_pipeline_stage_prints_its_reason(tmp_path, capsys):
     out = tmp_path / "pipe"
     out.mkdir()
     (out / "data").write_text("not a folder")  # the collect stage cannot write its data set here
-    rc, _ = cli("pipeline", "--out", out, "--n", "4", "--shard-size", "4")
+    rc, _ = cli("pipeline", "--out", out, "--n", "4")
     line = _one_line_error(capsys, "pipeline", "stage collect failed: ", str(out / "data"),
                            str(out / "logs" / "collect.log"))
     assert rc == 2 and line.count("symlearn") == 1, line  # the refusal's own message, not a nested command's
@@ -202,7 +202,7 @@ def test_a_stage_that_crashes_prints_one_line_and_keeps_the_traceback_in_its_log
 
     monkeypatch.setattr(collect_mod, "collect", crash)  # the library call the pipeline's collect stage makes
     out = tmp_path / "pipe"
-    rc, _ = cli("pipeline", "--out", out, "--n", "4", "--shard-size", "4")
+    rc, _ = cli("pipeline", "--out", out, "--n", "4")
     line = _one_line_error(capsys, "pipeline", "stage collect failed: IndexError: index 0 is out of bounds; see")
     assert rc == 2 and "for axis 0" not in line
     assert "Traceback (most recent call last)" in (out / "logs" / "collect.log").read_text()
@@ -212,11 +212,9 @@ def test_a_stage_that_crashes_prints_one_line_and_keeps_the_traceback_in_its_log
 
 
 @pytest.mark.parametrize("value", ["2000", str(2**31)])
-@pytest.mark.parametrize("command", ["plan", "benchmark", "train", "train-transition", "export-pddl"])
+@pytest.mark.parametrize("command", ["plan", "train", "train-transition", "export-pddl"])
 def test_threads_beyond_the_cap_are_refused_in_one_line(tmp_path, capsys, command, value):
-    required = {"plan": ["--run", "r", "--problem", "p.json"], "benchmark": ["--run", "r", "--problems", "p",
-                                                                             "--out", "b.json"],
-                "train": ["--data", "d", "--out", "r"], "train-transition": ["--run", "r", "--data", "d"],
+    required = {"plan": ["--run", "r", "--problem", "p.json"], "train": ["--data", "d", "--out", "r"], "train-transition": ["--run", "r", "--data", "d"],
                 "export-pddl": ["--run", "r", "--data", "d"]}[command]
     with pytest.raises(SystemExit) as info:
         cli(command, *required, "--threads", value)
@@ -269,7 +267,7 @@ def test_a_second_collect_into_a_folder_is_refused_with_the_holders_pid(tmp_path
 
     out = tmp_path / "data"
     pid = holder(out / LOCK_NAME)
-    rc, _ = cli("collect", "--out", out, "--n", "4", "--shard-size", "4", "--quiet")
+    rc, _ = cli("collect", "--out", out, "--n", "4", "--quiet")
     _one_line_error(capsys, "collect", f"{out} is being written by another symlearn process (pid {pid}")
     assert rc == 2 and sorted(p.name for p in out.iterdir()) == [LOCK_NAME]
 
@@ -279,7 +277,7 @@ def test_a_second_problems_into_a_folder_is_refused_with_the_holders_pid(tmp_pat
 
     out = tmp_path / "p"
     pid = holder(out / LOCK_NAME)
-    rc, _ = cli("problems", "--out", out, "--n", "1", "--objects", "1-1", "--length", "1-1")
+    rc, _ = cli("problems", "--kind", "walks", "--out", out, "--n", "1", "--objects", "1-1", "--length", "1-1")
     _one_line_error(capsys, "problems", f"pid {pid}")
     assert rc == 2 and sorted(p.name for p in out.iterdir()) == [LOCK_NAME]
 
@@ -289,7 +287,7 @@ def test_a_second_pipeline_into_a_folder_is_refused_with_the_holders_pid(tmp_pat
 
     out = tmp_path / "pipe"
     pid = holder(out / LOCK_NAME)
-    rc, _ = cli("pipeline", "--out", out, "--n", "4", "--shard-size", "4")
+    rc, _ = cli("pipeline", "--out", out, "--n", "4")
     _one_line_error(capsys, "pipeline", f"pid {pid}")
     assert rc == 2 and sorted(p.name for p in out.iterdir()) == [LOCK_NAME]  # no logs/, no data/
 
@@ -299,8 +297,7 @@ def test_a_second_benchmark_on_one_out_is_refused_before_any_row(tiny_run, probl
 
     out = tmp_path / "b.json"
     pid = holder(lock_path(out))
-    rc, _ = cli("benchmark", "--run", tiny_run.path, "--problems", problems, "--planners", "astar", "--out", out,
-                "--quiet")
+    rc, _ = cli("benchmark", "--run", tiny_run.path, "--problems", problems, "--planners", "astar", "--out", out)
     _one_line_error(capsys, "benchmark", f"{out} is being written by another symlearn process (pid {pid}")
     assert rc == 2 and not out.exists() and not rows_path(out).exists()
 
@@ -382,16 +379,16 @@ def test_plan_record_may_replace_its_own_gif_and_png(tmp_path):
 
 def _bench(tiny_run, problems, out, *extra):
     return cli("benchmark", "--run", tiny_run.path, "--problems", problems, "--planners", "astar", "--out", out,
-               "--quiet", *extra)
+               *extra)
 
 
-@pytest.mark.parametrize("case", ["out is a folder", "out is another file", "record is a file", "plots is a file",
-                                  "record is out", "row log is a folder"])
+@pytest.mark.parametrize("case", ["out is a folder", "out is another file", "record is a file", "record is out",
+                                  "row log is a folder"])
 def test_benchmark_outputs_are_refused_before_any_row(tiny_run, problems, tmp_path, capsys, monkeypatch, case):
     import symlearn.planning.benchmark as bm
 
     monkeypatch.setattr(bm, "_run_rows", lambda *a, **k: pytest.fail("a row ran before the outputs were checked"))
-    out, extra = tmp_path / "b.json", []
+    out, record = tmp_path / "b.json", None  # the failed plans' GIFs: benchmark(record_dir=...), the pipeline's
     if case == "out is a folder":
         out.mkdir()
     elif case == "out is another file":
@@ -399,18 +396,28 @@ def test_benchmark_outputs_are_refused_before_any_row(tiny_run, problems, tmp_pa
         out.write_text(json.dumps({"mae_mm": 1.0}))
     elif case == "record is a file":
         (tmp_path / "rec").write_text("x")
-        extra = ["--record", tmp_path / "rec"]
-    elif case == "plots is a file":
-        (tmp_path / "plots").write_text("x")
-        extra = ["--plots", tmp_path / "plots"]
+        record = tmp_path / "rec"
     elif case == "record is out":
-        extra = ["--record", out]
+        record = out
     else:
         bm.rows_path(out).mkdir()
     before = {p.name: (p.read_bytes() if p.is_file() else None) for p in tmp_path.iterdir()}
-    rc, _ = _bench(tiny_run, problems, out, *extra)
-    _one_line_error(capsys, "benchmark")
-    assert rc == 2 and {p.name: (p.read_bytes() if p.is_file() else None) for p in tmp_path.iterdir()} == before
+    if record is None:
+        rc, _ = _bench(tiny_run, problems, out)
+        _one_line_error(capsys, "benchmark")
+        assert rc == 2
+    else:
+        with pytest.raises(ValueError):
+            bm.benchmark(tiny_run.path, problems, ["astar"], out, record_dir=record, show_progress=False)
+    assert {p.name: (p.read_bytes() if p.is_file() else None) for p in tmp_path.iterdir()} == before
+
+
+def test_plots_into_a_file_is_refused(tmp_path, capsys):
+    (tmp_path / "plots").write_text("x")
+    (tmp_path / "b.json").write_text(json.dumps({"rows": []}))
+    rc, _ = cli("plots", tmp_path / "b.json", "--out", tmp_path / "plots")
+    _one_line_error(capsys, "plots", f"--out {tmp_path / 'plots'} is a file; give a folder")
+    assert rc == 2 and (tmp_path / "plots").read_text() == "x"
 
 
 def test_benchmark_out_may_replace_a_benchmark_result(tmp_path):
@@ -431,8 +438,8 @@ def test_problems_overwrite_refuses_before_deleting_anything(sim, tmp_path, caps
     generate_problems(out, 2, objects=(1, 1), length=(1, 1), seed=0, sim=sim)
     (out / "notes.txt").write_text("mine")
     before = {p.name: p.read_bytes() for p in out.iterdir()}
-    rc, _ = cli("problems", "--out", out, "--n", "2", "--objects", "1-1", "--length", "1-1", "--seed", "3",
-                "--overwrite")
+    rc, _ = cli("problems", "--kind", "walks", "--out", out, "--n", "2", "--objects", "1-1", "--length", "1-1",
+                "--seed", "3", "--overwrite")
     _one_line_error(capsys, "problems", "notes.txt")
     assert rc == 2 and {p.name: p.read_bytes() for p in out.iterdir()} == before
 
@@ -444,12 +451,13 @@ def test_a_goal_problem_is_not_written_into_a_generated_set(sim, tmp_path, capsy
     generate_problems(out, 2, objects=(1, 1), length=(1, 1), seed=0, sim=sim)
     before = {p.name: p.read_bytes() for p in out.iterdir()}
     goal = sorted((ROOT / "examples" / "goals").glob("*.json"))[0]
-    rc, _ = cli("problems", "--goal", goal, "--out", out)
+    rc, _ = cli("problems", goal, "--out", out)
     _one_line_error(capsys, "problems", "holds a generated problem set")
     assert rc == 2 and {p.name: p.read_bytes() for p in out.iterdir()} == before
     # the set stays usable: the same command completes it, --overwrite replaces it
-    assert cli("problems", "--out", out, "--n", "2", "--objects", "1-1", "--length", "1-1")[0] == 0
-    assert cli("problems", "--out", out, "--n", "1", "--objects", "1-1", "--length", "1-1", "--overwrite")[0] == 0
+    walks = ("problems", "--kind", "walks", "--out", out, "--objects", "1-1", "--length", "1-1")
+    assert cli(*walks, "--n", "2")[0] == 0
+    assert cli(*walks, "--n", "1", "--overwrite")[0] == 0
     assert sorted(p.name for p in out.iterdir()) == ["problem_0000.json", "problems.manifest"]
 
 

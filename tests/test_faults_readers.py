@@ -351,14 +351,14 @@ def test_benchmark_refuses_a_wrong_shaped_row_before_running_any(tiny_run, tmp_p
     shutil.copy(PRETRAINED / "problems" / "three_objects_two_actions.json", problems / "b.json")
     out = tmp_path / "bench.json"
     sets = problem_sets(problems)
-    settings = _settings(tiny_run.path, sets, load_sets(sets), ["astar"], False, 10.0, 3)
+    settings = _settings(tiny_run.path, sets, load_sets(sets), ["astar"], True, 10.0, 3)
     log = RowLog(out.with_name(out.name + ".rows.jsonl"), settings)
     log.open()
     log.append(("a.json", "astar", False), {**ROW, "replans": "three"})
     log.close()
     before = log.path.read_bytes()
     rc, _ = cli("benchmark", "--run", tiny_run.path, "--problems", problems, "--planners", "astar",
-                "--timeout", "10", "--out", out, "--quiet")
+                "--timeout", "10", "--out", out)
     assert rc == 2
     _cli_error(capsys, "benchmark", f"{log.path}: line 2", "field row.replans")
     assert log.path.read_bytes() == before and not out.exists()  # no row ran

@@ -1,6 +1,6 @@
 """Goal files and the structure suite: every template's reference plan reaches its goal in the simulator,
 goal files round-trip, arrangements the simulator cannot build are refused in one line naming the file,
-and `symlearn problems --suite structures` writes problems that load and resume."""
+and `symlearn problems --kind structures` writes problems that load and resume."""
 from __future__ import annotations
 
 import json
@@ -202,7 +202,7 @@ def test_goal_file_without_plan_uses_the_built_arrangement(sim, tmp_path):
 
 def test_cli_suite_writes_loadable_problems_and_resumes(tmp_path):
     out = tmp_path / "s"
-    args = ("problems", "--suite", "structures", "--out", out, "--n", 4, "--objects", "4-5", "--seed", 2)
+    args = ("problems", "--kind", "structures", "--out", out, "--n", 4, "--objects", "4-5", "--seed", 2)
     rc, text = cli(*args)
     assert rc == 0 and f"wrote 4 problems to {out}" in text
     problems = load_problems(out)
@@ -216,12 +216,13 @@ def test_cli_suite_writes_loadable_problems_and_resumes(tmp_path):
     assert {p.name: p.read_bytes() for p in out.glob("*.json")} == before  # the same problems, redrawn
     assert cli(*args[:-1], 3)[0] == 2  # other settings are refused
     assert cli(*args[:-1], 3, "--overwrite")[0] == 0 and load_problem(out / "problem_0000.json").seed == 3
-    assert cli("problems", "--suite", "structures", "--out", tmp_path / "x", "--length", "1-2")[0] == 2
+    assert cli("problems", "--kind", "structures", "--out", tmp_path / "x", "--length", "1-2")[0] == 2
 
 
 def test_cli_goal_file(tmp_path):
-    rc, text = cli("problems", "--goal", EXAMPLE, "--out", tmp_path)
+    rc, text = cli("problems", EXAMPLE, "--out", tmp_path)
     assert rc == 0 and text.strip() == f"wrote {tmp_path / 'fig6_composite.json'}"
     p = load_problem(tmp_path / "fig6_composite.json")
     assert p.task == "fig6-composite" and p.actions == (25, 18, 33)
-    assert cli("problems", "--goal", EXAMPLE, "--out", tmp_path, "--n", 3)[0] == 2
+    assert cli("problems", EXAMPLE, "--out", tmp_path, "--n", 3)[0] == 2
+    assert cli("problems", EXAMPLE, "--out", tmp_path, "--kind", "walks")[0] == 2

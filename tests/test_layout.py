@@ -171,14 +171,15 @@ def test_import_graph_parser_sees_real_imports():
 # the order their outputs flow (sim -> data -> learning -> symbolic -> planning -> report), then the pipeline,
 # which runs every stage, then the command line, which is the front end of all of them. The top-level modules of
 # symlearn/ are placed by name: the shared helpers every stage uses (plain world data, provenance and atomic
-# writes, folder locks, output-path checks, the optional Ray engine) sit below the first stage; the pipeline sits
+# writes, folder locks, output-path checks, the optional Ray engine, the settings-file reader, which names the stages'
+# configs as strings and imports one only when a file sets it) sit below the first stage; the pipeline sits
 # between the last stage and the CLI, so it calls the library and never the command line. A new top-level module
 # fails test_every_module_has_a_layer until it is placed here.
 LAYERS: tuple[tuple[str, frozenset[str]], ...] = (  # (layer, its modules: "pkg.*" is pkg and every module under it)
     ("pddl_export", frozenset({"pddl_export.*"})),
     ("search", frozenset({"search.*"})),
     ("symlearn helpers", frozenset({"symlearn", "symlearn.world", "symlearn.provenance", "symlearn.folder_lock",
-                                    "symlearn.outputs", "symlearn.cluster"})),
+                                    "symlearn.outputs", "symlearn.cluster", "symlearn.config_file"})),
     ("sim", frozenset({"symlearn.sim.*"})),
     ("data", frozenset({"symlearn.data.*"})),
     ("learning", frozenset({"symlearn.learning.*"})),

@@ -215,24 +215,25 @@ def test_stock_planners_plan_a_tower_the_rules_build(world_rules, tmp_path, plan
 
 
 def test_export_lifted_and_plan_with_stock_fast_downward_on_a_tiny_run(tiny_run_copy, tiny_data, tmp_path):
-    """The whole route on real codes: m(z) on 9 location bits, export-pddl --lifted, the registry's planner."""
+    """The whole route on real codes: m(z) on 9 location bits, export-pddl (lifted), the registry's planner."""
     import json
 
     import pyval
 
-    from conftest import TINY_TRANSITION_ARGS, cli
+    from conftest import cli, write_config
     from symlearn.data.dataset import load_split
     from symlearn.planning.export import training_codes
     from symlearn.planning.planners import PlannerContext, make_planner
     from symlearn.symbolic.learned_transition import planning_models
 
     run = tiny_run_copy
-    rc, _ = cli("export-pddl", "--run", run, "--data", tiny_data.path, "--lifted")
+    rc, _ = cli("export-pddl", "--run", run, "--data", tiny_data.path)
     assert rc == 2  # the tiny run's m(z) reads no location bits: refused in one line
-    rc, _ = cli("train-transition", "--run", run, "--data", tiny_data.path, *TINY_TRANSITION_ARGS,
-                "--location-bits", "9", "--quiet")
+    config = write_config(tmp_path / "located.toml", {"transition": {"location_bits": 9}, "lifted": {"min_count": 1}})
+    rc, _ = cli("train-transition", "--run", run, "--data", tiny_data.path, "--preset", "quick", "--config", config,
+                "--quiet")
     assert rc == 0
-    rc, text = cli("export-pddl", "--run", run, "--data", tiny_data.path, "--lifted", "--min-count", "1")
+    rc, text = cli("export-pddl", "--run", run, "--data", tiny_data.path, "--config", config)
     assert rc == 0 and "lifted rules" in text
     lifted = load_lifted(run / "pddl" / "lifted.json")
     report = json.loads((run / "pddl" / "lifted.json").read_text())["stats"]

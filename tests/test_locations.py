@@ -8,7 +8,7 @@ import shutil
 import numpy as np
 import pytest
 
-from conftest import TINY_TRANSITION_ARGS, cli, cli_json, recomputed_transition_accuracy
+from conftest import cli, cli_json, recomputed_transition_accuracy, write_config
 from pddl_export.symbolic import bits_from_codes
 from symlearn.sim.camera import CameraConfig, crop_centres_xy, crop_tops_z
 from symlearn.symbolic.locations import UNSEEN, location_bits
@@ -80,16 +80,18 @@ def test_crop_tops_tell_a_stack_apart(sim):
     assert (bits[:, :3] @ [4, 2, 1]).astype(int).tolist() == [1, 1, 3]
 
 
-def test_train_transition_with_location_bits_plans_on_13_bit_codes(tiny_run, tiny_run_copy, sim):
-    """--location-bits 5: m(z) on 13-bit codes whose last 5 bits are read from geometry, through export and planning."""
+def test_train_transition_with_location_bits_plans_on_13_bit_codes(tiny_run, tiny_run_copy, sim, tmp_path):
+    """location_bits = 5: m(z) on 13-bit codes whose last 5 bits are read from geometry, through export and planning."""
     from symlearn.learning.models import AttentiveDeepSym
     from symlearn.planning.scenes import scene_codes
     from symlearn.symbolic.learned_transition import LearnedTransition, planning_models
     from symlearn.symbolic.transition_data import SymbolReader
 
     run = tiny_run_copy
-    out = cli_json("train-transition", "--run", run, "--data", tiny_run.data, *TINY_TRANSITION_ARGS,
-                   "--location-bits", 5, "--quiet")
+    config = write_config(tmp_path / "loc5.toml", {"transition": {"location_bits": 5},
+                                                   "export": {"pddl_fidelity_cases": 20}})
+    out = cli_json("train-transition", "--run", run, "--data", tiny_run.data, "--preset", "quick", "--config", config,
+                   "--quiet")
     want = recomputed_transition_accuracy(run, tiny_run.data)  # on 13-bit codes: the reader adds location bits
     assert out["test"]["bit_accuracy"] == pytest.approx(want["bit_accuracy"], abs=1e-5)
     assert out["test"]["scene_accuracy"] == pytest.approx(want["scene_accuracy"], abs=1e-5)
@@ -114,7 +116,7 @@ def test_train_transition_with_location_bits_plans_on_13_bit_codes(tiny_run, tin
     assert (placed & 7).tolist() == [2, 4] and ((placed >> 3) & 63).tolist() == [1 << 3, 1 << 3]
     assert (placed >> 9).tolist() == (high >> 7).tolist()
 
-    rc, _ = cli("export-pddl", "--run", run, "--data", tiny_run.data, "--max-objects", 2, "--pddl-fidelity-cases", 20)
+    rc, _ = cli("export-pddl", "--run", run, "--data", tiny_run.data, "--rules", "--config", config)
     rules = json.loads((run / "pddl" / "rules.json").read_text())
     rep = json.loads((run / "pddl" / "report.json").read_text())
     assert rc == 0 and rules["bits"] == 13 and rep["fidelity"] == 1.0 and rep["pddl_fidelity"] == 1.0

@@ -25,7 +25,8 @@ def run(tmp_path_factory, tiny_data, tiny_run):
     root = tmp_path_factory.mktemp("pddl_pipeline")
     (root / "data").symlink_to(tiny_data.path, target_is_directory=True)
     shutil.copytree(tiny_run.path, root / "run")
-    rc, _ = cli("problems", "--out", root / "problems", "--n", 2, "--objects", "1-2", "--length", "1-2", "--seed", 0)
+    rc, _ = cli("problems", "--kind", "walks", "--out", root / "problems", "--n", 2, "--objects", "1-2", "--length",
+                "1-2", "--seed", 0)
     assert rc == 0
     return root
 

@@ -11,7 +11,7 @@ import sys
 import pytest
 
 from symlearn.cli.main import main
-from symlearn.cluster import as_finished
+from symlearn.cluster import EngineError, as_finished, check_engine
 from symlearn.data.dataset import load_manifest
 from symlearn.planning import benchmark as bench
 from symlearn.sim.collect import CollectConfig, collect, shard_name
@@ -83,8 +83,9 @@ def test_killed_ray_collection_resumes_to_the_same_bytes(ray_cluster, local_set,
 
 def test_cli_collect_on_ray(ray_cluster, local_set, tmp_path, capsys):
     out = tmp_path / "cli"
-    rc = main(["collect", "--out", str(out), "--n", "12", "--seed", "7", "--shard-size", "1", "--workers", "2",
-               "--engine", "ray", "--quiet"])
+    (tmp_path / "shards.toml").write_text("[collect]\nshard_size = 1\n")
+    rc = main(["collect", "--out", str(out), "--n", "12", "--seed", "7", "--config", str(tmp_path / "shards.toml"),
+               "--workers", "2", "--ray", "--quiet"])
     assert rc == 0 and json.loads(capsys.readouterr().out)["shards"] == 12
     assert _shards(out) == _shards(local_set)
 
@@ -145,26 +146,28 @@ def test_ray_benchmark_gives_the_local_rows_and_resumes(ray_cluster, tiny_run, t
 def test_engine_ray_without_the_extra_is_refused_in_one_line(tmp_path, monkeypatch, capsys):
     monkeypatch.setitem(sys.modules, "ray", None)  # `import ray` now raises ImportError
     out = tmp_path / "never"
-    rc = main(["collect", "--out", str(out), "--n", "12", "--engine", "ray", "--quiet"])
+    rc = main(["collect", "--out", str(out), "--n", "12", "--ray", "--quiet"])
     err = capsys.readouterr().err.strip().splitlines()
-    assert rc == 2 and err == ["symlearn collect: error: --engine ray needs Ray, which is not installed; "
+    assert rc == 2 and err == ["symlearn collect: error: --ray needs Ray, which is not installed; "
                                "pip install symlearn[ray]"]
     assert not out.exists()  # refused before any work
     rc = main(["benchmark", "--run", str(tmp_path / "run"), "--problems", str(tmp_path), "--out",
-               str(tmp_path / "b.json"), "--engine", "ray"])
+               str(tmp_path / "b.json"), "--ray", "auto"])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and err[0].endswith("pip install symlearn[ray]")
     with pytest.raises(RuntimeError, match=r"pip install symlearn\[ray\]"):
         collect(out, CFG, engine="ray")
 
 
-def test_engine_flags_refused_where_they_do_not_apply(tmp_path, capsys):
-    rc = main(["collect", "--out", str(tmp_path / "x"), "--n", "12", "--address", "10.0.0.1:6379", "--quiet"])
-    assert rc == 2 and "needs --engine ray" in capsys.readouterr().err
+def test_engine_settings_refused_where_they_do_not_apply(tmp_path, capsys):
+    with pytest.raises(EngineError, match="needs the ray engine"):
+        check_engine("local", "10.0.0.1:6379")
+    with pytest.raises(EngineError, match="unknown engine 'dask'"):
+        check_engine("dask")
     rc = main(["benchmark", "--run", str(tmp_path), "--problems", str(tmp_path), "--out", str(tmp_path / "b.json"),
                "--workers", "2"])
-    assert rc == 2 and "add --engine ray" in capsys.readouterr().err
+    assert rc == 2 and "add --ray" in capsys.readouterr().err
     with pytest.raises(SystemExit) as info:
-        main(["collect", "--out", str(tmp_path / "x"), "--engine", "dask"])
+        main(["collect", "--out", str(tmp_path / "x"), "--engine", "ray"])  # the flag is --ray
     assert info.value.code == 2
     assert not (tmp_path / "x").exists()

@@ -74,7 +74,7 @@ def test_the_recommended_run_builds_its_goals_in_simulation(tmp_path):
         shutil.copy(RECOMMENDED / "problems" / f"{name}.json", problems)
     out = tmp_path / "bench.json"
     rc, text = cli("benchmark", "--run", run, "--problems", problems, "--planners",
-                   "astar-outcomes,fast-downward-lifted", "--closed-loop", "--timeout", "60", "--out", out, "--quiet")
+                   "astar-outcomes,fast-downward-lifted", "--timeout", "60", "--out", out)
     assert rc == 0, text
     rows = {(r["problem"], r["planner"], r["closed_loop"]): r for r in json.loads(out.read_text())["rows"]}
     deep = rows[("k4_opt5-6_0000", "astar-outcomes", True)]

@@ -91,13 +91,16 @@ def full_run(tiny_run, tmp_path_factory) -> Path:
     probs = run.parent / "problems"
     for args in (("evaluate", "--run", run, "--data", tiny_run.data), ("table1", "--run", run),
                  ("symbols", "--run", run, "--data", tiny_run.data, "--min-count", 5),
-                 ("problems", "--out", probs, "--n", 2, "--objects", "1-2", "--length", "1-2", "--seed", 3),
-                 ("benchmark", "--run", run, "--problems", probs, "--planners", "astar", "--out",
-                  run / "benchmark.json", "--record", run / "recordings", "--quiet"),
+                 ("problems", "--kind", "walks", "--out", probs, "--n", 2, "--objects", "1-2", "--length", "1-2",
+                  "--seed", 3),
                  ("plan", "--run", run, "--problem", probs / "problem_0000.json", "--record", run / "plan.gif",
                   "--record-size", "160x120")):
         rc, out = cli(*args)
         assert rc == 0, (args[0], out)
+    # open loop, each failed plan recorded as a GIF (the pipeline's benchmark stage records them so)
+    from symlearn.planning.benchmark import benchmark
+
+    benchmark(run, probs, ["astar"], run / "benchmark.json", record_dir=run / "recordings", show_progress=False)
     return run
 
 
@@ -267,7 +270,7 @@ def test_plan_and_benchmark_recordings(report):
 # ------------------------------------------------------------------------------------------ pipeline
 
 # The demo preset at a test's size: 48 samples per set, one epoch, 1-object problems, 2 s per planner call.
-PIPE_ARGS = ("--preset", "tiny", "--n", 48, "--shard-size", 4, "--epochs", 1, "--transition-epochs", 2,
+PIPE_ARGS = ("--preset", "tiny", "--n", 48, "--epochs", 1, "--config", Path(__file__).resolve().parent / "pipe.toml",
              "--problems", 1, "--seed", 5)
 STAGE_LINE = re.compile(r"^\[(\d+)/(\d+)\] (\S+) \.\.\. (skipped \(done\)|done in [\d.]+ s)$", re.M)
 
@@ -309,10 +312,12 @@ def test_pipeline_resumes_without_redoing_finished_stages(tmp_path, tiny_preset)
     configs = {name: rec["config"] for name, rec in record["stages"].items()}
     assert configs["evaluate"] == {}  # nothing to set: it reads best.pt and the data set
     train = configs["train"]  # the TrainConfig the stage ran with: the recipe's, overridden
-    assert (train["preset"], train["epochs"], train["seed"], train["model"]["crop"]) == ("quick", 1, 5, 32)
+    assert (train["preset"], train["epochs"], train["seed"], train["model"]["crop"]) == ("recommended", 1, 5, 32)
     assert train["stability_weight"] == 0.1 and train["model"]["action_per_object"]
     assert configs["collect-extra"]["exploration"]["k_values"] == [1, 2, 3, 4, 5]
     assert configs["train-transition"]["transition"]["location_bits"] == 9
+    assert configs["train-transition"]["transition"]["epochs"] == 2  # tests/pipe.toml's [transition]
+    assert configs["collect"]["shard_size"] == configs["collect-extra"]["shard_size"] == 4  # and its [collect]
     assert configs["problems"] == {"n": 1, "seed": 5, "objects": [1, 1]}
     assert (out / "run" / "pddl" / "lifted" / "domain.pddl").is_file()
     bench = json.loads((out / "run" / "benchmark.json").read_text())
@@ -348,10 +353,12 @@ def test_the_default_preset_is_the_recommended_recipe(tmp_path):
     assert (main["n"], main["seed"], main["exploration"]["k_values"]) == (12000, 0, [1, 2, 3])
     assert (extra["n"], extra["seed"], extra["exploration"]["k_values"]) == (12000, 2, [1, 2, 3, 4, 5])
     train = configs["train"]
-    assert (train["preset"], train["epochs"], train["stability_weight"]) == ("quick", 40, 0.1)
+    assert (train["preset"], train["epochs"], train["stability_weight"]) == ("recommended", 40, 0.1)
+    assert train["model"]["crop"] == 32  # the quick model's sizes
     assert train["model"]["action_per_object"]  # the held object's token alone carries the action (Table I)
     transition = configs["train-transition"]
-    assert (transition["transition"]["preset"], transition["transition"]["location_bits"]) == ("quick", 9)
+    assert (transition["transition"]["preset"], transition["transition"]["location_bits"]) == ("recommended", 9)
+    assert transition["transition"]["hidden"] == 64  # the quick network
     assert transition["extra_data"] == ["data_extra"]
     assert set(configs["export-pddl"]) == {"lifted", "extra_data"} and configs["export-pddl"]["extra_data"] == [
         "data_extra"]
@@ -359,6 +366,9 @@ def test_the_default_preset_is_the_recommended_recipe(tmp_path):
     bench = configs["benchmark"]
     assert bench["planners"] == ["astar-outcomes", "fast-downward-lifted"] and bench["threads"] == 1
     assert (bench["execution"]["closed_loop"], bench["execution"]["timeout_s"]) == (True, 10.0)
+    from symlearn.planning.execution import RECOMMENDED_EXECUTION  # what plan and benchmark do by default
+
+    assert bench["execution"] == dataclasses.asdict(RECOMMENDED_EXECUTION)
     sizes = dict.fromkeys(("samples", "extra_samples", "epochs", "transition_epochs", "min_count", "lifted_min_count",
                            "problem_objects", "problems"))
     assert dataclasses.replace(PRESETS["demo"], **sizes) == PRESETS["recommended"]  # the recipe, smaller

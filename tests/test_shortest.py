@@ -209,7 +209,7 @@ def test_annotate_adds_shortest_plans_to_an_older_set_and_resumes(tmp_path):
     old.mkdir()
     (old / "problem_0000.json").write_text(json.dumps(d))
     (old / "problems.manifest").write_text(json.dumps({"format": "symlearn-problem-set", "problem_version": 2}))
-    with pytest.raises(ValueError, match="version 2, without shortest plans: 'symlearn problems --annotate --out"):
+    with pytest.raises(ValueError, match="version 2, without shortest plans: 'symlearn problems --kind annotate --out"):
         prepare_problem_dir(old, {"format": "symlearn-problem-set", "problem_version": PROBLEM_VERSION})
     add_shortest_plans(old)
     prepare_problem_dir(old, {"format": "symlearn-problem-set", "problem_version": PROBLEM_VERSION})
@@ -250,7 +250,7 @@ def _doc_command(out: str) -> list[str]:
     """The documented command that builds problems/<out> (docs/PROBLEMS.md), as argv after `symlearn`."""
     text = (ROOT / "docs" / "PROBLEMS.md").read_text()
     lines = [ln for block in re.findall(r"```[^\n]*\n(.*?)```", text, re.S) for ln in block.splitlines()
-             if ln.startswith("symlearn problems --stratify") and f"--out problems/{out} " in ln + " "]
+             if ln.startswith("symlearn problems ") and f"--out problems/{out} " in ln + " "]
     assert len(lines) == 1, lines
     return shlex.split(lines[0].split("  #")[0])[1:]
 

@@ -2,6 +2,7 @@ import json
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -90,11 +91,18 @@ def test_checkpoint_round_trip_and_refusals(tmp_path):
         load_effect_model(tmp_path / "missing")
 
 
+def _batch4(tmp_path: Path) -> Path:
+    """A settings file: batches of 4 scenes in float32."""
+    path = tmp_path / "batch4.toml"
+    path.write_text("[train]\nbatch_size = 4\nbf16 = false\n")
+    return path
+
+
 def test_two_process_ddp_ends_with_identical_weights(data, tmp_path):
     run = tmp_path / "ddp"
     cmd = [sys.executable, "-m", "torch.distributed.run", "--standalone", "--nproc_per_node=2", "-m", "symlearn.cli.main",
-           "train", "--data", str(data), "--out", str(run), "--preset", "quick", "--epochs", "1", "--batch-size", "4",
-           "--no-bf16", "--quiet"]
+           "train", "--data", str(data), "--out", str(run), "--preset", "quick", "--epochs", "1", "--config",
+           str(_batch4(tmp_path)), "--quiet"]
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr[-2000:]
     m = json.loads((run / "metrics.json").read_text())
@@ -114,7 +122,7 @@ def test_two_nodes_by_rendezvous_train_one_run(data, tmp_path):
     cmd = [sys.executable, "-m", "torch.distributed.run", "--nnodes", "2", "--nproc-per-node", "1",
            "--rdzv-backend", "c10d", "--rdzv-endpoint", f"127.0.0.1:{port}", "--rdzv-id", "test-two-nodes",
            "-m", "symlearn.cli", "train", "--data", str(data), "--out", str(run), "--preset", "quick",
-           "--epochs", "1", "--batch-size", "4", "--no-bf16", "--quiet"]
+           "--epochs", "1", "--config", str(_batch4(tmp_path)), "--quiet"]
     env = dict(os.environ, OMP_NUM_THREADS="1")
     # the first launcher hosts the rendezvous store: the second starts once it listens (both started at once on
     # one machine, both may try to host it, and the loser can hang in the rendezvous)

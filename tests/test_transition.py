@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import torch
 
-from conftest import TINY_TRANSITION_ARGS, cli, cli_json, recomputed_transition_accuracy
+from conftest import TINY_TRANSITION_ARGS, cli, cli_json, recomputed_transition_accuracy, write_config
 from search.learned_astar import plan_symbolic
 from pddl_export.symbolic import SymbolicGoal
 from symlearn.learning.checkpoint import load_effect_model
@@ -501,13 +501,14 @@ def test_a_mixture_names_both_outcomes_whole_where_independent_bits_cannot(tmp_p
     assert back.cfg.modes == 2 and again.tolist() == states.tolist()
 
 
-def test_train_transition_with_modes_plans_on_the_mixture(tiny_run, tiny_run_copy):
-    """--modes 3 through the CLI: the config and checkpoint hold 3 modes, and astar-outcomes branches on them."""
+def test_train_transition_with_modes_plans_on_the_mixture(tiny_run, tiny_run_copy, tmp_path):
+    """modes = 3 through the CLI: the config and checkpoint hold 3 modes, and astar-outcomes branches on them."""
     from search.learned_astar import mode_successors
     from symlearn.planning.execution import ObservedTransitions
 
-    out = cli_json("train-transition", "--run", tiny_run_copy, "--data", tiny_run.data, *TINY_TRANSITION_ARGS,
-                   "--modes", 3, "--quiet")
+    config = write_config(tmp_path / "modes3.toml", {"transition": {"modes": 3}})
+    out = cli_json("train-transition", "--run", tiny_run_copy, "--data", tiny_run.data, "--preset", "quick",
+                   "--config", config, "--quiet")
     want = recomputed_transition_accuracy(tiny_run_copy, tiny_run.data)  # the likeliest mode's predictions
     assert out["rollout_scene_accuracy"]["1"] == pytest.approx(want["scene_accuracy"], abs=1e-5)
     assert out["test"]["bit_accuracy"] == pytest.approx(want["bit_accuracy"], abs=1e-5)

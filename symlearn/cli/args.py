@@ -5,7 +5,6 @@ import argparse
 import math
 import os
 
-from symlearn.cluster import ENGINES
 
 
 def int_range(text: str) -> tuple[int, int]:
@@ -95,13 +94,35 @@ class OneLineParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def add_engine_flags(c: argparse.ArgumentParser, unit: str) -> None:
-    """--engine {local,ray} and --address, for the commands whose `unit`s (shards, rows) can run as Ray tasks."""
-    c.add_argument("--engine", choices=ENGINES, default="local",
-                   help=f"where each {unit} runs: this machine, or a Ray task (pip install symlearn[ray]; "
-                        "docs/SCALING.md)")
-    c.add_argument("--address", help="with --engine ray: the Ray cluster to join (head IP:6379, or auto); "
-                                     "default a local Ray")
+def add_ray_flag(c: argparse.ArgumentParser, unit: str) -> None:
+    """--ray [ADDRESS], for the commands whose `unit`s (shards, rows) can run as Ray tasks: on a local Ray without
+    an address, else on the cluster at ADDRESS (head IP:6379, or auto)."""
+    c.add_argument("--ray", nargs="?", const="", metavar="ADDRESS",
+                   help=f"run each {unit} as a Ray task (pip install symlearn[ray]; docs/SCALING.md): on a local Ray, "
+                        "or on the cluster at ADDRESS (head IP:6379, or auto)")
+
+
+def ray_engine(args: argparse.Namespace) -> tuple[str, str | None]:
+    """(engine, address) from --ray: ("local", None) without it, ("ray", None) for a local Ray, ("ray", ADDRESS)."""
+    return ("local", None) if args.ray is None else ("ray", args.ray or None)
+
+
+# TrainConfig's and TransitionConfig's presets (training.TRAIN_PRESETS, transition_model.TRANSITION_PRESETS; a test
+# keeps the three equal), named here so that --help needs no torch
+TRAIN_PRESET_NAMES = ("recommended", "quick", "paper")
+
+
+def add_config_flag(c: argparse.ArgumentParser, tables: str) -> None:
+    """--config FILE.toml: the levers that are not flags (symlearn.config_file); `tables` says which it reads."""
+    c.add_argument("--config", metavar="FILE.toml",
+                   help=f"settings file (docs/CONFIG.md): {tables}; flags given here win over it")
+
+
+def read_config_file(path: str | None) -> dict:
+    """The checked tables of --config (symlearn.config_file.read_config_file), {} without one."""
+    from symlearn.config_file import read_config_file as read
+
+    return read(path)
 
 
 THREADS_HELP = ("torch CPU threads (default: torch's, one per core); use 1 per process when other jobs share the "

@@ -7,34 +7,39 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 import time
 from pathlib import Path
 
-from symlearn.cli.args import (THREADS_HELP, OneLineParser, add_engine_flags, int_range, non_negative_finite_float,
-                               non_negative_int, positive_finite_float, positive_int, set_threads, thread_count)
+from symlearn.cli.args import (THREADS_HELP, TRAIN_PRESET_NAMES, OneLineParser, add_config_flag, add_ray_flag,
+                               int_range, non_negative_int, positive_int, ray_engine, read_config_file, set_threads,
+                               thread_count)
 from symlearn.cli.pipeline import add_pipeline_command
 from symlearn.cli.planning import add_planning_commands
-from symlearn.cli.report import add_report_command
+from symlearn.cli.report import add_plots_command, add_report_command
 from symlearn.outputs import folder_output
 
 
 def cmd_collect(args: argparse.Namespace) -> int:
     from symlearn.cluster import check_engine
-    from symlearn.sim.collect import CollectConfig, collect
+    from symlearn.config_file import replace_nested
     from symlearn.data.dataset import summarize
+    from symlearn.sim.collect import CollectConfig, collect
     from symlearn.sim.exploration import ExplorationConfig
 
-    expl = ExplorationConfig() if args.objects is None else ExplorationConfig.with_k_range(*args.objects)
-    cfg = CollectConfig(n=args.n, seed=args.seed, shard_size=args.shard_size, exploration=expl)
-    check_engine(args.engine, args.address)  # before any work: a missing Ray is refused in one line
-    where = f" on Ray{f' at {args.address}' if args.address else ''}" if args.engine == "ray" else ""
+    cfg = replace_nested(CollectConfig(), read_config_file(args.config).get("collect", {}))  # [collect]
+    if args.objects is not None:
+        cfg = dataclasses.replace(cfg, exploration=ExplorationConfig.with_k_range(*args.objects))
+    cfg = dataclasses.replace(cfg, **{k: v for k, v in dict(n=args.n, seed=args.seed).items() if v is not None})
+    engine, address = ray_engine(args)
+    check_engine(engine, address)  # before any work: a missing Ray is refused in one line
+    where = f" on Ray{f' at {address}' if address else ''}" if engine == "ray" else ""
     print(f"collect: {cfg.n} samples, seed {cfg.seed}, {len(cfg.shard_sizes())} shards, "
           f"{args.workers} worker(s){where} -> {args.out}", file=sys.stderr)
     t0 = time.time()
-    collect(Path(args.out), cfg, workers=args.workers, show_progress=not args.quiet, engine=args.engine,
-            address=args.address)
+    collect(Path(args.out), cfg, workers=args.workers, show_progress=not args.quiet, engine=engine, address=address)
     summary = summarize(Path(args.out))
     summary["wall_s"] = round(time.time() - t0, 1)
     print(json.dumps(summary, indent=2, allow_nan=False))
@@ -74,22 +79,14 @@ def _init_distributed() -> None:
 
 
 def cmd_train(args: argparse.Namespace) -> int:
+    from symlearn.config_file import flat_overrides
     from symlearn.learning.training import TrainConfig, train
 
-    over = {k: v for k, v in dict(epochs=args.epochs, batch_size=args.batch_size, lr=args.lr, seed=args.seed,
-                                   max_train_samples=args.max_train_samples, rider_weight=args.rider_weight,
-                                   dynamics_weight=args.dynamics_weight,
-                                   stability_weight=args.stability_weight,
-                                   stability_margin=args.stability_margin,
-                                   distinct_weight=args.distinct_weight,
-                                   distinct_margin=args.distinct_margin, bits=args.bits).items() if v is not None}
+    over = flat_overrides(read_config_file(args.config).get("train", {}))  # [train] and [train.model]
+    over.update({k: v for k, v in dict(epochs=args.epochs, seed=args.seed).items() if v is not None})
     if args.no_attention:
         over["attention"] = False
-    if args.action_per_object:
-        over["action_per_object"] = True
-    if args.constant_lr:
-        over["cosine_lr"] = False
-    cfg = TrainConfig.from_preset(args.preset, bf16=not args.no_bf16, compile=args.compile, **over)
+    cfg = TrainConfig.from_preset(args.preset, **over)
     folder_output(Path(args.out), "--out")
     set_threads(args.threads)
     _init_distributed()
@@ -137,15 +134,14 @@ def cmd_symbols(args: argparse.Namespace) -> int:
 
 
 def cmd_export_lifted(args: argparse.Namespace) -> int:
+    from symlearn.config_file import replace_nested
     from symlearn.planning.lifted_export import (LIFTED_DIR, LIFTED_FILE, MAX_DATA_OBJECTS, LiftedConfig,
                                                  export_lifted, write_problem_folder)
-
     from symlearn.planning.problem import load_problems
 
+    cfg = replace_nested(LiftedConfig(), read_config_file(args.config).get("lifted", {}))  # [lifted]
     for d in args.problems or []:
         load_problems(Path(d))  # a missing, empty or malformed problem set is refused before any work
-    given = {"min_count": args.min_count}
-    cfg = LiftedConfig(**{k: v for k, v in given.items() if v is not None})
     set_threads(args.threads)
     out = Path(args.out) if args.out else None
     rep = export_lifted(Path(args.run), Path(args.data), tuple(Path(d) for d in args.extra_data), cfg, out)
@@ -170,17 +166,14 @@ def cmd_export_lifted(args: argparse.Namespace) -> int:
 
 
 def cmd_export_pddl(args: argparse.Namespace) -> int:
+    from symlearn.config_file import replace_nested
     from symlearn.planning.export import ExportConfig, export_pddl
 
-    if args.lifted:
+    if not args.rules:
         return cmd_export_lifted(args)
     if args.problems:
-        raise ValueError("--problems writes problem folders of the lifted domain: it needs --lifted")
-
-    given = {"max_objects": args.max_objects, "min_count": args.min_count, "closure": args.closure,
-             "pddl_fidelity_cases": args.pddl_fidelity_cases, "scenes": args.scenes, "seed": args.seed,
-             "outcome_min_ratio": args.outcome_min_ratio, "larger_scenes": args.larger_scenes}
-    cfg = ExportConfig(**{k: v for k, v in given.items() if v is not None})  # unset flags keep ExportConfig's defaults
+        raise ValueError("--problems writes problem folders of the lifted domain; --rules does not")
+    cfg = replace_nested(ExportConfig(), read_config_file(args.config).get("export", {}))  # [export]
     out = folder_output(Path(args.out), "--out") if args.out else None  # before hours of enumeration
     set_threads(args.threads)
     rep = export_pddl(Path(args.run), Path(args.data), cfg, out, extra_data=tuple(Path(d) for d in args.extra_data))
@@ -189,7 +182,7 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
           f"{rep['enumeration_queries_per_s']:.0f} queries/s; rules {rep['n_rules_before_generalization']} -> "
           f"{rep['n_rules']} after generalization over {rep['n_actions_with_rules']} actions")
     through = (f"({rep['pddl_fidelity_cases']} sampled cases) {rep['pddl_fidelity']}"
-               if rep["pddl_fidelity"] is not None else "not measured (--pddl-fidelity-cases 0)")
+               if rep["pddl_fidelity"] is not None else "not measured (pddl_fidelity_cases = 0)")
     print(f"fidelity (rules, every case) {rep['fidelity']:.4f}; through the PDDL {through}")
     for d in rep["disagreements"][:5]:
         print(f"  disagreement: {d}")
@@ -204,14 +197,14 @@ def add_collect_command(sub) -> None:
     """Add `collect` to the CLI's sub-parsers."""
     c = sub.add_parser("collect", help="collect interaction data in the simulator")
     c.add_argument("--out", required=True, help="data set directory (created, or resumed)")
-    c.add_argument("--n", type=positive_int, default=12000, help="number of samples (actions)")
-    c.add_argument("--workers", type=positive_int, default=1,
-                   help="worker processes (with --engine ray: shards in flight at once, and a local Ray's CPUs)")
-    add_engine_flags(c, "shard")
-    c.add_argument("--seed", type=non_negative_int, default=0)
+    c.add_argument("--n", type=positive_int, help="number of samples (actions; default 12000)")
+    c.add_argument("--seed", type=non_negative_int, help="default 0")
     c.add_argument("--objects", type=int_range, default=None,
                    help="objects per scene, e.g. 4-5 (default: the paper's mix of 1-3)")
-    c.add_argument("--shard-size", type=positive_int, default=250, help="samples per shard")
+    c.add_argument("--workers", type=positive_int, default=1,
+                   help="worker processes (with --ray: shards in flight at once, and a local Ray's CPUs)")
+    add_ray_flag(c, "shard")
+    add_config_flag(c, "[collect] (CollectConfig: shard_size, [collect.exploration], [collect.sim])")
     c.add_argument("--quiet", action="store_true", help="no progress bar")
     c.set_defaults(func=cmd_collect)
 
@@ -230,33 +223,15 @@ def add_train_command(sub) -> None:
     t = sub.add_parser("train", help="train the attentive effect model (runs under torchrun too)")
     t.add_argument("--data", required=True)
     t.add_argument("--out", required=True, help="run directory (resumed if it holds the same run)")
-    t.add_argument("--preset", default="paper", choices=["paper", "quick"])
+    t.add_argument("--preset", default="recommended", choices=list(TRAIN_PRESET_NAMES),
+                   help="recommended (default): the quick sizes, the stability loss and the action on the held "
+                        "object's token, the recipe that plans best; quick: the small model alone; paper: the "
+                        "paper's sizes and schedule")
+    add_config_flag(t, "[train] (TrainConfig) and [train.model] (ModelConfig), e.g. batch_size, lr, bf16, "
+                       "stability_weight, rider_weight, bits")
     t.add_argument("--epochs", type=positive_int)
-    t.add_argument("--batch-size", type=positive_int)
-    t.add_argument("--lr", type=positive_finite_float)
     t.add_argument("--seed", type=non_negative_int)
-    t.add_argument("--max-train-samples", type=positive_int, help="train on the first N samples only")
-    t.add_argument("--bits", type=positive_int,
-                   help="code length of each object's symbol, 1-16 (default 8, the paper's: at most 256 symbols)")
     t.add_argument("--no-attention", action="store_true", help="the DeepSym baseline without attention")
-    t.add_argument("--action-per-object", action="store_true",
-                   help="give the action to the held object's token only (the authors' code), not to every object")
-    t.add_argument("--rider-weight", type=positive_finite_float,
-                   help="loss weight of riders, objects carried by the held one (default 1)")
-    t.add_argument("--dynamics-weight", type=non_negative_finite_float,
-                   help="weight of a joint next-code loss: codes trained to carry what decides their next values (default 0)")
-    t.add_argument("--stability-weight", type=non_negative_finite_float,
-                   help="weight of a loss keeping the codes of objects an action left in place unchanged (default 0)")
-    t.add_argument("--stability-margin", type=positive_finite_float,
-                   help="logit distance from 0 the stability loss asks of each bit (default 1)")
-    t.add_argument("--distinct-weight", type=non_negative_finite_float,
-                   help="weight of a loss giving every two objects of a scene a code bit on which they differ "
-                        "(objects sharing a code are moved alike by the rules; default 0)")
-    t.add_argument("--distinct-margin", type=positive_finite_float,
-                   help="logit distance from 0, on opposite sides, the distinct loss asks of that bit (default 1)")
-    t.add_argument("--constant-lr", action="store_true", help="no cosine decay of the learning rate")
-    t.add_argument("--no-bf16", action="store_true", help="plain float32 (bf16 autocast is the default)")
-    t.add_argument("--compile", action="store_true", help="torch.compile the model")
     t.add_argument("--no-resume", action="store_true", help="start over even if RUN/last.pt exists")
     t.add_argument("--threads", type=thread_count, help="CPU threads; use 1 per process when the cores are shared "
                    "(OpenMP threads that wait for busy cores slow training several-fold)")
@@ -286,34 +261,22 @@ def add_analysis_commands(sub) -> None:
 
 def add_export_pddl_command(sub) -> None:
     """Add `export-pddl` to the CLI's sub-parsers."""
-    x = sub.add_parser("export-pddl", help="distil the transition network into rules and a PDDL domain")
+    x = sub.add_parser("export-pddl", help="distil the transition network into PDDL: the lifted domain (default) "
+                                           "or the rules over whole codes (--rules)")
     x.add_argument("--run", required=True)
-    x.add_argument("--data", required=True, help="the data set whose training codes form the vocabulary")
+    x.add_argument("--data", required=True, help="the data set whose training scenes m(z) is asked about")
     x.add_argument("--extra-data", nargs="+", default=[], metavar="DIR",
-                   help="more data sets whose training codes join the vocabulary and the observed scenes")
+                   help="more data sets whose training scenes (and, with --rules, codes) join the main set's")
     x.add_argument("--out", help="output directory (default RUN/pddl)")
-    x.add_argument("--max-objects", type=int, help="largest enumerated scene (default 3)")
-    x.add_argument("--min-count", type=int,
-                   help="training objects a code needs to enter the vocabulary (default 1)")
-    x.add_argument("--scenes", choices=["observed", "all"],
-                   help="enumerate the code multisets of training scenes (default) or every multiset")
-    x.add_argument("--closure", action="store_true", default=None,
-                   help="with --scenes all: add codes the network produces")
-    x.add_argument("--larger-scenes", action="store_true", default=None,
-                   help="with --scenes observed: also enumerate the sub-scenes of up to --max-objects codes of "
-                        "observed scenes with more objects")
-    x.add_argument("--pddl-fidelity-cases", type=int,
-                   help="cases simulated through the PDDL (-1: every enumerated case; default 500)")
-    x.add_argument("--outcome-min-ratio", type=float,
-                   help="outcomes.json (rules-outcomes): keep an object's second likeliest next code where it is "
-                        "at least this fraction as likely as the likeliest (default 0.05)")
-    x.add_argument("--seed", type=int, help="seed of the sampled PDDL fidelity cases (default 0)")
-    x.add_argument("--lifted", action="store_true",
-                   help="write the lifted domain instead (RUN/pddl/lifted/domain.pddl, lifted.json): typed "
-                        "STRIPS schemas distilled from m(z) on observed scenes; needs --location-bits 9")
+    x.add_argument("--rules", action="store_true",
+                   help="the rules over whole codes (rules.json, outcomes.json, domain.pddl; read by the rules-* and "
+                        "SAS+ planners) instead of the lifted domain (lifted.json, lifted/domain.pddl: typed STRIPS "
+                        "schemas; needs m(z) on 9 location bits, docs/DOMAIN.md)")
     x.add_argument("--problems", nargs="+", metavar="DIR",
-                   help="with --lifted: also write each problem set as a standalone folder "
+                   help="lifted domain: also write each problem set as a standalone folder "
                         "(RUN/pddl/lifted/SET/domain.pddl, p01.pddl, ..., index.json)")
+    add_config_flag(x, "[lifted] (LiftedConfig: min_count, rider_min_count) or, with --rules, [export] "
+                       "(ExportConfig: max_objects, min_count, scenes, larger_scenes, pddl_fidelity_cases, ...)")
     x.add_argument("--threads", type=thread_count, help=THREADS_HELP)
     x.set_defaults(func=cmd_export_pddl)
 
@@ -329,6 +292,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_export_pddl_command(sub)
     add_planning_commands(sub)
     add_report_command(sub)
+    add_plots_command(sub)
     add_pipeline_command(sub)
     return p
 

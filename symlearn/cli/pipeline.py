@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from symlearn.cli.args import non_negative_int, positive_int
+from symlearn.cli.args import add_config_flag, non_negative_int, positive_int, read_config_file
 from symlearn.pipeline import DEFAULT_PRESET, PRESETS, PipelineSettings, run_pipeline
 
 PRESETS_HELP = ("recommended (default): the recipe that plans best, at full scale (a paper-style data set and a "
@@ -23,8 +23,8 @@ PRESETS_HELP = ("recommended (default): the recipe that plans best, at full scal
 
 def cmd_pipeline(args: argparse.Namespace) -> int:
     s = PipelineSettings(preset=args.preset, out=Path(args.out), n=args.n, seed=args.seed, epochs=args.epochs,
-                         transition_epochs=args.transition_epochs, problems=args.problems, workers=args.workers,
-                         shard_size=args.shard_size, stop_after=args.stop_after)
+                         problems=args.problems, workers=args.workers, overrides=read_config_file(args.config),
+                         stop_after=args.stop_after)
     run_pipeline(s, echo=lambda line: print(line, flush=True))
     print(f"wrote {s.out / 'pipeline.json'}; report at {s.out / 'run' / 'report.html'}")
     return 0
@@ -40,11 +40,11 @@ def add_pipeline_command(sub) -> None:
     p.add_argument("--n", type=positive_int, help="samples of each collected set (preset's if unset)")
     p.add_argument("--seed", type=non_negative_int, default=0)
     p.add_argument("--epochs", type=positive_int, help="effect model epochs (preset's if unset)")
-    p.add_argument("--transition-epochs", type=positive_int, help="transition network epochs (preset's if unset)")
     p.add_argument("--problems", type=positive_int,
                    help="planning problems to benchmark, per cell of objects x shortest-plan length with the "
                         "recommended and demo presets (preset's if unset)")
     p.add_argument("--workers", type=positive_int, default=1, help="collection worker processes")
-    p.add_argument("--shard-size", type=positive_int, default=250, help="samples per data shard")
+    add_config_flag(p, "every table ([collect], [train], [transition], [lifted], [export], [problems], "
+                       "[execution]), over the preset's values; recorded per stage in pipeline.json")
     p.add_argument("--stop-after", help=argparse.SUPPRESS)  # tests: simulate an interruption after a stage
     p.set_defaults(func=cmd_pipeline)

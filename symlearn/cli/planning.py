@@ -5,16 +5,17 @@ a config and calls one library function, returning an exit code. Errors are rais
 ValueError / RuntimeError with one-line messages, which the main CLI prints.
 
     symlearn train-transition --run runs/paper --data data/paper --preset paper
-    symlearn problems --out problems/p13 --n 50 --objects 1-3 --length 1-4 --seed 0
-    symlearn problems --suite structures --out problems/structures --n 22 --objects 1-5 --seed 0
-    symlearn problems --stratify --out problems/dev --n 10 --objects 1-5 --seed 1000
-    symlearn problems --annotate --out problems/p13
-    symlearn problems --goal examples/goals/fig6_composite.json --out problems/goals
-    symlearn plan --run runs/paper --problem problems/p13/problem_0000.json --planner astar --closed-loop
+    symlearn problems --out problems/dev --n 10 --objects 1-5 --seed 1000
+    symlearn problems --kind walks --out problems/p13 --n 50 --objects 1-3 --length 1-4 --seed 0
+    symlearn problems --kind structures --out problems/structures --n 22 --objects 1-5 --seed 0
+    symlearn problems --kind annotate --out problems/p13
+    symlearn problems --out problems/goals examples/goals/fig6_composite.json
+    symlearn plan --run runs/paper --problem problems/p13/problem_0000.json --planner astar
     symlearn benchmark --run runs/paper --problems problems/p13 --planners astar,astar-ucs --out bench.json
-    symlearn benchmark --run runs/paper --problems problems/grid --planners astar,symk-sas --out g.json --plots plots/
-    symlearn benchmark --run runs/paper --problems problems/grid --planners astar --out g.json --engine ray --workers 8
+    symlearn benchmark --run runs/paper --problems problems/grid --planners astar --out g.json --ray --workers 8
+    symlearn plots bench.json --out plots/
 
+Every lever that is not a flag is a key of --config FILE.toml (symlearn.config_file; docs/CONFIG.md).
 `problems` records its settings in OUT/problems.manifest: the same command again completes an
 interrupted set, other settings are refused unless --overwrite. `benchmark` appends every finished
 row to OUT.rows.jsonl: the same command again after a kill resumes there (other settings are refused).
@@ -22,15 +23,16 @@ row to OUT.rows.jsonl: the same command again after a kill resumes there (other 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import sys
 from pathlib import Path
 
-from symlearn.cli.args import (THREADS_HELP, add_engine_flags, int_range, non_negative_int, planner_list,
-                               positive_finite_float, positive_int, set_threads, thread_count)
+from symlearn.cli.args import (THREADS_HELP, TRAIN_PRESET_NAMES, add_config_flag, add_ray_flag, int_range,
+                               non_negative_int, planner_list, positive_int, ray_engine, read_config_file,
+                               set_threads, thread_count)
 from symlearn.planning.planner_catalogue import DEFAULT_PLANNER, planners_help
-from symlearn.symbolic.locations import DEFAULT_LOCATION_BITS, LOCATION_BITS
 
 
 MAX_TIMEOUT_S = 86_400.0  # one day: larger values are typos, and the SAS+ planners need a finite limit
@@ -51,10 +53,7 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
     from symlearn.symbolic.transition_model import TransitionConfig
     from symlearn.symbolic.transition_training import train_transition
 
-    over = {k: v for k, v in (("epochs", args.epochs), ("copy_prior", args.copy_prior),
-                              ("attention_rounds", args.attention_rounds), ("modes", args.modes),
-                              ("location_bits", args.location_bits)) if v is not None}
-    cfg = TransitionConfig.from_preset(args.preset, **over)
+    cfg = TransitionConfig.from_preset(args.preset, **read_config_file(args.config).get("transition", {}))
     set_threads(args.threads)
     located = f", {cfg.location_bits} location bits" if cfg.location_bits else ""
     modes = f", {cfg.modes} outcome modes" if cfg.modes > 1 else ""
@@ -74,43 +73,63 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
     return 0
 
 
+PROBLEM_KINDS = {
+    "stratified": "--n problems (default 10) per cell of object count x shortest-plan length (1-2, 3-4, 5-6, 7-8, "
+                  "9-12 actions) within --objects (default 1-5), plus an off-location cell per object count, named by "
+                  "cell (k3_opt5-6_0007, k3_off_0001); the default",
+    "walks": "--n random walks of --length generator actions (default 1-4) within --objects (default 1-3)",
+    "located-walks": "walks, redrawn while the goal leaves an object more than 5 cm from every table location",
+    "reference": "--n walks per cell of object count x walk length (1-2, 3-4, 5-6, 7-8): the older depth sets",
+    "structures": "named structure tasks (towers, cubes on the stick, ...) within --objects (default 1-5)",
+    "annotate": "record the shortest plan in every problem of --out that lacks it (sets made before it existed)",
+}
+
+
 def cmd_problems(args: argparse.Namespace) -> int:
+    """`problems`: a set of the --kind asked for, or one problem per goal file."""
+    kind = args.kind or ("goal" if args.goals else "stratified")
+    if args.goals and kind != "goal":
+        raise ValueError(f"goal files make one problem each; --kind {kind} does not apply")
+    not_for = {"goal": ("--n", "--objects", "--length", "--seed", "--exclude"),
+               "annotate": ("--n", "--objects", "--length", "--seed", "--exclude", "--overwrite"),
+               "stratified": ("--length",), "structures": ("--length", "--exclude")}
+    given = {"--n": args.n, "--objects": args.objects, "--length": args.length, "--seed": args.seed,
+             "--exclude": args.exclude, "--overwrite": args.overwrite or None}
+    wrong = [f for f in not_for.get(kind, ("--exclude",)) if given[f] is not None]
+    if wrong:
+        raise ValueError(f"{', '.join(wrong)} do{'es' if len(wrong) == 1 else ''} not apply to "
+                         + ("goal files" if kind == "goal" else f"--kind {kind}"))
+    if kind == "annotate":
+        return _cmd_annotate(args)
+    if kind in ("goal", "structures"):
+        return _cmd_structure_problems(args)
+    if kind == "stratified":
+        return _cmd_stratified(args)
+    return _cmd_walks(args, reference=kind == "reference", on_locations=kind == "located-walks")
+
+
+def _cmd_walks(args: argparse.Namespace, reference: bool, on_locations: bool) -> int:
+    """`problems --kind walks|located-walks|reference`: random-walk problems."""
     from symlearn.planning.problem_generation import N_PROBLEMS, generate_problems
 
-    if args.exclude and not args.stratify:
-        raise ValueError("--exclude applies to --stratify sets only")
-    if args.annotate:
-        return _cmd_annotate(args)
-    if args.suite or args.goal:
-        for flag in ("stratify", "stratify_reference", "on_locations"):
-            if getattr(args, flag):
-                raise ValueError(f"--{flag.replace('_', '-')} applies to random-walk problems only")
-        return _cmd_structure_problems(args)
-    if args.stratify:
-        return _cmd_stratified(args)
-    args.n, args.objects = args.n or N_PROBLEMS, args.objects or (1, 3)
-    args.length, args.seed = args.length or (1, 4), 0 if args.seed is None else args.seed
-    per = " per cell" if args.stratify_reference else ""
-    placed = ", goals on the table locations" if args.on_locations else ""
-    print(f"problems: {args.n} problems{per}, objects {args.objects[0]}-{args.objects[1]}, length "
-          f"{args.length[0]}-{args.length[1]}{placed}, seed {args.seed} -> {args.out}", file=sys.stderr)
-    paths = generate_problems(Path(args.out), args.n, objects=args.objects, length=args.length, seed=args.seed,
-                              overwrite=args.overwrite, stratify=args.stratify_reference,
-                              on_locations=args.on_locations)
+    n, objects = args.n or N_PROBLEMS, args.objects or (1, 3)
+    length, seed = args.length or (1, 4), args.seed or 0
+    per = " per cell" if reference else ""
+    placed = ", goals on the table locations" if on_locations else ""
+    print(f"problems: {n} problems{per}, objects {objects[0]}-{objects[1]}, length {length[0]}-{length[1]}{placed}, "
+          f"seed {seed} -> {args.out}", file=sys.stderr)
+    paths = generate_problems(Path(args.out), n, objects=objects, length=length, seed=seed, overwrite=args.overwrite,
+                              stratify=reference, on_locations=on_locations)
     print(f"wrote {len(paths)} problems to {args.out}")
     return 0
 
 
 def _cmd_stratified(args: argparse.Namespace) -> int:
-    """`problems --stratify`: --n problems per cell of objects x shortest-plan length, and per off-location cell."""
+    """`problems` (--kind stratified): --n problems per cell of objects x shortest-plan length, and per
+    off-location cell."""
     from symlearn.planning.stratified import OBJECTS, PER_CELL, generate_stratified
 
-    given = [f for f, v in (("--length", args.length), ("--on-locations", args.on_locations or None),
-                            ("--stratify-reference", args.stratify_reference or None)) if v is not None]
-    if given:
-        raise ValueError(f"--stratify draws walks of every length and keeps off-location goals in their own "
-                         f"cells; {', '.join(given)} do not apply")
-    n, objects, seed = args.n or PER_CELL, args.objects or OBJECTS, 0 if args.seed is None else args.seed
+    n, objects, seed = args.n or PER_CELL, args.objects or OBJECTS, args.seed or 0
     exclude = tuple(Path(x) for x in (args.exclude or "").split(",") if x.strip())
     print(f"problems: {n} problems per cell of objects {objects[0]}-{objects[1]} x shortest-plan length, "
           f"seed {seed}" + (f", none of {', '.join(map(str, exclude))}" if exclude else "") + f" -> {args.out}",
@@ -125,15 +144,9 @@ def _cmd_stratified(args: argparse.Namespace) -> int:
 
 
 def _cmd_annotate(args: argparse.Namespace) -> int:
-    """`problems --annotate --out DIR`: record the shortest plan in every problem file of DIR that lacks it."""
+    """`problems --kind annotate --out DIR`: record the shortest plan in every problem file of DIR that lacks it."""
     from symlearn.planning.problem_generation import add_shortest_plans
 
-    given = [f for f, v in (("--n", args.n), ("--objects", args.objects), ("--length", args.length),
-                            ("--seed", args.seed), ("--suite", args.suite), ("--goal", args.goal)) if v is not None]
-    given += [f for f, v in (("--stratify", args.stratify), ("--stratify-reference", args.stratify_reference),
-                             ("--on-locations", args.on_locations), ("--overwrite", args.overwrite)) if v]
-    if given:
-        raise ValueError(f"--annotate adds shortest plans to the problems in --out; {', '.join(given)} do not apply")
     counts = add_shortest_plans(Path(args.out))
     print(f"{args.out}: {counts['annotated']} problems annotated, {counts['kept']} already were; shortest plans "
           f"known for {counts['known']}, undecided for {counts['undecided']}")
@@ -141,23 +154,17 @@ def _cmd_annotate(args: argparse.Namespace) -> int:
 
 
 def _cmd_structure_problems(args: argparse.Namespace) -> int:
-    """`problems --suite structures` (named tasks) or `problems --goal FILE` (one problem from a goal file)."""
+    """`problems --kind structures` (named tasks) or `problems GOAL.json ...` (one problem per goal file)."""
     from symlearn.planning.structure_suite import generate_structures, write_goal_problem
 
-    if args.length is not None:
-        raise ValueError("--length applies to random-walk problems only; --suite and --goal problems carry "
-                         "their own reference plans")
-    if args.goal:
-        given = [f for f, v in (("--n", args.n), ("--objects", args.objects), ("--seed", args.seed)) if v is not None]
-        if given:
-            raise ValueError(f"--goal makes one problem from its file; {', '.join(given)} do not apply")
-        path = write_goal_problem(Path(args.goal), Path(args.out), overwrite=args.overwrite)
-        print(f"wrote {path}")
+    if args.goals:
+        for goal in args.goals:
+            print(f"wrote {write_goal_problem(Path(goal), Path(args.out), overwrite=args.overwrite)}")
         return 0
-    n, objects, seed = args.n or 20, args.objects or (1, 5), 0 if args.seed is None else args.seed
-    print(f"problems: suite {args.suite}, {n} problems, objects {objects[0]}-{objects[1]}, seed {seed} -> {args.out}",
+    n, objects, seed = args.n or 20, args.objects or (1, 5), args.seed or 0
+    print(f"problems: structure tasks, {n} problems, objects {objects[0]}-{objects[1]}, seed {seed} -> {args.out}",
           file=sys.stderr)
-    paths = generate_structures(Path(args.out), n, objects=objects, seed=seed, suite=args.suite,
+    paths = generate_structures(Path(args.out), n, objects=objects, seed=seed, suite="structures",
                                 overwrite=args.overwrite)
     print(f"wrote {len(paths)} problems to {args.out}")
     return 0
@@ -179,16 +186,25 @@ def note_rule_loading(run: Path, planners: list[str]) -> None:
         print(f"loading {' and '.join(str(p) for p in paths)} ({megabytes:.0f} MB)", file=sys.stderr)
 
 
+def execution_config(args: argparse.Namespace):
+    """The recipe's execution (closed loop, 10 s a call: execution.RECOMMENDED_EXECUTION) with --config's
+    [execution] table and --timeout over it."""
+    from symlearn.config_file import replace_nested
+    from symlearn.planning.execution import RECOMMENDED_EXECUTION
+
+    cfg = replace_nested(RECOMMENDED_EXECUTION, read_config_file(args.config).get("execution", {}))
+    return cfg if args.timeout is None else dataclasses.replace(cfg, timeout_s=args.timeout)
+
+
 def cmd_plan(args: argparse.Namespace) -> int:
-    from symlearn.planning.execution import ExecutionConfig
     from symlearn.planning.single import plan_problem
 
+    cfg = execution_config(args)
     set_threads(args.threads)
     note_rule_loading(Path(args.run), [args.planner])
-    cfg = ExecutionConfig(closed_loop=args.closed_loop, max_replans=args.max_replans, timeout_s=args.timeout)
     done = plan_problem(Path(args.run), Path(args.problem), args.planner, cfg,
                         record=Path(args.record) if args.record else None, record_size=args.record_size,
-                        risk_weight=args.risk_weight)
+                        risk_weight=cfg.risk_weight)
     problem, row = done.problem, done.row
     if done.gif is not None:
         print(f"wrote {done.gif} ({done.frames} frames) and {done.filmstrip}")
@@ -208,23 +224,20 @@ def cmd_plan(args: argparse.Namespace) -> int:
 def cmd_benchmark(args: argparse.Namespace) -> int:
     from symlearn.cluster import check_engine
     from symlearn.planning.benchmark import benchmark, format_goal_placement, format_table
-    from symlearn.planning.benchmark_plots import format_grid, format_shortest_grid, write_plots
+    from symlearn.planning.benchmark_plots import format_grid, format_shortest_grid
 
-    from symlearn.outputs import distinct_outputs, folder_output
-
-    check_engine(args.engine, args.address)  # before any work: a missing Ray is refused in one line
-    if args.workers > 1 and args.engine != "ray":
-        raise ValueError(f"--workers {args.workers}: the local engine runs rows one after another; add --engine ray")
-    outputs = {"--out": Path(args.out), "--record": args.record, "--plots": args.plots}
-    distinct_outputs({k: Path(v) for k, v in outputs.items() if v})  # --out and its row log: benchmark() checks
-    if args.plots:
-        folder_output(Path(args.plots), "--plots")
-    set_threads(args.threads)
+    cfg = execution_config(args)
+    engine, address = ray_engine(args)
+    check_engine(engine, address)  # before any work: a missing Ray is refused in one line
+    if args.workers > 1 and engine != "ray":
+        raise ValueError(f"--workers {args.workers}: this machine's rows run one after another; add --ray")
+    # search-time inference runs the networks on small batches, many times slower on 2 threads than on 1 when
+    # another busy process shares the cores (docs/BENCHMARKS.md): one thread a planning call, here and in Ray tasks
+    set_threads(1)
     note_rule_loading(Path(args.run), list(args.planners))
-    res = benchmark(Path(args.run), args.problems, args.planners, Path(args.out), closed_loop=args.closed_loop,
-                    timeout_s=args.timeout, max_replans=args.max_replans, show_progress=not args.quiet,
-                    record_dir=Path(args.record) if args.record else None, risk_weight=args.risk_weight,
-                    engine=args.engine, workers=args.workers, address=args.address)
+    res = benchmark(Path(args.run), args.problems, args.planners, Path(args.out), closed_loop=cfg.closed_loop,
+                    timeout_s=cfg.timeout_s, max_replans=cfg.max_replans, show_progress=True,
+                    risk_weight=cfg.risk_weight, engine=engine, workers=args.workers, address=address)
     print(format_table(res))
     print(format_goal_placement(res))
     print()
@@ -232,10 +245,7 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
     print()
     print("secondary view: by reference (generator) plan length")
     print(format_grid(res["grid"]))
-    print(f"wrote {args.out}")
-    if args.plots:
-        for path in write_plots(res["grid"], Path(args.plots), res["shortest_grid"]):
-            print(f"wrote {path}")
+    print(f"wrote {args.out} (plots: symlearn plots {args.out} --out DIR)")
     return 0
 
 
@@ -257,20 +267,12 @@ def add_train_transition_command(sub) -> None:
     t.add_argument("--data", required=True, help="the data set to encode")
     t.add_argument("--extra-data", nargs="+", default=[], metavar="DIR",
                    help="more data sets whose train and val splits join m(z)'s (their test splits are reported apart)")
-    t.add_argument("--preset", default="paper", choices=["paper", "quick"])
-    t.add_argument("--epochs", type=int)
-    t.add_argument("--copy-prior", type=float, help="logit bias toward keeping each input bit (preset's if unset)")
-    t.add_argument("--attention-rounds", type=positive_int,
-                   help="self-attention rounds over the scene (the paper and the presets: 1)")
-    t.add_argument("--modes", type=positive_int,
-                   help="whole-scene outcomes of a mixture m(z), which astar-outcomes follows (the paper: 1; "
-                   "docs/DESIGN.md, 'Outcome modes')")
-    t.add_argument("--location-bits", type=int, nargs="?", const=DEFAULT_LOCATION_BITS, choices=LOCATION_BITS,
-                   metavar="N", help="codes end with N bits read from each crop's geometry: the nearest table "
-                   "location, then whether (4), which way (5) or which way and how far (6) the object stands off "
-                   "it; 7 (without N): whether, then its height in 5 cm layers; 9: which way and how far, then "
-                   "the height (docs/DESIGN.md, 'Location bits')")
-    t.add_argument("--seed", type=int, default=0)
+    t.add_argument("--preset", default="recommended", choices=list(TRAIN_PRESET_NAMES),
+                   help="recommended (default): the quick network on codes ending with 9 location bits, which the "
+                        "lifted domain reads; quick: learned codes only; paper: the paper's layers")
+    add_config_flag(t, "[transition] (TransitionConfig: epochs, copy_prior, attention_rounds, modes, "
+                       "location_bits, ...; docs/DESIGN.md)")
+    t.add_argument("--seed", type=non_negative_int, default=0)
     t.add_argument("--threads", type=thread_count, help=THREADS_HELP)
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=cmd_train_transition)
@@ -278,35 +280,19 @@ def add_train_transition_command(sub) -> None:
 
 def add_problems_command(sub) -> None:
     """Add `problems` to the CLI's sub-parsers."""
-    p = sub.add_parser("problems", help="generate planning problems (initial scene, goal scene) in the simulator")
+    kinds = "; ".join(f"{k}: {v}" for k, v in PROBLEM_KINDS.items())
+    p = sub.add_parser("problems", help="generate planning problems (initial scene, goal scene) in the simulator",
+                       description=f"Kinds of problem set (--kind) -- {kinds}. docs/PROBLEMS.md has the details.")
+    p.add_argument("goals", nargs="*", metavar="GOAL.json",
+                   help="goal files (docs/PROBLEMS.md): write one problem each, OUT/<file stem>.json")
     p.add_argument("--out", required=True, help="directory for the problem JSON files")
-    p.add_argument("--n", type=positive_int, help="number of problems (default 20)")
-    p.add_argument("--objects", type=int_range,
-                   help="objects per scene, e.g. 1-3 or 4-5 (default 1-3; 1-5 with --suite)")
-    p.add_argument("--length", type=int_range, help="generator actions per random-walk problem, e.g. 1-4 (default 1-4)")
+    p.add_argument("--kind", choices=list(PROBLEM_KINDS), help="the kind of set (the description above)")
+    p.add_argument("--n", type=positive_int, help="problems, per cell with stratified and reference")
+    p.add_argument("--objects", type=int_range, help="objects per scene, e.g. 1-3 or 4-5")
+    p.add_argument("--length", type=int_range, help="walks: generator actions per problem, e.g. 1-4")
     p.add_argument("--seed", type=non_negative_int, help="base seed (default 0)")
-    p.add_argument("--stratify", action="store_true",
-                   help="--n problems (default 10) per cell of object count x shortest-plan length (1-2, 3-4, 5-6, "
-                        "7-8, 9-12 actions) within --objects (default 1-5), plus an off-location cell per object "
-                        "count, drawn from random walks, structure tasks and walks aimed at deep states, named by "
-                        "cell (k3_opt5-6_0007, k3_off_0001; docs/PROBLEMS.md)")
-    p.add_argument("--exclude", help="with --stratify: problem sets (A,B) none of whose problems may be drawn "
-                                     "again, e.g. the dev set when making the test set")
-    p.add_argument("--stratify-reference", action="store_true",
-                   help="--n random-walk problems per cell of object count x reference (walk) length bucket (1-2, "
-                        "3-4, 5-6, 7-8 actions) within --objects and --length, named by cell (k3_len5-6_0007): "
-                        "the older depth sets")
-    p.add_argument("--annotate", action="store_true",
-                   help="record the shortest plan (optimal_length) in every problem file of --out that lacks it, "
-                        "e.g. sets made before it existed; nothing else changes")
-    p.add_argument("--on-locations", action="store_true",
-                   help="random walks only: redraw a walk whose goal leaves an object more than 5 cm from every table "
-                        "location (a stick across two places), so every goal is one place-and-level symbols can name")
-    kind = p.add_mutually_exclusive_group()
-    kind.add_argument("--suite", choices=["structures"],
-                      help="named structure tasks (towers, cubes on the stick, ...; docs/PROBLEMS.md) instead of "
-                           "random walks")
-    kind.add_argument("--goal", help="a goal file (docs/PROBLEMS.md): write one problem, OUT/<file stem>.json")
+    p.add_argument("--exclude", help="stratified: problem sets (A,B) none of whose problems may be drawn again, e.g. "
+                                     "the dev set when making the test set")
     p.add_argument("--overwrite", action="store_true",
                    help="remove the problem files already in --out first (without it, a folder holding problems "
                         "of other settings is refused; one of the same settings is completed)")
@@ -315,22 +301,16 @@ def add_problems_command(sub) -> None:
 
 def _add_execution_flags(c: argparse.ArgumentParser) -> None:
     """The execution flags `plan` and `benchmark` share."""
-    c.add_argument("--closed-loop", action="store_true", help="replan when the scene departs from the prediction")
-    c.add_argument("--max-replans", type=non_negative_int, default=3)
-    c.add_argument("--timeout", type=timeout_seconds, default=30.0,
-                   help=f"seconds per planner call, finite and in (0, {MAX_TIMEOUT_S:g}]")
-    # search-time inference runs the networks on small batches, many times slower on 2 threads than on 1 when
-    # another busy process shares the cores (docs/BENCHMARKS.md), so one thread unless asked for more
-    c.add_argument("--threads", type=thread_count, default=1, help="torch CPU threads for the networks (default 1)")
-    c.add_argument("--risk-weight", type=positive_finite_float, default=1.0,
-                   help="astar-likely, astar-outcomes and rules-outcomes only: each action costs 1 + W * (-log "
-                        "P(its predicted next state)) (rules-outcomes: W times a second outcome's extra -log P) "
-                        "(default 1)")
+    c.add_argument("--timeout", type=timeout_seconds,
+                   help=f"seconds per planner call, finite and in (0, {MAX_TIMEOUT_S:g}] (default 10)")
+    add_config_flag(c, "[execution] (ExecutionConfig: closed_loop, default true; max_replans; risk_weight, the "
+                       "weight W of astar-likely, astar-outcomes and rules-outcomes, each action costing 1 + W * "
+                       "(-log P))")
 
 
 def add_plan_command(sub) -> None:
     """Add `plan` to the CLI's sub-parsers."""
-    c = sub.add_parser("plan", help="plan one problem with the learned symbols and execute it",
+    c = sub.add_parser("plan", help="plan one problem with the learned symbols and execute it (closed loop)",
                        epilog=planners_help(), formatter_class=argparse.RawDescriptionHelpFormatter)
     c.add_argument("--run", required=True, help="run directory with best.pt and transition.pt")
     c.add_argument("--problem", required=True, help="problem JSON file")
@@ -339,12 +319,16 @@ def add_plan_command(sub) -> None:
     c.add_argument("--record", help="save the executed plan as this animated GIF (and a filmstrip .png beside it)")
     c.add_argument("--record-size", type=_size, default=(320, 240), help="recorded frame size WxH (default 320x240)")
     _add_execution_flags(c)
+    # search-time inference runs the networks on small batches, many times slower on 2 threads than on 1 when
+    # another busy process shares the cores (docs/BENCHMARKS.md), so one thread unless asked for more
+    c.add_argument("--threads", type=thread_count, default=1, help="torch CPU threads for the networks (default 1)")
     c.set_defaults(func=cmd_plan)
 
 
 def add_benchmark_command(sub) -> None:
     """Add `benchmark` to the CLI's sub-parsers."""
-    c = sub.add_parser("benchmark", help="plan and execute every problem of a directory with several planners",
+    c = sub.add_parser("benchmark", help="plan and execute every problem of a directory with several planners "
+                                         "(closed loop, one torch thread a call)",
                        epilog=planners_help(), formatter_class=argparse.RawDescriptionHelpFormatter)
     c.add_argument("--run", required=True, help="run directory with best.pt and transition.pt")
     c.add_argument("--problems", required=True,
@@ -352,15 +336,11 @@ def add_benchmark_command(sub) -> None:
                         "sets (rows then carry the set's folder name)")
     c.add_argument("--planners", type=planner_list, default=[DEFAULT_PLANNER],
                    help=f"comma-separated planners of the list below (default {DEFAULT_PLANNER})")
-    c.add_argument("--out", required=True, help="benchmark JSON file")
-    c.add_argument("--plots", help="folder for the plots: success and executed / shortest plan length by objects x "
-                                   "shortest-plan length, success and planning time by objects x reference length")
-    c.add_argument("--quiet", action="store_true")
-    c.add_argument("--record", help="directory for GIFs of failed plans (<problem>_<planner>.gif)")
+    c.add_argument("--out", required=True, help="benchmark JSON file (its plots: symlearn plots OUT --out DIR)")
     _add_execution_flags(c)
-    add_engine_flags(c, "problem-planner pair")
+    add_ray_flag(c, "problem-planner pair")
     c.add_argument("--workers", type=positive_int, default=1,
-                   help="with --engine ray: pairs in flight at once, and a local Ray's CPUs (default 1)")
+                   help="with --ray: pairs in flight at once, and a local Ray's CPUs (default 1)")
     c.set_defaults(func=cmd_benchmark)
 
 

@@ -62,7 +62,7 @@ class ModelConfig:
 
     @staticmethod
     def from_preset(name: str, **overrides) -> "ModelConfig":
-        """A named preset (paper, quick) with optional field overrides."""
+        """A named preset (paper, quick, recommended) with optional field overrides."""
         if name not in PRESETS:
             raise ValueError(f"unknown preset {name!r}; known: {', '.join(PRESETS)}")
         return dataclasses.replace(PRESETS[name], **overrides)
@@ -87,6 +87,9 @@ PRESETS = {
     "quick": ModelConfig(crop=32, conv_channels=(32, 64, 64, 64), d_model=64, n_heads=4, n_layers=2, ff_dim=256,
                          decoder_hidden=(128, 128, 128)),
 }
+# the recipe that plans best (pretrained/recommended): the quick sizes, the action on the held object's token only
+# (docs/RESULTS.md, "Riders and Table I")
+PRESETS["recommended"] = dataclasses.replace(PRESETS["quick"], action_per_object=True)
 
 
 class EffectOutput(NamedTuple):

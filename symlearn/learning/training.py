@@ -36,6 +36,16 @@ class TrainingError(RuntimeError):
     """Training cannot go on (NaN loss, mismatched run directory)."""
 
 
+# Each preset's optimisation settings; the model preset of the same name (models.PRESETS) gives its sizes.
+TRAIN_PRESETS = {
+    "paper": dict(epochs=60, batch_size=128, lr=5e-4),
+    "quick": dict(epochs=40, batch_size=64, lr=1e-3),
+    # the recipe that plans best (pretrained/recommended): quick, with the stability loss that keeps the codes of
+    # objects an action left in place unchanged (docs/RESULTS.md, "Levers for symbols that plan")
+    "recommended": dict(epochs=40, batch_size=64, lr=1e-3, stability_weight=0.1),
+}
+
+
 @dataclass(frozen=True)
 class TrainConfig:
     """Optimization settings; `paper` and `quick` pair with the model presets of the same name."""
@@ -72,18 +82,17 @@ class TrainConfig:
 
     @staticmethod
     def from_preset(name: str, **overrides) -> "TrainConfig":
-        """A named preset (paper, quick); model fields among the overrides go to the model config.
+        """A named preset (TRAIN_PRESETS); model fields among the overrides go to the model config.
 
         A positive dynamics_weight switches the model's dynamics head on.
         """
         model_over = {k: overrides.pop(k) for k in list(overrides) if k in ModelConfig.__dataclass_fields__}
         if overrides.get("dynamics_weight", 0) > 0:
             model_over.setdefault("dynamics_head", True)
-        base = {"paper": dict(epochs=60, batch_size=128, lr=5e-4),
-                "quick": dict(epochs=40, batch_size=64, lr=1e-3)}
-        if name not in base:
-            raise ValueError(f"unknown preset {name!r}; known: paper, quick")
-        return TrainConfig(model=ModelConfig.from_preset(name, **model_over), preset=name, **{**base[name], **overrides})
+        if name not in TRAIN_PRESETS:
+            raise ValueError(f"unknown preset {name!r}; known: {', '.join(TRAIN_PRESETS)}")
+        base = TRAIN_PRESETS[name]
+        return TrainConfig(model=ModelConfig.from_preset(name, **model_over), preset=name, **{**base, **overrides})
 
     def to_json(self) -> dict:
         """The config as plain JSON, as stored in checkpoints and config.json."""

@@ -560,7 +560,7 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
     check_engine(engine, address)
     if not (isinstance(workers, int) and workers >= 1) or (workers > 1 and engine != "ray"):
         raise ValueError(f"workers={workers!r}: the local engine runs rows one after another; "
-                         "more workers need --engine ray")
+                         "more workers need the ray engine (--ray)")
     if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
         raise ValueError(f"timeout {timeout_s!r} must be a finite positive number of seconds")
     run_dir, out_file = Path(run_dir), Path(out_file)

@@ -1,16 +1,14 @@
 """The objects x shortest-plan-length grid of a benchmark (and the older reference-length one) as text,
 Markdown and plots.
 
-`symlearn benchmark` prints `format_grid` after a run and, with --plots DIR, writes `write_plots`'
-figures; on a saved result JSON the same come from this module's command line, which prints the
-Markdown tables for the docs:
+`symlearn benchmark` prints `format_grid` after a run; `symlearn plots` (plots_of_results) writes
+`write_plots`' figures of saved result JSONs and prints the Markdown tables for the docs:
 
-    python -m symlearn.planning.benchmark_plots bench.json --out plots/
-    python -m symlearn.planning.benchmark_plots a.json b.json --out plots/   # planners split over processes
+    symlearn plots bench.json --out plots/
+    symlearn plots a.json b.json --out plots/ --merged ab.json   # planners split over processes
 """
 from __future__ import annotations
 
-import argparse
 import math
 from pathlib import Path
 
@@ -253,36 +251,25 @@ def write_plots(grid: dict, out_dir: Path, shortest: dict | None = None) -> list
     return written + [_save(success, out_dir / PLOT_FILES[0]), _save(timing, out_dir / PLOT_FILES[1])]
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Write a saved benchmark result's plots into --out and print its Markdown tables."""
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("result", type=Path, nargs="+",
-                    help="JSON written by symlearn benchmark; several (same run and problems, other planners) merge")
-    ap.add_argument("--out", type=Path, required=True, help="folder for the plots")
-    ap.add_argument("--merged", type=Path, help="also write the merged result JSON here")
-    args = ap.parse_args(argv)
+def plots_of_results(paths: list[Path], out_dir: Path, merged: Path | None = None) -> tuple[list[Path], str]:
+    """Write the plots of saved benchmark results into out_dir (several results, of the same run and problems with
+    other planners, are merged first; with `merged`, the merged JSON is written there too); returns the written
+    paths and the Markdown tables. An unreadable or unmergeable result is a ValueError naming the file."""
     results = []
-    for path in args.result:
+    for path in paths:
         try:
             results.append(read_json_file(path, what="benchmark JSON", max_bytes=512 * MiB))
         except JsonFileError as e:
-            raise SystemExit(f"not a readable benchmark JSON: {e}")
+            raise ValueError(f"not a readable benchmark JSON: {e}") from None
     try:
-        result = merge_results(results, [str(p) for p in args.result])
+        result = merge_results(results, [str(p) for p in paths])
         summary = grid_of(result)
     except (ValueError, TypeError, KeyError) as e:
-        raise SystemExit(f"{args.result[0]}: {e}")
-    if args.merged:
+        raise ValueError(f"{paths[0]}: {e}") from None
+    written = []
+    if merged:
         from pddl_export.files import atomic_write_json, finite_or_null
 
-        atomic_write_json(args.merged, finite_or_null(result))
-        print(f"wrote {args.merged}")
-    for path in write_plots(summary["grid"], args.out, summary.get("shortest_grid")):
-        print(f"wrote {path}")
-    print()
-    print(markdown_grid(summary))
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+        atomic_write_json(merged, finite_or_null(result))
+        written.append(merged)
+    return written + write_plots(summary["grid"], out_dir, summary.get("shortest_grid")), markdown_grid(summary)

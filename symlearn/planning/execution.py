@@ -28,6 +28,7 @@ disagree on that step, aliasing, replans.
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import asdict, dataclass, field
 from enum import Enum
@@ -69,14 +70,24 @@ class ExecutionConfig:
     max_replans: int = 3  # bound on replanning calls per problem
     max_fallbacks: int = 3  # bound on switches to another plan's suffix (top-k fallback) per problem
     timeout_s: float = 30.0  # per planner call
+    # astar-likely, astar-outcomes and rules-outcomes: each action costs 1 + risk_weight * (-log P(its predicted next
+    # state)) (rules-outcomes: risk_weight times a second outcome's extra -log P); symlearn.planning.planners
+    risk_weight: float = 1.0
 
     def __post_init__(self) -> None:
         if not self.tolerance_m > 0:
             raise ValueError(f"tolerance_m={self.tolerance_m} must be positive")
         if self.max_replans < 0 or self.max_fallbacks < 0:
             raise ValueError(f"max_replans={self.max_replans} and max_fallbacks={self.max_fallbacks} must be >= 0")
-        if not self.timeout_s > 0:
-            raise ValueError(f"timeout_s={self.timeout_s} must be positive")
+        if not (math.isfinite(self.timeout_s) and self.timeout_s > 0):
+            raise ValueError(f"timeout_s={self.timeout_s} must be a finite positive number of seconds")
+        if not (math.isfinite(self.risk_weight) and self.risk_weight > 0):
+            raise ValueError(f"risk_weight={self.risk_weight} must be a finite positive number")
+
+
+# How plan and benchmark execute by default, the recipe's (docs/RESULTS.md): replan when the scene departs from the
+# prediction, up to 3 times, 10 s a planner call.
+RECOMMENDED_EXECUTION = ExecutionConfig(closed_loop=True, timeout_s=10.0)
 
 
 @dataclass(frozen=True)

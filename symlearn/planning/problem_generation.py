@@ -174,7 +174,7 @@ def prepare_problem_dir(out_dir: Path, settings: dict, overwrite: bool = False) 
             keys = [k for k in set(settings) | set(old) if old.get(k) != settings.get(k)]
             if keys == ["problem_version"]:
                 raise ValueError(f"{out_dir} holds problems of version {old.get('problem_version')}, without shortest "
-                                 f"plans: 'symlearn problems --annotate --out {out_dir}' adds them, then this command "
+                                 f"plans: 'symlearn problems --kind annotate --out {out_dir}' adds them, then this command "
                                  f"completes the set; or --overwrite")
             diff = ", ".join(f"{k} {old.get(k)} (asked {v})" for k, v in settings.items() if old.get(k) != v)
             raise ValueError(f"{out_dir} already holds problems of other settings ({diff}); "

@@ -1,7 +1,7 @@
 """Problem sets stratified by shortest-plan length: n problems per cell of objects x shortest-plan length.
 
-`symlearn problems --stratify` fills the cells (k objects, 1-5) x (shortest plan 1-2, 3-4, 5-6, 7-8, 9-12
-actions), plus one "off" cell per object count: goals that leave a judged object off the table locations
+`symlearn problems` (its default kind, stratified) fills the cells (k objects, 1-5) x (shortest plan 1-2, 3-4, 5-6,
+7-8, 9-12 actions), plus one "off" cell per object count: goals that leave a judged object off the table locations
 (no shortest length: symlearn.planning.shortest), kept apart from the on-location cells. Problem i of a cell
 is the first of its draws (rng [seed, k, lo, hi, i, draw]; the off cell has lo = hi = 0) that falls in the
 cell and is not already in the cell or in an `exclude`d set (same initial and goal scene within 2 cm). Draws
@@ -50,7 +50,7 @@ OFF_WALK_LENGTH = (1, 8)  # walk lengths drawn for the off-location cell
 SOURCES = ("walk", "structure", "aimed")
 AIMED_WALK = "aimed-walk"  # the task of a walk aimed at a state of the model
 AIMED_START_WALK = 8  # an aimed walk starts after 0..8 random actions from the dropped scene
-PER_CELL = 10  # problems per cell unless asked otherwise (`problems --stratify`, the recommended pipeline)
+PER_CELL = 10  # problems per cell unless asked otherwise (`symlearn problems`, the recommended pipeline)
 OBJECTS = (1, 5)  # the object range stratified unless asked otherwise: every scene size the data sets hold
 
 

@@ -208,7 +208,7 @@ def benchmark_section(bench: dict | None, why: str = "") -> Section:
         tables += _shortest_tables(shortest)
     elif bench.get("summary"):
         text.append("no grid by shortest-plan length: the benchmark was written before problems recorded their "
-                    "shortest plans ('symlearn problems --annotate --out DIR', then benchmark again)")
+                    "shortest plans ('symlearn problems --kind annotate --out DIR', then benchmark again)")
     return Section("benchmark", title, text=text, tables=tables)
 
 

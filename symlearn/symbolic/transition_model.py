@@ -113,6 +113,10 @@ TRANSITION_PRESETS = {
     "paper": TransitionConfig(preset="paper", copy_prior=3.0),
     "quick": TransitionConfig(preset="quick", hidden=64, n_heads=4, epochs=40, batch_size=64, lr=2e-3),
 }
+# the recipe that plans best (pretrained/recommended): quick, with the 9 location bits the lifted domain reads
+# (which way and how far an object stands off its location, and its height; pddl_export/lifted_scene.py)
+TRANSITION_PRESETS["recommended"] = dataclasses.replace(TRANSITION_PRESETS["quick"], preset="recommended",
+                                                        location_bits=9)
 
 
 class TransitionOutput(NamedTuple):
