@@ -28,7 +28,7 @@ def _range(text: str) -> tuple[int, int]:
 
 def select(folders: list[Path], objects: tuple[int, int], min_length: int) -> list[tuple[str, object]]:
     """(label, problem) for the problems of the folders with objects[0]..objects[1] objects and a long reference."""
-    from symlearn.planning.problem import load_problems
+    from symlearn.problems.problem import load_problems
 
     out = []
     for d in folders:
@@ -43,7 +43,7 @@ def time_planners(run: Path, problems: list, planners: list[str], timeout_s: flo
     from symlearn.learning.checkpoint import load_effect_model
     from symlearn.planning.execution import safe_plan
     from symlearn.planning.planners import make_planners
-    from symlearn.planning.scenes import scene_codes, symbolic_goal
+    from symlearn.symbolic.scenes import scene_codes, symbolic_goal
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.learned_transition import LearnedTransition
 
@@ -112,7 +112,7 @@ def main() -> None:
     if args.problems:
         folders = [Path(p) for p in args.problems.split(",") if p]
     else:
-        from symlearn.planning.problem_generation import generate_problems
+        from symlearn.problems.problem_generation import generate_problems
 
         folders = [args.out.parent / f"{args.out.stem}_problems"]
         generate_problems(folders[0], args.n, objects=args.objects, length=args.length, seed=args.seed)

@@ -41,7 +41,7 @@ def record_calls(run: Path, problems: list[Path], timeout_s: float) -> tuple[lis
     import pddl_export.rule_successors as rs_module
     from symlearn.planning.execution import ExecutionConfig, run_problem
     from symlearn.planning.planners import make_planners
-    from symlearn.planning.problem import load_problem
+    from symlearn.problems.problem import load_problem
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.learned_transition import planning_models
 

@@ -15,11 +15,11 @@ from pathlib import Path
 from pddl_export.rules_io import RULES_FILE
 from pddl_export.symbolic import SymbolicGoal, code_str
 from symlearn.planning.execution import safe_plan
-from symlearn.planning.lifted_export import LIFTED_FILE
+from symlearn.export.lifted_export import LIFTED_FILE
 from symlearn.planning.planner_catalogue import FAMILIES
 from symlearn.planning.planners import PLANNERS, make_planners
-from symlearn.planning.problem import load_problem
-from symlearn.planning.scenes import scene_codes, symbolic_goal
+from symlearn.problems.problem import load_problem
+from symlearn.symbolic.scenes import scene_codes, symbolic_goal
 from symlearn.sim.simulator import TabletopSimulator
 from symlearn.symbolic.learned_transition import planning_models
 from symlearn.world import decode_action

@@ -12,7 +12,7 @@ import re
 from pathlib import Path
 
 from pddl_export.lifted_rules import load_lifted
-from symlearn.planning.lifted_export import LIFTED_FILE, write_problem_folder
+from symlearn.export.lifted_export import COST_FORM_DIR, LIFTED_FILE, write_problem_folder
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -25,7 +25,7 @@ def main() -> None:
     args = ap.parse_args()
     run, out = Path(args.run), Path(args.out)
     problems = Path(args.problems) if args.problems else run / "problems"
-    if out.exists() and any(p.suffix not in (".pddl", ".json") for p in out.iterdir()):
+    if out.exists() and any(p.suffix not in (".pddl", ".json") and p.name != COST_FORM_DIR for p in out.iterdir()):
         raise SystemExit(f"generate_domain.py: error: {out} holds files other than a domain folder's; give another --out")
     rules = load_lifted(run / "pddl" / LIFTED_FILE)
     index = write_problem_folder(run, problems, out)
@@ -33,6 +33,9 @@ def main() -> None:
     print(f"domain {out / 'domain.pddl'}: {len(domain) / 1000:.0f} KB, {domain.count('(:action ')} typed STRIPS "
           f"schemas distilled from {rules.stats.get('moves')} observed moves, the same file for any number of objects")
     print("predicates: " + " ".join(sorted(set(re.findall(r"\((bit-\d+|no-bit-\d+|[a-z]+) \?", domain)))))
+    costed = (out / COST_FORM_DIR / "domain.pddl").read_text()
+    print(f"all-outcomes cost form {out / COST_FORM_DIR}/: {costed.count('(:action ')} schemas, one per outcome of a "
+          f"rule, each costing by how often m(z) answered it (for a cost-aware planner, e.g. A* with LM-cut)")
     print(f"\n{'problem':<8} {'objects':>7} {'shortest plan':>13}  source")
     for name, p in index["problems"].items():
         print(f"{name:<8} {p['objects']:>7} {str(p['optimal_length']):>13}  {p['file']}")

@@ -18,6 +18,10 @@ row neighbours, and which ones overlap before and after depends on the pair.
 
 `LiftedRules.step_pieces` and `step_codes` apply them to a state (the Python form of the PDDL that
 `lifted_writer` writes): a move no rule covers leaves the state as it is, as the PDDL offers no action for it.
+
+A rule also keeps how often its outcome was m(z)'s answer among the moves of its descriptions (`share`) and the
+other writable outcomes seen at least ALTERNATIVE_MIN_SHARE of the time (`alternatives`): the all-outcomes
+determinisation that the cost form of the domain writes, one action per outcome costing by its -log share.
 """
 from __future__ import annotations
 
@@ -39,6 +43,8 @@ MAX_LIFTED_BYTES = 64 << 20  # a lifted rules file is kilobytes; refuse anything
 STRUCTURE = ("cls", "o.stick", "o.place", "o.level", "u.level", "v.level", "riders.sides", "riders.place",
              "riders.level", "beneath", "landing", "u.at", "v.at")
 REFINEMENTS = (("o.kind",), ("v.kind",), ("u.kind",), ("riders.kind",))
+ALTERNATIVE_MIN_SHARE = 0.1  # an outcome this often m(z)'s answer among a rule's moves becomes an alternative
+MAX_ALTERNATIVES = 2  # per rule, the most frequent ones (the cost form writes 1 + this many actions per rule)
 WHERE = ("to", "from", "stay", "shift")  # where a piece ends, relative to the action; an int is a location
 
 
@@ -166,6 +172,12 @@ class Rule:
     key: tuple
     outcome: Outcome
     support: int  # observed moves it was distilled from (all of its key's)
+    share: float = 1.0  # how often `outcome` was m(z)'s answer among those moves
+    alternatives: tuple = ()  # ((outcome, share), ...): other writable answers, at least ALTERNATIVE_MIN_SHARE each
+
+    def outcomes(self) -> tuple:
+        """((outcome, share), ...): the rule's own outcome first, then its alternatives."""
+        return ((self.outcome, self.share), *self.alternatives)
 
     def fields(self) -> dict:
         return dict(self.key)
@@ -209,8 +221,10 @@ class LiftedRules:
                 return r
         return None
 
-    def step_pieces(self, pieces: Sequence[Piece], action: int) -> tuple[tuple[Piece, ...], Rule | None]:
-        """The pieces after an action (pick * 6 + release), and the rule that fired (None: nothing changes)."""
+    def step_pieces(self, pieces: Sequence[Piece], action: int, alternative: int = 0
+                    ) -> tuple[tuple[Piece, ...], Rule | None]:
+        """The pieces after an action (pick * 6 + release), and the rule that fired (None: nothing changes); with
+        `alternative` j > 0, the rule's j-th alternative outcome instead of its own."""
         pick, release = divmod(int(action), 6)
         graph = read_scene(pieces)
         m = participants(graph, pick, release)
@@ -220,7 +234,10 @@ class LiftedRules:
         if rule is None:
             return tuple(pieces), None
         out = list(pieces)
-        o_change, u_kind, v_kind, *r_changes = rule.outcome
+        outcomes = rule.outcomes()
+        if not 0 <= alternative < len(outcomes):
+            raise ValueError(f"the rule of action {action} has {len(outcomes) - 1} alternatives, not {alternative}")
+        o_change, u_kind, v_kind, *r_changes = outcomes[alternative][0]
         for i, change in zip((m.o, *m.riders), (o_change, *r_changes)):
             out[i] = _place(pieces[i], change, m)
         for i, kind in ((m.below, u_kind), (m.v_at, v_kind)):
@@ -236,10 +253,12 @@ class LiftedRules:
             learned = self.layout.with_kind(self.layout.learned(old_code), piece.kind)
         return (int(learned) << 9) | (piece.loc << 6) | (piece.place << 3) | piece.level
 
-    def step_codes(self, codes: Sequence[int], action: int) -> tuple[tuple[int, ...], Rule | None]:
-        """The located codes after an action: unmoved objects keep theirs, moved ones get code_of their pieces."""
+    def step_codes(self, codes: Sequence[int], action: int, alternative: int = 0
+                   ) -> tuple[tuple[int, ...], Rule | None]:
+        """The located codes after an action (with a rule's alternative outcome if asked): unmoved objects keep
+        theirs, moved ones get code_of their pieces."""
         pieces = self.pieces(codes)
-        after, rule = self.step_pieces(pieces, action)
+        after, rule = self.step_pieces(pieces, action, alternative)
         return tuple(int(c) if a == p else self.code_of(a, c) for c, p, a in zip(codes, pieces, after)), rule
 
     def to_json(self) -> dict:
@@ -247,10 +266,18 @@ class LiftedRules:
                 "code_bits": self.layout.code_bits, "kept": list(self.layout.kept),
                 "stick_of": [[int(a), int(b), bool(s)] for (a, b), s in sorted(self.stick_of.items())],
                 "rules": [{"depth": r.depth, "key": [[k, v] for k, v in r.key],
-                           "outcome": [list(c) if isinstance(c, tuple) else c for c in r.outcome],
-                           "support": r.support} for r in self.rules],
+                           "outcome": _outcome_json(r.outcome), "support": r.support, "share": r.share,
+                           "alternatives": [[_outcome_json(o), p] for o, p in r.alternatives]} for r in self.rules],
                 "codebook": [[bool(k[0]), *map(int, k[1:]), int(v)] for k, v in sorted(self.codebook.items())],
                 "stats": self.stats}
+
+
+def _outcome_json(outcome: Outcome) -> list:
+    return [list(c) if isinstance(c, tuple) else c for c in outcome]
+
+
+def _outcome_of_json(d: list) -> Outcome:
+    return tuple(tuple(c) if isinstance(c, list) else c for c in d)
 
 
 def stick_reader(codes: np.ndarray, mask: np.ndarray, is_stick: np.ndarray, layout: CodeLayout) -> dict:
@@ -303,20 +330,34 @@ def distil_lifted(layout: CodeLayout, stick_of: dict, moves: Sequence[tuple[dict
             groups[(d, key_of(sig, d))].add(majority[k][0])
             support[(d, key_of(sig, d))] += sum(tally[k].values())
     rules, unwritable = {}, 0
+    answers: dict = defaultdict(Counter)  # a rule's key -> m(z)'s answers over all moves of its descriptions
     for k, sig in sigs.items():
         for d in range(full + 1):
             g = (d, key_of(sig, d))
             if len(groups[g]) == 1:
                 if writable(majority[k][0]):
                     rules[g] = Rule(d, g[1], majority[k][0], support[g])
+                    answers[g].update(tally[k])
                 else:
                     unwritable += 1
                 break
+    rules = {g: _with_alternatives(r, answers[g]) for g, r in rules.items()}
     stats = {"moves": len(moves), "descriptions": len(tally), "kept_descriptions": len(majority),
              "rules": len(rules), "descriptions_without_move": unwritable,
              "agreement": _agreement(tally, majority)}
     return LiftedRules(layout, stick_of, tuple(sorted(rules.values(), key=lambda r: (repr(r.key), r.depth))),
                        model_hash, stats)
+
+
+def _with_alternatives(rule: Rule, answers: Counter) -> Rule:
+    """The rule with its outcome's share of m(z)'s answers and the other writable answers of at least
+    ALTERNATIVE_MIN_SHARE (the MAX_ALTERNATIVES most frequent)."""
+    total = sum(answers.values())
+    if not total:
+        return rule
+    alts = tuple((out, round(n / total, 4)) for out, n in answers.most_common()
+                 if out != rule.outcome and writable(out) and n / total >= ALTERNATIVE_MIN_SHARE)[:MAX_ALTERNATIVES]
+    return dataclasses.replace(rule, share=round(answers[rule.outcome] / total, 4), alternatives=alts)
 
 
 def _agreement(tally: dict, majority: dict) -> float:
@@ -337,9 +378,12 @@ def load_lifted(path) -> LiftedRules:
         stick_of = {(int(a), int(b)): bool(s) for a, b, s in d["stick_of"]}
         codebook = {(bool(e[0]), int(e[1]), int(e[2]), int(e[3]), int(e[4])): int(e[5]) for e in d.get("codebook", [])}
         rules = tuple(Rule(int(r["depth"]), tuple((k, tuple(v) if isinstance(v, list) else v) for k, v in r["key"]),
-                           tuple(tuple(c) if isinstance(c, list) else c for c in r["outcome"]), int(r["support"]))
+                           _outcome_of_json(r["outcome"]), int(r["support"]), float(r.get("share", 1.0)),
+                           tuple((_outcome_of_json(o), float(p)) for o, p in r.get("alternatives", [])))
                       for r in d["rules"])
         for r in rules:
+            if not all(0 < share <= 1 for _, share in r.outcomes()):
+                raise ValueError(f"a rule's outcome shares {[share for _, share in r.outcomes()]} must lie in (0, 1]")
             names = tuple(k for k, _ in r.key)
             if names[:len(STRUCTURE)] != STRUCTURE or not 0 <= r.depth <= len(REFINEMENTS):
                 raise ValueError(f"a rule's key names {names[:len(STRUCTURE)]}, expected {STRUCTURE}")

@@ -11,6 +11,11 @@ action schema in plain STRIPS with typing: no negative preconditions, no equalit
 quantifiers, no axioms, so that Fast Downward (LM-cut included), pyperplan and pyval take it. `at`, `level`,
 `rests` and `height` hold one value per block or location, which Fast Downward's translator finds.
 
+The cost form (`costs=True`: domain_pddl, problem_pddl) is the all-outcomes determinisation of the rules: one
+action per outcome of a rule (its own and its alternatives, `-altJ`), each costing OUTCOME_COST_UNIT * (1 - ln
+share) rounded (`:action-costs`, `(:metric minimize (total-cost))`), so that a cost-aware search (A* with LM-cut)
+takes the plan whose steps m(z) answered most often, as `rules-outcomes` does on the rules over whole codes.
+
 A cube's rule and a stick's moved within the near row are lifted over both locations (`?from`, `?to`); a stick
 moved in or out of the far row covers its row neighbours with its ends, and which of those overlap depends on
 the pair, so its rules name the two locations (`pick-release-stick-l1-l2-...`).
@@ -21,6 +26,7 @@ the pair, so its rules name the two locations (`pick-release-stick-l1-l2-...`).
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -29,6 +35,14 @@ from pddl_export.lifted_scene import FAR_ROW, NEAR_ROW, N_LOCATIONS, neighbours,
 from pddl_export.symbolic import SymbolicGoal
 
 LEVELS = 8
+OUTCOME_COST_UNIT = 10  # the cost of a step m(z) always answered so; -ln share adds in the same unit
+
+
+def outcome_cost(share: float) -> int:
+    """An action's cost in the cost form: OUTCOME_COST_UNIT * (1 - ln share), rounded (share in (0, 1])."""
+    if not 0 < share <= 1:
+        raise ValueError(f"an outcome's share {share!r} must lie in (0, 1]")
+    return OUTCOME_COST_UNIT + round(-OUTCOME_COST_UNIT * math.log(share))
 
 
 def loc_name(loc: int) -> str:
@@ -55,6 +69,7 @@ class Schema:
     params: tuple = ()
     pre: tuple = ()
     eff: tuple = ()
+    alternative: int = 0  # which of its rule's outcomes (0: the rule's own)
 
 
 def _bit_literals(rules: LiftedRules, term: str, kind: int, present: bool = True) -> list[str]:
@@ -81,8 +96,9 @@ def _bit_effects(rules: LiftedRules, term: str, new_kind: int, old_kind: int | N
     return out
 
 
-def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
-    """The action schema of one rule (see the module docstring for the vocabulary)."""
+def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0, cost: int | None = None) -> Schema:
+    """The action schema of one rule (see the module docstring for the vocabulary): of its own outcome, or of its
+    alternative-th alternative; with a cost, the action increases total-cost by it."""
     f = rule.fields()
     cls = f["cls"]
     concrete = isinstance(cls, tuple)
@@ -101,7 +117,8 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
             pre += ["(near ?from)", "(near ?to)"]
     if f.get("o.kind") is not None:
         pre += _bit_literals(rules, "?o", f["o.kind"])
-    o_out, u_kind, v_kind, *r_out = rule.outcome
+    outcome = rule.outcomes()[alternative][0]
+    o_out, u_kind, v_kind, *r_out = outcome
     lands_on = o_out[1] == 0  # o ends on the release location (else off it: a far stick then covers no neighbour)
     new_o = level_name(o_out[2])
 
@@ -153,10 +170,13 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int) -> Schema:
         eff += _replace("height", loc, old, new)
     # beneath facts a landing re-adds where it also lifted them cancel out; keep the effects consistent
     eff = _net_effects(eff)
+    if cost is not None:
+        eff.append(f"(increase (total-cost) {int(cost)})")
 
-    name = f"pick-release-{'stick' if f['o.stick'] else 'cube'}{f'-{frm}-{to}' if concrete else ''}-{index}"
-    text = _schema_text(name, params, pre, eff, _comment(rule, f))
-    return Schema(name, pick, release, text, tuple(params), tuple(dict.fromkeys(pre)), tuple(eff))
+    name = (f"pick-release-{'stick' if f['o.stick'] else 'cube'}{f'-{frm}-{to}' if concrete else ''}-{index}"
+            + (f"-alt{alternative}" if alternative else ""))
+    text = _schema_text(name, params, pre, eff, _comment(rule, f, alternative))
+    return Schema(name, pick, release, text, tuple(params), tuple(dict.fromkeys(pre)), tuple(eff), alternative)
 
 
 PLACES = ("on-spot", "minus-y-near", "minus-y-mid", "minus-y-far", "plus-y-near", "plus-y-mid", "plus-y-far", "off-x")
@@ -242,9 +262,12 @@ def _net_effects(eff: list[str]) -> list[str]:
     return out
 
 
-def _comment(rule: Rule, f: dict) -> str:
-    o = rule.outcome[0]
-    return (f"; rule of {rule.support} observed moves; {'a stick' if f['o.stick'] else 'a cube'} "
+def _comment(rule: Rule, f: dict, alternative: int = 0) -> str:
+    outcome, share = rule.outcomes()[alternative]
+    o = outcome[0]
+    which = f"alternative {alternative} of the rule, m(z)'s answer {share:.0%} of the time" if alternative else \
+        f"rule of {rule.support} observed moves"
+    return (f"; {which}; {'a stick' if f['o.stick'] else 'a cube'} "
             f"{'lands on its release location' if o[1] == 0 else 'ends off its release location'} at level {o[2]}")
 
 
@@ -256,57 +279,79 @@ def _schema_text(name: str, params, pre, eff, comment: str) -> str:
             f"    :effect (and\n      {eff_s}))\n")
 
 
-def schemas(rules: LiftedRules) -> tuple[Schema, ...]:
-    """The domain's action schemas, one per rule.
+def schemas(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
+    """The domain's action schemas, one per rule; in the cost form one per outcome of each rule, with its cost.
 
     (A form with one schema per kind of move and a conditional effect per rule would ground to far fewer
     actions, but Fast Downward's translator then works out, for every fact one clause adds and another
     deletes, the negation of the other clauses' conditions: a 4-object task did not translate in 10 minutes.)
     """
-    return tuple(rule_schema(rules, r, i) for i, r in enumerate(rules.rules))
+    if not costs:
+        return tuple(rule_schema(rules, r, i) for i, r in enumerate(rules.rules))
+    out = []
+    for i, r in enumerate(rules.rules):
+        for j, (_, share) in enumerate(r.outcomes()):
+            try:
+                out.append(rule_schema(rules, r, i, j, outcome_cost(share)))
+            except ValueError:
+                if j == 0:  # the rule's own outcome always writes (export_lifted checks it)
+                    raise
+                # an alternative whose heights cannot be stated from the rule's key: no action for it
+    return tuple(out)
 
 
-def action_decoder(rules: LiftedRules):
-    """Plan step ('(pick-release-cube-3 o1 l0 l4 ...)') -> robot action id (pick * 6 + release)."""
-    by_name = {s.name: s for s in schemas(rules)}
+def step_decoder(rules: LiftedRules, costs: bool = False):
+    """Plan step ('(pick-release-cube-3-alt1 o1 l0 l4 ...)') -> (robot action id, pick * 6 + release; the outcome
+    of its rule the step stands for, 0 for the rule's own)."""
+    by_name = {s.name: s for s in schemas(rules, costs)}
 
-    def action_id(step: str) -> int:
+    def decode(step: str) -> tuple[int, int]:
         words = step.strip().strip("()").split()
         if not words or words[0].lower() not in by_name:
             raise ValueError(f"plan step {step!r} names no action of the lifted domain")
         s = by_name[words[0].lower()]
         if s.pick is not None:
-            return s.pick * N_LOCATIONS + s.release
+            return s.pick * N_LOCATIONS + s.release, s.alternative
         frm, to = words[2].lower(), words[3].lower()
-        return int(frm[1:]) * N_LOCATIONS + int(to[1:])
-    return action_id
+        return int(frm[1:]) * N_LOCATIONS + int(to[1:]), s.alternative
+    return decode
 
 
-def domain_pddl(rules: LiftedRules) -> str:
-    """The lifted domain's text."""
+def action_decoder(rules: LiftedRules, costs: bool = False):
+    """Plan step ('(pick-release-cube-3 o1 l0 l4 ...)') -> robot action id (pick * 6 + release)."""
+    decode = step_decoder(rules, costs)
+    return lambda step: decode(step)[0]
+
+
+def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
+    """The lifted domain's text; with costs, its all-outcomes cost form (the module docstring)."""
     bits = " ".join(f"(bit-{b} ?b - block) (no-bit-{b} ?b - block)" for b in rules.layout.kept)
     locs = " ".join(loc_name(i) for i in range(N_LOCATIONS))
     lvls = " ".join(level_name(h) for h in range(LEVELS))
-    body = "".join(s.text for s in schemas(rules))
+    body = "".join(s.text for s in schemas(rules, costs))
+    requirements = ":strips :typing :action-costs" if costs else ":strips :typing"
+    functions = "  (:functions (total-cost) - number)\n" if costs else ""
     return (f"; A lifted domain distilled from the transition model {rules.model_hash or '(no hash)'} by symlearn.\n"
             f"; Blocks stand at locations l0-l5 (far row l0-l2, near row l3-l5) on a support, at a level (5 cm layers).\n"
             f"(define (domain {domain_name(rules)})\n"
-            "  (:requirements :strips :typing)\n"
+            f"  (:requirements {requirements})\n"
             "  (:types block location layer position - object cube stick - block)\n"
             f"  (:constants {locs} - location {lvls} - layer {' '.join(PLACES)} - position)\n"
             "  (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer) (rests ?b - block ?h - layer)\n"
             "               (height ?l - location ?h - layer) (beneath ?l - location ?h - layer) (place ?b - block ?p - position)\n"
             "               (near ?l - location) (differ ?a - location ?b - location)"
             + (f"\n               {bits}" if bits else "") + ")\n"
-            + body + ")\n")
+            + functions + body + ")\n")
 
 
 def object_name(i: int) -> str:
     return f"o{i}"
 
 
-def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicGoal, name: str) -> str:
-    """A problem of the lifted domain: the start scene read from its codes, the goal's located fields."""
+def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicGoal, name: str,
+                 costs: bool = False) -> str:
+    """A problem of the lifted domain (of its cost form, with costs): the start scene read from its codes, the goal's
+    located fields."""
     if len(goal.codes) != len(start_codes):
         raise ValueError(f"the goal has {len(goal.codes)} objects, the start {len(start_codes)}")
     pieces = rules.pieces(start_codes)
@@ -340,10 +385,13 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
             goals.append(f"(at {o} {loc_name(g.loc)})")
         goals.append(f"(level {o} {level_name(g.level)})")
         goals.append(f"(place {o} {place_name(g.place)})")
+    if costs:
+        init.append("(= (total-cost) 0)")
     init_s = "\n    ".join(init)
     goal_s = "\n    ".join(goals)
+    metric = "\n  (:metric minimize (total-cost))" if costs else ""
     return (f"(define (problem {name})\n  (:domain {domain_name(rules)})\n  (:objects {objs})\n"
-            f"  (:init\n    {init_s})\n  (:goal (and\n    {goal_s})))\n")
+            f"  (:init\n    {init_s})\n  (:goal (and\n    {goal_s})){metric})\n")
 
 
 def plan_actions(rules: LiftedRules, steps: Sequence[str]) -> list[int]:

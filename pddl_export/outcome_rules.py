@@ -194,7 +194,7 @@ def _action(a) -> int:
 def load_outcomes(run_dir: Path) -> tuple[OutcomeRules, str]:
     """RUN/pddl/outcomes.json and the model hash recorded with it; one-line ValueError naming the file otherwise."""
     path = Path(run_dir) / PDDL_DIR / OUTCOMES_FILE
-    fix = f"re-run 'symlearn export-pddl --run {run_dir}'"
+    fix = f"re-run 'symlearn export-pddl --run {run_dir} --rules'"
     if not path.exists():
         raise ValueError(f"no exported outcome rules at {path}; {fix}")
     try:

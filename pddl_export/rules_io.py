@@ -120,7 +120,7 @@ def _read_rules_json(path: Path, run_dir: Path) -> dict:
     try:
         d = read_json_file(path, what="rules file", max_bytes=RULES_FILE_BYTES)
     except JsonFileError as e:
-        raise JsonFileError(f"{e}; re-run 'symlearn export-pddl --run {run_dir}'") from None
+        raise JsonFileError(f"{e}; re-run 'symlearn export-pddl --run {run_dir} --rules'") from None
     if not isinstance(d, dict):
         raise ValueError(f"{path}: not a rules file (a JSON {type(d).__name__}, expected an object with "
                          f"'bits', 'vocabulary', 'max_objects' and 'rules')")
@@ -131,7 +131,7 @@ def load_rules(run_dir: Path) -> tuple[RuleSet, str]:
     """RUN/pddl/rules.json and the model hash recorded with it; ValueError (one line, naming the file) if unreadable."""
     path = Path(run_dir) / PDDL_DIR / RULES_FILE
     if not path.exists():
-        raise ValueError(f"no exported rules at {path}; run 'symlearn export-pddl --run {run_dir}' first")
+        raise ValueError(f"no exported rules at {path}; run 'symlearn export-pddl --run {run_dir} --rules' first")
     with paused_gc(freeze=path.stat().st_size >= FREEZE_BYTES):
         d = _read_rules_json(path, run_dir)
         try:

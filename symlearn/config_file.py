@@ -35,9 +35,9 @@ TABLES: Mapping[str, str] = types.MappingProxyType({
     "collect": "symlearn.sim.collect:CollectConfig",
     "train": "symlearn.learning.training:TrainConfig",
     "transition": "symlearn.symbolic.transition_model:TransitionConfig",
-    "export": "symlearn.planning.export:ExportConfig",
-    "lifted": "symlearn.planning.lifted_export:LiftedConfig",
-    "problems": "symlearn.planning.problem_generation:ProblemConfig",
+    "export": "symlearn.export.rules_export:ExportConfig",
+    "lifted": "symlearn.export.lifted_export:LiftedConfig",
+    "problems": "symlearn.problems.problem_generation:ProblemConfig",
     "execution": "symlearn.planning.execution:ExecutionConfig",
 })
 # fields a file may not set: what the command line or the stage itself decides (the preset names the base config)

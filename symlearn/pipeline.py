@@ -43,9 +43,9 @@ from symlearn.provenance import atomic_write_json, sha256_bytes, sha256_file
 if TYPE_CHECKING:  # the configs' modules load torch (and the simulator): imported where a stage is built
     from symlearn.learning.training import TrainConfig
     from symlearn.planning.execution import ExecutionConfig
-    from symlearn.planning.export import ExportConfig
-    from symlearn.planning.lifted_export import LiftedConfig
-    from symlearn.planning.problem_generation import ProblemConfig
+    from symlearn.export.rules_export import ExportConfig
+    from symlearn.export.lifted_export import LiftedConfig
+    from symlearn.problems.problem_generation import ProblemConfig
     from symlearn.sim.collect import CollectConfig
     from symlearn.symbolic.transition_model import TransitionConfig
 
@@ -286,7 +286,7 @@ def _transition_config(s: PipelineSettings) -> TransitionStageConfig:
 
 
 def _export_config(s: PipelineSettings) -> ExportConfig:
-    from symlearn.planning.export import ExportConfig
+    from symlearn.export.rules_export import ExportConfig
 
     from symlearn.config_file import replace_nested
 
@@ -296,7 +296,7 @@ def _export_config(s: PipelineSettings) -> ExportConfig:
 
 
 def _lifted_config(s: PipelineSettings) -> LiftedStageConfig:
-    from symlearn.planning.lifted_export import LiftedConfig
+    from symlearn.export.lifted_export import LiftedConfig
 
     from symlearn.config_file import replace_nested
 
@@ -305,7 +305,7 @@ def _lifted_config(s: PipelineSettings) -> LiftedStageConfig:
 
 
 def _problems_config(s: PipelineSettings) -> ProblemsStageConfig:
-    from symlearn.planning.problem_generation import N_PROBLEMS, ProblemConfig
+    from symlearn.problems.problem_generation import N_PROBLEMS, ProblemConfig
 
     from symlearn.config_file import replace_nested
 
@@ -314,7 +314,7 @@ def _problems_config(s: PipelineSettings) -> ProblemsStageConfig:
 
 
 def _stratified_config(s: PipelineSettings) -> StratifiedStageConfig:
-    from symlearn.planning.stratified import OBJECTS, PER_CELL
+    from symlearn.problems.stratified import OBJECTS, PER_CELL
 
     p = s.preset_values
     return StratifiedStageConfig(n=_first(s.problems, p.problems, PER_CELL), seed=s.seed,
@@ -387,7 +387,7 @@ def _train_transition(out: Path, cfg: TransitionStageConfig, s: PipelineSettings
 
 
 def _export_pddl(out: Path, cfg: ExportConfig, s: PipelineSettings) -> None:
-    from symlearn.planning.export import export_pddl
+    from symlearn.export.rules_export import export_pddl
 
     rep = export_pddl(out / RUN, out / DATA, cfg)
     print(f"vocabulary {rep['vocabulary_size']} codes; {rep['n_rules']} rules over {rep['n_actions_with_rules']} "
@@ -395,7 +395,7 @@ def _export_pddl(out: Path, cfg: ExportConfig, s: PipelineSettings) -> None:
 
 
 def _export_lifted(out: Path, cfg: LiftedStageConfig, s: PipelineSettings) -> None:
-    from symlearn.planning.lifted_export import export_lifted
+    from symlearn.export.lifted_export import export_lifted
 
     rep = export_lifted(out / RUN, out / DATA, tuple(out / d for d in cfg.extra_data), cfg.lifted)
     print(f"kept learned bits {rep['kept_bits']}; {rep['moves']} moves of m(z) on observed scenes -> "
@@ -407,7 +407,7 @@ def _export_lifted(out: Path, cfg: LiftedStageConfig, s: PipelineSettings) -> No
 
 
 def _problems(out: Path, cfg: ProblemsStageConfig, s: PipelineSettings) -> None:
-    from symlearn.planning.problem_generation import generate_problems
+    from symlearn.problems.problem_generation import generate_problems
 
     # a stage runs again only when its config changed, so the old problem set is replaced, never mixed
     paths = generate_problems(out / PROBLEMS, cfg.n, objects=cfg.problem.objects, length=cfg.problem.length,
@@ -416,7 +416,7 @@ def _problems(out: Path, cfg: ProblemsStageConfig, s: PipelineSettings) -> None:
 
 
 def _stratified(out: Path, cfg: StratifiedStageConfig, s: PipelineSettings) -> None:
-    from symlearn.planning.stratified import generate_stratified
+    from symlearn.problems.stratified import generate_stratified
 
     paths, cells = generate_stratified(out / PROBLEMS, cfg.n, objects=cfg.objects, seed=cfg.seed, overwrite=True,
                                        progress=lambda line: print(line, flush=True))

@@ -124,7 +124,7 @@ def test_train_bf16_path(tiny_data, tiny_run, tmp_path):
 
 def test_other_code_length_runs_through_the_pipeline(tiny_data, tmp_path):
     """--bits 4: 4-bit codes from the encoder through m(z) to the exported rules (at most 16 symbols)."""
-    from symlearn.planning.export import training_codes
+    from symlearn.export.rules_export import training_codes
 
     run = tmp_path / "b4"
     bits4 = write_config(tmp_path / "bits4.toml", {"train": {"model": {"bits": 4}}, "export": {"pddl_fidelity_cases": 20}})
@@ -222,7 +222,7 @@ def test_export_pddl_all_scenes(tiny_data, tiny_run, tmp_path):
     assert rep["n_enumerated_scenes"] >= tiny_run.export_report["n_enumerated_scenes"]
     assert rep["fidelity"] == 1.0 and rep["pddl_fidelity"] == 1.0 and rep["pddl_fidelity_cases"] == 20
     # settings left unset keep ExportConfig's defaults; the given ones are recorded
-    from symlearn.planning.export import ExportConfig
+    from symlearn.export.rules_export import ExportConfig
     want = dataclasses.asdict(ExportConfig(scenes="all", max_objects=2, pddl_fidelity_cases=20))
     assert rep["config"] == want
 

@@ -33,6 +33,11 @@ def test_generate_domain_writes_the_runs_lifted_domain_and_problems_a_parser_loa
         problem = parse_problem(folder / f"{name}.pddl")
         assert len(problem.objects) == entry["objects"]
         assert f"{name:<8} {entry['objects']:>7}" in out
+    costed = parse_domain(folder / index["cost_form"])  # the all-outcomes cost form: one action per outcome
+    alternatives = sum(len(r["alternatives"]) for r in json.loads((RECOMMENDED / "pddl" / "lifted.json").read_text())[
+        "rules"])
+    assert n < len(costed.actions) <= n + alternatives and f"{len(costed.actions)} schemas, one per outcome" in out
+    assert len(parse_problem(folder / "costs" / "p01.pddl").objects) == index["problems"]["p01"]["objects"]
     (tmp_path / "lifted_domain" / "notes.txt").write_text("mine")  # a folder holding other files is refused
     r = subprocess.run([sys.executable, str(ROOT / "examples" / "generate_domain.py")], cwd=tmp_path,
                        capture_output=True, text=True, timeout=600)
@@ -44,10 +49,11 @@ def test_call_planners_solves_the_tower_with_every_planner_the_run_supports(tmp_
     rows = {line.split()[0]: line.split() for line in out.splitlines()[4:] if line.strip()}
     # the shipped run has m(z) and the lifted domain, no rules.json: the learned net and stock Fast Downward
     assert set(rows) == {"astar-outcomes", "astar", "astar-likely", "astar-ucs", "fast-downward-lifted",
-                         "fast-downward-lifted-opt"}
+                         "fast-downward-lifted-opt", "fast-downward-lifted-outcomes"}
     for name, cells in rows.items():  # every planner plans it; none in fewer actions than the tower's shortest, 2
         assert cells[1] == "solved" and int(cells[3]) >= 2, (name, cells)
-    for name in ("astar-outcomes", "fast-downward-lifted", "fast-downward-lifted-opt"):  # and these in exactly 2
+    for name in ("astar-outcomes", "fast-downward-lifted", "fast-downward-lifted-opt",
+                 "fast-downward-lifted-outcomes"):  # and these in exactly 2
         assert rows[name][3] == "2", rows[name]
     assert not any((RECOMMENDED / "pddl").glob("problems"))  # nothing written into the shipped run
 

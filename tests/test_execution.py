@@ -24,9 +24,9 @@ from pddl_export.rules import Rule, RuleSet
 from pddl_export.sas_writer import SASEncoder
 from pddl_export.symbolic import SymbolicGoal
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig
-from symlearn.planning.problem import GOAL_TOLERANCE_M, load_problem, load_problems
-from symlearn.planning.problem_generation import generate_problems
-from symlearn.planning.scenes import goal_codes, scene_codes
+from symlearn.problems.problem import GOAL_TOLERANCE_M, load_problem, load_problems
+from symlearn.problems.problem_generation import generate_problems
+from symlearn.symbolic.scenes import goal_codes, scene_codes
 from pddl_export.files import sha256_file
 from symlearn.symbolic.learned_transition import LearnedTransition
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, save_transition
@@ -417,10 +417,11 @@ def test_registry_holds_every_planner_and_is_immutable():
                               "fast-downward-blind", "fast-downward-sas", "fast-downward-sas-opt", "symk-sas",
                               "symk-sas-topk", "fast-downward-sas-ms", "fast-downward-sas-lama",
                               "rules-astar", "rules-bfs", "rules-outcomes", "fast-downward-lifted",
-                              "fast-downward-lifted-opt"]
+                              "fast-downward-lifted-opt", "fast-downward-lifted-outcomes"]
     assert [n for n, s in PLANNERS.items() if not s.needs_rules and not s.needs_lifted] == [
         "astar", "astar-ucs", "astar-likely", "astar-outcomes"]
-    assert [n for n, s in PLANNERS.items() if s.needs_lifted] == ["fast-downward-lifted", "fast-downward-lifted-opt"]
+    assert [n for n, s in PLANNERS.items() if s.needs_lifted] == ["fast-downward-lifted", "fast-downward-lifted-opt",
+                                                                  "fast-downward-lifted-outcomes"]
     assert all(s.name == n and s.description for n, s in PLANNERS.items())
     with pytest.raises(TypeError):
         PLANNERS["mine"] = PLANNERS["astar"]  # type: ignore[index]

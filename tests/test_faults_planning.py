@@ -30,7 +30,7 @@ TIMING_KEYS = {"planning_time_s", "timings", "expansions"}
 @pytest.fixture(scope="module")
 def problems(tmp_path_factory, sim) -> Path:
     """Four problems of 1-2 objects and 1-2 generator actions."""
-    from symlearn.planning.problem_generation import generate_problems
+    from symlearn.problems.problem_generation import generate_problems
 
     out = tmp_path_factory.mktemp("faults") / "p"
     generate_problems(out, 4, objects=(1, 2), length=(1, 2), seed=0, sim=sim)
@@ -72,7 +72,7 @@ BAD_NAMES = ["../../../../escaped", "/tmp/symlearn_abs_escape", "..", ".hidden",
 
 @pytest.mark.parametrize("name", BAD_NAMES)
 def test_unsafe_problem_names_are_refused_at_load(problems, tmp_path, name):
-    from symlearn.planning.problem import load_problem
+    from symlearn.problems.problem import load_problem
 
     d = _problem_json(problems)
     d["name"] = name
@@ -98,7 +98,7 @@ def test_plan_with_traversing_name_writes_nothing_outside_the_run(tiny_run_copy,
 
 @pytest.mark.parametrize("parts", [("..", "x"), ("/etc",), ("a", "..", "..", "b"), (".",), ("link", "x")])
 def test_path_under_refuses_escapes(tmp_path, parts):
-    from symlearn.planning.paths import path_under
+    from symlearn.problems.paths import path_under
 
     base = tmp_path / "base"
     base.mkdir()
@@ -108,14 +108,14 @@ def test_path_under_refuses_escapes(tmp_path, parts):
 
 
 def test_path_under_keeps_inside_paths(tmp_path):
-    from symlearn.planning.paths import path_under
+    from symlearn.problems.paths import path_under
 
     assert path_under(tmp_path, "problem_0000", "problem.pddl") == tmp_path / "problem_0000" / "problem.pddl"
     assert path_under(tmp_path, "a", "..", "b") == tmp_path / "a" / ".." / "b"  # stays inside: allowed
 
 
 def test_problem_constructor_refuses_unsafe_name(problems):
-    from symlearn.planning.problem import Problem, load_problem
+    from symlearn.problems.problem import Problem, load_problem
 
     pr = load_problem(problems / "problem_0000.json")
     with pytest.raises(ValueError, match="is not a safe name"):
@@ -180,7 +180,7 @@ def _contents(d: Path) -> dict[str, str]:
 
 
 def test_problems_into_a_folder_of_other_settings_is_refused(sim, tmp_path):
-    from symlearn.planning.problem_generation import PROBLEMS_MANIFEST, generate_problems
+    from symlearn.problems.problem_generation import PROBLEMS_MANIFEST, generate_problems
 
     out = tmp_path / "p"
     generate_problems(out, 2, objects=(1, 1), length=(1, 1), seed=0, sim=sim)
@@ -200,8 +200,8 @@ def test_problems_into_a_folder_of_other_settings_is_refused(sim, tmp_path):
 
 
 def test_problems_overwrite_clears_the_old_set(sim, tmp_path):
-    from symlearn.planning.problem import load_problems
-    from symlearn.planning.problem_generation import generate_problems
+    from symlearn.problems.problem import load_problems
+    from symlearn.problems.problem_generation import generate_problems
 
     out = tmp_path / "p"
     generate_problems(out, 3, objects=(1, 1), length=(1, 1), seed=0, sim=sim)
@@ -254,7 +254,7 @@ SCENE_FAULTS = {
 @pytest.mark.parametrize("fault", list(SCENE_FAULTS))
 @pytest.mark.parametrize("scene", ["initial", "goal"])
 def test_impossible_scenes_are_refused_at_load(problems, tmp_path, fault, scene):
-    from symlearn.planning.problem import load_problem
+    from symlearn.problems.problem import load_problem
 
     d = copy.deepcopy(_problem_json(problems))
     change, message = SCENE_FAULTS[fault]
@@ -267,7 +267,7 @@ def test_impossible_scenes_are_refused_at_load(problems, tmp_path, fault, scene)
 
 @pytest.mark.parametrize("literal", ["NaN", "Infinity", "-Infinity", "1e999"])
 def test_non_finite_numbers_in_problem_files_are_refused(problems, tmp_path, literal):
-    from symlearn.planning.problem import load_problem
+    from symlearn.problems.problem import load_problem
 
     d = _problem_json(problems)
     text = json.dumps(d).replace(json.dumps(d["initial"]["objects"][0]["position"][0]), literal, 1)
@@ -302,7 +302,7 @@ def test_valid_problem_scenes_pass_the_reach_check(problems):
     """The simulator's generated scenes (initial and goal) pass check_scene, with room to spare: each object rests
     on the table, more than 15 cm inside the reach box's sides. The check is no rubber stamp: the same scenes with
     one object moved 1 um past any edge of the reach box are refused, and 1 um inside it they still pass."""
-    from symlearn.planning.problem import (REACH_CENTER_X, REACH_HALF_X, REACH_HALF_Y, REACH_Z_MAX, check_scene,
+    from symlearn.problems.problem import (REACH_CENTER_X, REACH_HALF_X, REACH_HALF_Y, REACH_Z_MAX, check_scene,
                                            load_problems)
     from symlearn.world import TABLE_TOP_Z
 

@@ -42,7 +42,7 @@ def _one_line_error(capsys, command: str, *words: str) -> str:
 @pytest.fixture(scope="module")
 def problems(tmp_path_factory, sim) -> Path:
     """Two problems of 1 object and 1 generator action."""
-    from symlearn.planning.problem_generation import generate_problems
+    from symlearn.problems.problem_generation import generate_problems
 
     out = tmp_path_factory.mktemp("faults_processes") / "p"
     generate_problems(out, 2, objects=(1, 1), length=(1, 1), seed=0, sim=sim)
@@ -432,7 +432,7 @@ def test_benchmark_out_may_replace_a_benchmark_result(tmp_path):
 
 
 def test_problems_overwrite_refuses_before_deleting_anything(sim, tmp_path, capsys):
-    from symlearn.planning.problem_generation import generate_problems
+    from symlearn.problems.problem_generation import generate_problems
 
     out = tmp_path / "set"
     generate_problems(out, 2, objects=(1, 1), length=(1, 1), seed=0, sim=sim)
@@ -445,7 +445,7 @@ def test_problems_overwrite_refuses_before_deleting_anything(sim, tmp_path, caps
 
 
 def test_a_goal_problem_is_not_written_into_a_generated_set(sim, tmp_path, capsys):
-    from symlearn.planning.problem_generation import generate_problems
+    from symlearn.problems.problem_generation import generate_problems
 
     out = tmp_path / "set"
     generate_problems(out, 2, objects=(1, 1), length=(1, 1), seed=0, sim=sim)
@@ -487,8 +487,8 @@ def test_plan_exits_non_zero_with_the_reason_when_the_planner_cannot_run(tiny_ru
 @pytest.fixture(scope="module")
 def planning_task(tiny_run, problems, sim):
     """(transition, start codes, symbolic goal) of the first problem under the tiny run's networks."""
-    from symlearn.planning.scenes import place_scene, scene_codes, symbolic_goal
-    from symlearn.planning.problem import load_problem
+    from symlearn.symbolic.scenes import place_scene, scene_codes, symbolic_goal
+    from symlearn.problems.problem import load_problem
     from symlearn.symbolic.learned_transition import planning_models
 
     encoder, transition = planning_models(tiny_run.path)

@@ -150,7 +150,7 @@ def _goal(tmp_path: Path, **change) -> Path:
 
 
 def test_goal_version_true_is_not_version_1(tmp_path):
-    from symlearn.planning.goals import load_goal
+    from symlearn.problems.goals import load_goal
 
     assert load_goal(_goal(tmp_path, version=1)).plan  # the file itself is fine
     with pytest.raises(ValueError) as info:
@@ -159,7 +159,7 @@ def test_goal_version_true_is_not_version_1(tmp_path):
 
 
 def test_goal_reference_plan_has_a_length_cap(tmp_path):
-    from symlearn.planning.goals import MAX_PLAN_STEPS, load_goal
+    from symlearn.problems.goals import MAX_PLAN_STEPS, load_goal
 
     plan = [[4, 1], [1, 4]] * (MAX_PLAN_STEPS // 2)
     assert len(load_goal(_goal(tmp_path, reference_plan=plan)).plan) == MAX_PLAN_STEPS
@@ -174,7 +174,7 @@ def test_goal_reference_plan_has_a_length_cap(tmp_path):
     ('{"format": "symlearn-goal", "version": 1, "seed": ' + "7" * 400 + "}", ["field seed", "outside 64 bits"]),
 ])
 def test_goal_deep_or_huge_values_are_refused_naming_the_file(tmp_path, text, words):
-    from symlearn.planning.goals import load_goal
+    from symlearn.problems.goals import load_goal
 
     path = tmp_path / "g.json"
     path.write_text(text)
@@ -207,8 +207,8 @@ def _refusal(loader, path) -> str:
 
 def test_goal_and_problem_files_that_are_fifos_do_not_hang(tmp_path):
     """A FIFO named *.json: refused at once."""
-    from symlearn.planning.goals import load_goal
-    from symlearn.planning.problem import load_problem
+    from symlearn.problems.goals import load_goal
+    from symlearn.problems.problem import load_problem
 
     for loader in (load_goal, load_problem):
         fifo = tmp_path / f"{loader.__name__}.json"
@@ -238,7 +238,7 @@ def test_plan_problem_dev_zero_is_refused_at_once(tmp_path):
     ({"task": "t" * 20_000}, ["task must be"]),
 ])
 def test_problem_files_have_typed_bounded_fields(tmp_path, change, words):
-    from symlearn.planning.problem import load_problem
+    from symlearn.problems.problem import load_problem
 
     path = tmp_path / "p.json"
     path.write_text(json.dumps({**json.loads(PROBLEM.read_text()), **change}))
@@ -596,9 +596,9 @@ def _open_row_log(path: Path) -> None:
 
 READERS = {  # kind -> (a valid document, where it is written under tmp, the loader given that path)
     "goal": (lambda: json.loads(GOAL.read_text()), "g.json",
-             lambda p: __import__("symlearn.planning.goals", fromlist=["x"]).load_goal(p)),
+             lambda p: __import__("symlearn.problems.goals", fromlist=["x"]).load_goal(p)),
     "problem": (lambda: json.loads(PROBLEM.read_text()), "p.json",
-                lambda p: __import__("symlearn.planning.problem", fromlist=["x"]).load_problem(p)),
+                lambda p: __import__("symlearn.problems.problem", fromlist=["x"]).load_problem(p)),
     "rules": (lambda: _small_rules("rules.json"), "run/pddl/rules.json", _load_rules_kind("rules.json")),
     "outcomes": (lambda: _small_rules("outcomes.json"), "run/pddl/outcomes.json", _load_rules_kind("outcomes.json")),
     "pipeline": (lambda: {"kind": "symlearn-pipeline", "out": "x", "preset": "quick", "stages": {

@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 
 from conftest import cli
-from symlearn.planning.goal_problems import goal_file_problem, goal_problem
-from symlearn.planning.goals import Goal, ObjectGoal, arrangement_errors, drop_order, load_goal, parse_goal, save_goal
-from symlearn.planning.problem import load_problem, load_problems
-from symlearn.planning.scenes import max_goal_distance
-from symlearn.planning.stacking import run_script
-from symlearn.planning.structure_suite import fitting_templates
-from symlearn.planning.structures import TEMPLATES, structure_goal
+from symlearn.problems.goal_problems import goal_file_problem, goal_problem
+from symlearn.problems.goals import Goal, ObjectGoal, arrangement_errors, drop_order, load_goal, parse_goal, save_goal
+from symlearn.problems.problem import load_problem, load_problems
+from symlearn.problems.problem import max_goal_distance
+from symlearn.problems.stacking import run_script
+from symlearn.problems.structure_suite import fitting_templates
+from symlearn.problems.structures import TEMPLATES, structure_goal
 from symlearn.world import LOCATIONS, ObjectType, decode_action
 
 ROOT = Path(__file__).resolve().parents[1]

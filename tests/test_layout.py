@@ -168,7 +168,8 @@ def test_import_graph_parser_sees_real_imports():
 
 # The layers, lowest first: a module may import from its own layer and from lower ones, never from a higher one.
 # pddl_export and search are the plain-Python layers under symlearn. Inside symlearn, the stage packages come in
-# the order their outputs flow (sim -> data -> learning -> symbolic -> planning -> report), then the pipeline,
+# the order their outputs flow (sim -> data -> problems -> learning -> symbolic -> export -> planning -> report;
+# problems are drawn in the simulator and read by everything that plans or scores plans), then the pipeline,
 # which runs every stage, then the command line, which is the front end of all of them. The top-level modules of
 # symlearn/ are placed by name: the shared helpers every stage uses (plain world data, provenance and atomic
 # writes, folder locks, output-path checks, the optional Ray engine, the settings-file reader, which names the stages'
@@ -182,8 +183,10 @@ LAYERS: tuple[tuple[str, frozenset[str]], ...] = (  # (layer, its modules: "pkg.
                                     "symlearn.outputs", "symlearn.cluster", "symlearn.config_file"})),
     ("sim", frozenset({"symlearn.sim.*"})),
     ("data", frozenset({"symlearn.data.*"})),
+    ("problems", frozenset({"symlearn.problems.*"})),
     ("learning", frozenset({"symlearn.learning.*"})),
     ("symbolic", frozenset({"symlearn.symbolic.*"})),
+    ("export", frozenset({"symlearn.export.*"})),
     ("planning", frozenset({"symlearn.planning.*"})),
     ("report", frozenset({"symlearn.report.*"})),
     ("pipeline", frozenset({"symlearn.pipeline"})),

@@ -1,6 +1,6 @@
 """The lifted domain: located codes read as pieces, rules distilled from moves, and the PDDL that states them.
 
-The world here is the simulator's own symbolic model (symlearn.planning.stacking) written as located codes the way
+The world here is the simulator's own symbolic model (symlearn.problems.stacking) written as located codes the way
 the encoder and location bits give them: eight learned bits of which five repeat the location (as the trained
 encoders' do, from the crops' image x and y), one says cube, one says "on the table", then location, place and
 level. Rules distilled from its moves must reproduce held-out moves exactly, and the PDDL must do what the rules do.
@@ -18,7 +18,7 @@ from pddl_export.lifted_rules import REFINEMENTS, LiftedRules, distil_lifted, ke
 from pddl_export.lifted_scene import CodeLayout, Piece, kept_bits, read_scene
 from pddl_export.lifted_writer import domain_pddl, object_name, plan_actions, problem_pddl
 from pddl_export.symbolic import SymbolicGoal
-from symlearn.planning.stacking import act, drop_all
+from symlearn.problems.stacking import act, drop_all
 from symlearn.world import ObjectType
 
 LOC_PATTERN = (0b10101, 0b01101, 0b11011, 0b00110, 0b10010, 0b01001)  # five learned bits that track the location
@@ -222,7 +222,7 @@ def test_export_lifted_and_plan_with_stock_fast_downward_on_a_tiny_run(tiny_run_
 
     from conftest import cli, write_config
     from symlearn.data.dataset import load_split
-    from symlearn.planning.export import training_codes
+    from symlearn.export.rules_export import training_codes
     from symlearn.planning.planners import PlannerContext, make_planner
     from symlearn.symbolic.learned_transition import planning_models
 
@@ -253,6 +253,20 @@ def test_export_lifted_and_plan_with_stock_fast_downward_on_a_tiny_run(tiny_run_
     (tmp_path / "plan.txt").write_text("".join(f"{s}\n" for s in res.steps))
     verdict = pyval.PDDLValidator().validate(str(tmp_path / "tasks" / "domain.pddl"),
                                              str(tmp_path / "tasks" / "problem.pddl"), str(tmp_path / "plan.txt"))
+    assert verdict.status == "VALID"
+    # the all-outcomes cost form of the same export: its files, stock Fast Downward's plan, pyval's verdict
+    planner = make_planner("fast-downward-lifted-outcomes", PlannerContext.for_run(
+        run, ["fast-downward-lifted-outcomes"], write_dir=tmp_path / "cost_tasks"))
+    res = planner(None, np.asarray(start), SymbolicGoal(tuple(want)), 60.0)
+    assert res.found and len(res.plan) <= 1, res.message
+    assert fields(res.predicted_states[-1]) == fields(want)
+    domain = (tmp_path / "cost_tasks" / "domain.pddl").read_text()
+    assert ":action-costs" in domain and "(:metric minimize (total-cost))" in (
+        tmp_path / "cost_tasks" / "problem.pddl").read_text()
+    (tmp_path / "cost_plan.txt").write_text("".join(f"{s}\n" for s in res.steps))
+    verdict = pyval.PDDLValidator().validate(str(tmp_path / "cost_tasks" / "domain.pddl"),
+                                             str(tmp_path / "cost_tasks" / "problem.pddl"),
+                                             str(tmp_path / "cost_plan.txt"))
     assert verdict.status == "VALID"
 
 
@@ -295,3 +309,68 @@ def test_moves_that_carry_riders_need_fewer_answers_than_others():
     assert not riders(distil_lifted(layout, stick_of, moves, min_count=high))
     kept = distil_lifted(layout, stick_of, moves, min_count=high, rider_min_count=1)
     assert riders(kept) and all(len(r.outcome) > 3 or r.support >= high for r in kept.rules)
+
+
+def test_a_rule_keeps_its_outcome_share_and_the_cost_form_plans_on_its_alternatives(tmp_path):
+    """A description m(z) answered two ways (7 and 3 times): one rule with share 0.7 and the other answer as its
+    alternative. The deterministic domain states the rule's own outcome; the cost form one action per outcome,
+    costing 10 (1 - ln share), so stock Fast Downward (A* with LM-cut) takes the cheaper one where both reach the
+    goal and the alternative where only it does; the planner's predictions follow the outcome each step chose."""
+    import dataclasses
+
+    import pyval
+
+    from pddl_export.lifted_writer import outcome_cost, step_decoder
+    from search.stock_planners import solve_texts
+    from symlearn.planning.lifted_planner import LiftedPlanner
+    before, actions, after, mask, stick = _arrays(world_moves(300, seed=0))
+    objs = before[mask]
+    layout = CodeLayout(8, kept_bits((objs[:, None] >> (9 + np.arange(7, -1, -1))) & 1, (objs >> 6) & 7))
+    stick_of = stick_reader(before, mask, stick, layout)
+    plain = LiftedRules(layout, stick_of)
+    for i in range(len(actions)):  # the first move of a lone cube onto the table: no riders, nothing under it
+        one, _ = observed_moves(plain, before[i:i + 1], after[i:i + 1], actions[i:i + 1], mask[i:i + 1])
+        if one and len(one[0][1]) == 3 and one[0][0]["cls"] == "cube" and one[0][1][0][2] == 2:
+            break
+    sig, out = one[0]
+    higher = ((out[0][0], out[0][1], out[0][2] + 1, out[0][3]), *out[1:])  # the cube ends one level higher
+    rules = distil_lifted(layout, stick_of, [(sig, out)] * 7 + [(sig, higher)] * 3, min_count=3, model_hash="ab" * 8)
+    assert len(rules.rules) == 1
+    rule = rules.rules[0]
+    assert (rule.outcome, rule.share, rule.alternatives) == (out, 0.7, ((higher, 0.3),))
+    (tmp_path / "lifted.json").write_text(__import__("json").dumps(rules.to_json()))
+    assert load_lifted(tmp_path / "lifted.json").rules == rules.rules  # shares and alternatives round-trip
+
+    start, action = [int(c) for c in before[i][mask[i]]], int(actions[i])
+    own, _ = rules.step_codes(start, action)
+    alt, _ = rules.step_codes(start, action, alternative=1)
+    moved = [j for j in range(len(start)) if own[j] != start[j]]
+    assert [rules.pieces(alt)[j].level for j in moved] == [rules.pieces(own)[j].level + 1 for j in moved]
+    with pytest.raises(ValueError, match="has 1 alternatives, not 2"):
+        rules.step_codes(start, action, alternative=2)
+
+    deterministic, costed = domain_pddl(rules), domain_pddl(rules, costs=True)
+    assert deterministic.count("(:action") == 1 and "total-cost" not in deterministic
+    assert costed.count("(:action") == 2 and ":action-costs" in costed
+    assert (outcome_cost(0.7), outcome_cost(0.3), outcome_cost(1.0)) == (14, 22, 10)
+    assert "(increase (total-cost) 14)" in costed and "(increase (total-cost) 22)" in costed
+    with pytest.raises(ValueError, match="must lie in"):
+        outcome_cost(0.0)
+    decode = step_decoder(rules, costs=True)
+    for target, alternative in ((own, 0), (alt, 1)):
+        goal = SymbolicGoal(tuple(c if j in moved else None for j, c in enumerate(target)))
+        problem = problem_pddl(rules, start, goal, "p", costs=True)
+        assert "(:metric minimize (total-cost))" in problem
+        res = solve_texts(costed, problem, "fd-lmcut", 60, action_id=lambda s: decode(s)[0])
+        assert res.found and [decode(s) for s in res.steps] == [(action, alternative)], res.message
+        (tmp_path / "d.pddl").write_text(costed)
+        (tmp_path / "p.pddl").write_text(problem)
+        (tmp_path / "plan.txt").write_text("".join(f"{s}\n" for s in res.steps))
+        assert pyval.PDDLValidator().validate(str(tmp_path / "d.pddl"), str(tmp_path / "p.pddl"),
+                                              str(tmp_path / "plan.txt")).status == "VALID"
+        planned = LiftedPlanner(rules, "fast-downward-lifted-outcomes", "fd-lmcut", costs=True)(None, np.asarray(start),
+                                                                                                  goal, 60.0)
+        assert planned.found and planned.predicted_states[-1] == tuple(
+            g if g is not None else c for c, g in zip(target, goal.codes))
+    only_own = dataclasses.replace(rule, alternatives=())
+    assert domain_pddl(dataclasses.replace(rules, rules=(only_own,)), costs=True).count("(:action") == 1

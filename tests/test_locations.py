@@ -83,7 +83,7 @@ def test_crop_tops_tell_a_stack_apart(sim):
 def test_train_transition_with_location_bits_plans_on_13_bit_codes(tiny_run, tiny_run_copy, sim, tmp_path):
     """location_bits = 5: m(z) on 13-bit codes whose last 5 bits are read from geometry, through export and planning."""
     from symlearn.learning.models import AttentiveDeepSym
-    from symlearn.planning.scenes import scene_codes
+    from symlearn.symbolic.scenes import scene_codes
     from symlearn.symbolic.learned_transition import LearnedTransition, planning_models
     from symlearn.symbolic.transition_data import SymbolReader
 

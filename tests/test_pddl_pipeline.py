@@ -12,7 +12,7 @@ from pddl_export.pddl_writer import action_name, code_from_predicate, conditiona
 from pddl_export.rules_io import load_rules, rules_from_json, rules_to_json
 from pddl_export.symbolic import N_ACTIONS
 from search.result import PlanResult, PlanStatus
-from symlearn.planning.export import ExportConfig, export_pddl
+from symlearn.export.rules_export import ExportConfig, export_pddl
 from symlearn.planning.planners import make_pddl_planner, network_agrees
 from symlearn.symbolic.learned_transition import LearnedTransition
 
@@ -66,7 +66,7 @@ def test_export_writes_domain_rules_and_exact_report(run):
 
 
 def test_observed_scenes_take_sub_scenes_of_larger_scenes_on_request():
-    from symlearn.planning.export import observed_scenes
+    from symlearn.export.rules_export import observed_scenes
 
     codes = np.array([[1, 2, 3, 4], [1, 1, -1, -1], [1, 4, -1, -1]])  # 4 lies outside the vocabulary
     assert observed_scenes({1, 2, 3}, 2, codes) == [(1,), (1, 1)]
@@ -75,7 +75,7 @@ def test_observed_scenes_take_sub_scenes_of_larger_scenes_on_request():
 
 def test_export_with_extra_data_and_larger_scenes(run, tiny_k45, tmp_path):
     from symlearn.data.dataset import data_fingerprint
-    from symlearn.planning.export import code_counts, observed_scenes, training_codes
+    from symlearn.export.rules_export import code_counts, observed_scenes, training_codes
 
     cfg = ExportConfig(max_objects=2, pddl_fidelity_cases=0, larger_scenes=True)
     rep = export_pddl(run / "run", run / "data", cfg, tmp_path / "pddl", extra_data=(tiny_k45,))
@@ -112,7 +112,7 @@ def _one_step_task(run: Path, rules) -> tuple[np.ndarray, int, np.ndarray]:
     is provably reachable, and every planner must return a plan.
     """
     from pddl_export.rules import apply_rules
-    from symlearn.planning.export import observed_scenes, training_codes
+    from symlearn.export.rules_export import observed_scenes, training_codes
 
     assert rules.n_rules >= 1, "the tiny run exported no rule: nothing to plan on"
     scenes = observed_scenes(set(rules.vocabulary), rules.max_objects, *training_codes(run / "run", run / "data"))
@@ -205,7 +205,7 @@ def test_export_writes_second_outcomes_and_rules_outcomes_plans_on_them(run):
     assert rep["outcomes"]["n_rules"] == outcomes.rules.n_rules and rep["outcomes"]["min_ratio"] == 0.05
     tr = LearnedTransition.from_run(run / "run")
     second = SecondOutcome(tr, 0.05)
-    from symlearn.planning.export import observed_scenes, training_codes
+    from symlearn.export.rules_export import observed_scenes, training_codes
 
     scenes = [s for s in observed_scenes(set(rules.vocabulary), 2, *training_codes(run / "run", run / "data"))
               if len(s) == 1]

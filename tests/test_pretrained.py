@@ -16,7 +16,7 @@ from pddl_export.rules_io import load_rules
 
 if TYPE_CHECKING:
     from symlearn.planning.execution import ProblemRun
-    from symlearn.planning.problem import Problem
+    from symlearn.problems.problem import Problem
     from symlearn.world import Scene
 
 PRETRAINED = Path(__file__).resolve().parents[1] / "pretrained" / "quick-authors12k"
@@ -40,8 +40,8 @@ def _plan_and_execute(sim, tmp_path: Path, run: Path, problem_path: Path, planne
     task files under it): plan, execute in the session's simulator, and read back the executed scene and codes."""
     from symlearn.planning.execution import ExecutionConfig, run_problem
     from symlearn.planning.planners import make_planners
-    from symlearn.planning.problem import load_problem
-    from symlearn.planning.scenes import scene_codes
+    from symlearn.problems.problem import load_problem
+    from symlearn.symbolic.scenes import scene_codes
     from symlearn.symbolic.learned_transition import planning_models
     from symlearn.symbolic.transition_data import encode_observation
 
@@ -59,7 +59,7 @@ def _plan_and_execute(sim, tmp_path: Path, run: Path, problem_path: Path, planne
 def _assert_goal_reached(ex: Executed) -> None:
     """The row says success, and the executed scene shows it: every judged object within the 2 cm tolerance of its
     goal position (the largest distance is the row's), and the executed scene's codes are the goal scene's."""
-    from symlearn.planning.problem import GOAL_TOLERANCE_M
+    from symlearn.problems.problem import GOAL_TOLERANCE_M
 
     row, problem = ex.row, ex.problem
     assert row.found and row.status == "solved" and row.success and row.symbolic_match, row

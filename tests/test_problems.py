@@ -8,10 +8,10 @@ import re
 import numpy as np
 import pytest
 
-from symlearn.planning.problem import GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems, save_problem
-from symlearn.planning.problem_generation import MAX_ACTION_DRAWS, ProblemConfig, _changing_action, generate_problems
+from symlearn.problems.problem import GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems, save_problem
+from symlearn.problems.problem_generation import MAX_ACTION_DRAWS, ProblemConfig, _changing_action, generate_problems
 from symlearn.sim.exploration import ExplorationConfig
-from symlearn.planning.scenes import max_goal_distance
+from symlearn.problems.problem import max_goal_distance
 from symlearn.world import N_LOCATIONS, ObjectType, Scene, decode_action
 
 
@@ -198,7 +198,7 @@ def test_problem_validation_fails_on_purpose(problem_dir):
 
 
 def test_goal_off_locations_counts_judged_objects_away_from_every_location():
-    from symlearn.planning.problem import ON_LOCATION_M
+    from symlearn.problems.problem import ON_LOCATION_M
     from symlearn.world import LOCATIONS, ObjectState
 
     def problem(dy: float, free: tuple[int, ...] = ()) -> Problem:

@@ -112,7 +112,7 @@ def _without_timings(result: dict) -> dict:
 
 @pytest.fixture(scope="module")
 def two_problems(tmp_path_factory, sim):
-    from symlearn.planning.problem_generation import generate_problems
+    from symlearn.problems.problem_generation import generate_problems
 
     out = tmp_path_factory.mktemp("ray_problems")
     generate_problems(out, 2, objects=(1, 2), length=(1, 2), seed=11, sim=sim)

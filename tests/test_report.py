@@ -226,7 +226,7 @@ def test_recorded_gif_has_one_frame_per_action_plus_start(sim, tiny_run, actions
     from search.result import PlanResult, PlanStatus
     from symlearn.learning.checkpoint import load_effect_model
     from symlearn.planning.execution import execute_plan
-    from symlearn.planning.problem import Problem
+    from symlearn.problems.problem import Problem
     from symlearn.planning.recording import PlanRecorder, location_pixels
     from symlearn.world import ObjectState, ObjectType, Scene
 

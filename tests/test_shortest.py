@@ -9,13 +9,13 @@ from pathlib import Path
 
 import pytest
 
-from symlearn.planning.goals import ObjectGoal
-from symlearn.planning.problem import PROBLEM_VERSION, Problem, load_problem, load_problems, save_problem
-from symlearn.planning.problem_generation import add_shortest_plans, generate_problems
-from symlearn.planning.scenes import max_goal_distance
-from symlearn.planning.shortest import (NotCovered, scene_state, shortest_plan, state_scene, with_shortest)
-from symlearn.planning.stacking import act, check_state, drop_all, levels, successors
-from symlearn.planning.stratified import MODEL_MAX_LENGTH, same_problem
+from symlearn.problems.goals import ObjectGoal
+from symlearn.problems.problem import PROBLEM_VERSION, Problem, load_problem, load_problems, save_problem
+from symlearn.problems.problem_generation import add_shortest_plans, generate_problems
+from symlearn.problems.problem import max_goal_distance
+from symlearn.problems.shortest import (NotCovered, scene_state, shortest_plan, state_scene, with_shortest)
+from symlearn.problems.stacking import act, check_state, drop_all, levels, successors
+from symlearn.problems.stratified import MODEL_MAX_LENGTH, same_problem
 from symlearn.world import ObjectState, ObjectType, Scene, action_id, decode_action
 
 C, S = ObjectType.CUBE, ObjectType.STICK
@@ -204,7 +204,7 @@ def test_annotate_adds_shortest_plans_to_an_older_set_and_resumes(tmp_path):
     assert json.loads((tmp_path / "problems.manifest").read_text())["problem_version"] == PROBLEM_VERSION
     before = (tmp_path / "problem_0000.json").stat().st_mtime_ns
     # a set of the older version is completed only once annotated: its command says how
-    from symlearn.planning.problem_generation import prepare_problem_dir
+    from symlearn.problems.problem_generation import prepare_problem_dir
     old = tmp_path / "old"
     old.mkdir()
     (old / "problem_0000.json").write_text(json.dumps(d))
@@ -223,7 +223,7 @@ def test_annotate_adds_shortest_plans_to_an_older_set_and_resumes(tmp_path):
 def test_shortest_plans_reach_their_goals_in_the_simulator(tmp_path, sim):
     """The model against the simulator: the plans it finds for small walks and structure tasks, executed there,
     end within 2 cm of the goal on every judged object, and are never longer than the reference plan."""
-    from symlearn.planning.structure_suite import generate_structures
+    from symlearn.problems.structure_suite import generate_structures
 
     paths = generate_problems(tmp_path / "walks", 4, objects=(1, 3), length=(2, 5), seed=11, sim=sim)
     paths += generate_structures(tmp_path / "tasks", 3, objects=(2, 3), seed=2, sim=sim)

@@ -135,9 +135,9 @@ def cmd_symbols(args: argparse.Namespace) -> int:
 
 def cmd_export_lifted(args: argparse.Namespace) -> int:
     from symlearn.config_file import replace_nested
-    from symlearn.planning.lifted_export import (LIFTED_DIR, LIFTED_FILE, MAX_DATA_OBJECTS, LiftedConfig,
+    from symlearn.export.lifted_export import (LIFTED_DIR, LIFTED_FILE, MAX_DATA_OBJECTS, LiftedConfig,
                                                  export_lifted, write_problem_folder)
-    from symlearn.planning.problem import load_problems
+    from symlearn.problems.problem import load_problems
 
     cfg = replace_nested(LiftedConfig(), read_config_file(args.config).get("lifted", {}))  # [lifted]
     for d in args.problems or []:
@@ -167,7 +167,7 @@ def cmd_export_lifted(args: argparse.Namespace) -> int:
 
 def cmd_export_pddl(args: argparse.Namespace) -> int:
     from symlearn.config_file import replace_nested
-    from symlearn.planning.export import ExportConfig, export_pddl
+    from symlearn.export.rules_export import ExportConfig, export_pddl
 
     if not args.rules:
         return cmd_export_lifted(args)

@@ -110,7 +110,7 @@ def cmd_problems(args: argparse.Namespace) -> int:
 
 def _cmd_walks(args: argparse.Namespace, reference: bool, on_locations: bool) -> int:
     """`problems --kind walks|located-walks|reference`: random-walk problems."""
-    from symlearn.planning.problem_generation import N_PROBLEMS, generate_problems
+    from symlearn.problems.problem_generation import N_PROBLEMS, generate_problems
 
     n, objects = args.n or N_PROBLEMS, args.objects or (1, 3)
     length, seed = args.length or (1, 4), args.seed or 0
@@ -127,7 +127,7 @@ def _cmd_walks(args: argparse.Namespace, reference: bool, on_locations: bool) ->
 def _cmd_stratified(args: argparse.Namespace) -> int:
     """`problems` (--kind stratified): --n problems per cell of objects x shortest-plan length, and per
     off-location cell."""
-    from symlearn.planning.stratified import OBJECTS, PER_CELL, generate_stratified
+    from symlearn.problems.stratified import OBJECTS, PER_CELL, generate_stratified
 
     n, objects, seed = args.n or PER_CELL, args.objects or OBJECTS, args.seed or 0
     exclude = tuple(Path(x) for x in (args.exclude or "").split(",") if x.strip())
@@ -145,7 +145,7 @@ def _cmd_stratified(args: argparse.Namespace) -> int:
 
 def _cmd_annotate(args: argparse.Namespace) -> int:
     """`problems --kind annotate --out DIR`: record the shortest plan in every problem file of DIR that lacks it."""
-    from symlearn.planning.problem_generation import add_shortest_plans
+    from symlearn.problems.problem_generation import add_shortest_plans
 
     counts = add_shortest_plans(Path(args.out))
     print(f"{args.out}: {counts['annotated']} problems annotated, {counts['kept']} already were; shortest plans "
@@ -155,7 +155,7 @@ def _cmd_annotate(args: argparse.Namespace) -> int:
 
 def _cmd_structure_problems(args: argparse.Namespace) -> int:
     """`problems --kind structures` (named tasks) or `problems GOAL.json ...` (one problem per goal file)."""
-    from symlearn.planning.structure_suite import generate_structures, write_goal_problem
+    from symlearn.problems.structure_suite import generate_structures, write_goal_problem
 
     if args.goals:
         for goal in args.goals:

@@ -33,7 +33,7 @@ from pddl_export.rules_io import PDDL_DIR, RULES_FILE
 from search.processes import PlannerInterrupted
 from symlearn.planning.execution import ExecutionConfig, ProblemRun, failure_causes, run_problem
 from symlearn.planning.planners import RISK_PLANNERS, make_planners
-from symlearn.planning.problem import RANDOM_WALK, Problem, load_problems
+from symlearn.problems.problem import RANDOM_WALK, Problem, load_problems
 from symlearn.folder_lock import locked
 from symlearn.planning.recording import PlanRecorder
 from symlearn.provenance import atomic_write_json, atomic_write_text, sha256_bytes, sha256_file, versions
@@ -353,7 +353,7 @@ def _settings(run_dir: Path, sets: list[Path], problems: list[SetProblem], plann
     if any(p in RISK_PLANNERS for p in planners):  # only then does the weight change a result
         out["risk_weight"] = risk_weight
     if any(planner_spec(n).needs_lifted for n in planners):  # a re-export changes what they plan on
-        from symlearn.planning.lifted_export import LIFTED_FILE
+        from symlearn.export.lifted_export import LIFTED_FILE
         out["lifted_sha256"] = sha256_file(run_dir / PDDL_DIR / LIFTED_FILE)[:16]
     return out
 

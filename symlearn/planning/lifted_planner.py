@@ -7,6 +7,9 @@ rules rolled along the plan (pddl_export.lifted_rules.LiftedRules.step_codes), s
 departures as it does for the other planners; where an object's predicted fields are its goal's, its predicted
 code is the goal's code.
 
+With `costs`, the planner reads the domain's cost form (pddl_export.lifted_writer: one action per outcome of each
+rule, costing by how often m(z) answered it) and its predictions follow the outcome each step of the plan chose.
+
     >>> plan = LiftedPlanner(load_lifted(run / "pddl/lifted.json"), "fast-downward-lifted", "fd-lama-first")  # doctest: +SKIP
 """
 from __future__ import annotations
@@ -19,11 +22,11 @@ import numpy as np
 
 from pddl_export.files import atomic_write_text
 from pddl_export.lifted_rules import LiftedRules, LiftedTransition
-from pddl_export.lifted_writer import action_decoder, domain_pddl, problem_pddl
+from pddl_export.lifted_writer import domain_pddl, problem_pddl, step_decoder
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
 from search.result import PlanResult, PlanStatus, failed
 from search.stock_planners import solve_texts
-from symlearn.planning.paths import path_under
+from symlearn.problems.paths import path_under
 
 
 def _fields(rules: LiftedRules, code: int, stick: bool) -> tuple:
@@ -34,10 +37,12 @@ def _fields(rules: LiftedRules, code: int, stick: bool) -> tuple:
 class LiftedPlanner:
     """A stock planner (search.stock_planners name, e.g. fd-lama-first) on the lifted domain of a run."""
 
-    def __init__(self, rules: LiftedRules, name: str, engine: str, write_dir: Path | None = None) -> None:
-        self.lifted, self.name, self.engine = rules, name, engine
-        self.domain = domain_pddl(rules)
-        self.action_id = action_decoder(rules)
+    def __init__(self, rules: LiftedRules, name: str, engine: str, write_dir: Path | None = None,
+                 costs: bool = False) -> None:
+        self.lifted, self.name, self.engine, self.costs = rules, name, engine, costs
+        self.domain = domain_pddl(rules, costs)
+        self.decode = step_decoder(rules, costs)
+        self.action_id = lambda step: self.decode(step)[0]
         self.write_dir = None if write_dir is None else Path(write_dir)
         self.calls = 0
 
@@ -45,12 +50,14 @@ class LiftedPlanner:
         """What this planner predicts a step does: the lifted rules."""
         return LiftedTransition(self.lifted)
 
-    def predictions(self, start: list[int], plan: list[int], goal: SymbolicGoal) -> tuple[tuple[int, ...], ...]:
-        """The lifted rules' states along a plan; an object whose fields are its goal's gets its goal code."""
+    def predictions(self, start: list[int], plan: list[int], goal: SymbolicGoal,
+                    alternatives: list[int] | None = None) -> tuple[tuple[int, ...], ...]:
+        """The lifted rules' states along a plan (each step with the outcome it chose, its rule's own by default);
+        an object whose fields are its goal's gets its goal code."""
         sticks = [p.stick for p in self.lifted.pieces(start)]
         states, codes = [tuple(start)], tuple(start)
-        for a in plan:
-            codes = self.lifted.step_codes(codes, a)[0]
+        for a, alt in zip(plan, alternatives or [0] * len(plan)):
+            codes = self.lifted.step_codes(codes, a, alt)[0]
             states.append(codes)
         def at_goal(state):
             return tuple(g if g is not None and _fields(self.lifted, c, s) == _fields(self.lifted, g, s) else c
@@ -61,7 +68,7 @@ class LiftedPlanner:
         t0 = time.perf_counter()
         init = [int(c) for c in start]
         try:
-            problem = problem_pddl(self.lifted, init, goal, "task")
+            problem = problem_pddl(self.lifted, init, goal, "task", self.costs)
         except ValueError as e:
             return failed(self.name, PlanStatus.ERROR, t0, str(e))
         self._save(problem)
@@ -69,7 +76,8 @@ class LiftedPlanner:
         res = solve_texts(self.domain, problem, self.engine, max(timeout_s - write_s, 0.001),
                           action_id=self.action_id)
         extra = dict(res.extra, pddl_write_time_s=round(write_s, 5))
-        predicted = self.predictions(init, list(res.plan), goal) if res.found else ()
+        alternatives = [self.decode(step)[1] for step in res.steps] if res.found else None
+        predicted = self.predictions(init, list(res.plan), goal, alternatives) if res.found else ()
         return dataclasses.replace(res, planner=self.name, predicted_states=predicted,
                                    planning_time_s=write_s + res.planning_time_s, extra=extra)
 

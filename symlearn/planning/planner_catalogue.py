@@ -35,16 +35,18 @@ DESCRIPTIONS: Mapping[str, str] = MappingProxyType({
                       "determinization), a deviation costing 1 - w log of its odds",
     "fast-downward-lifted": "stock Fast Downward (its translator, LAMA's first iteration) on the lifted domain",
     "fast-downward-lifted-opt": "stock Fast Downward, optimal A* with LM-cut, on the lifted domain",
+    "fast-downward-lifted-outcomes": "stock Fast Downward, A* with LM-cut, on the lifted domain's all-outcomes cost "
+                                     "form: each outcome of a rule an action costing by how often m(z) answered it",
 })
 
 # (family, its planners, what it searches and when to use it)
 FAMILIES: tuple[tuple[str, tuple[str, ...], str], ...] = (
     ("learned net", ("astar-outcomes", "astar", "astar-likely", "astar-ucs"),
      "search m(z) itself; astar-outcomes (its likely outcomes) plans best, on any run"),
-    ("lifted PDDL", ("fast-downward-lifted", "fast-downward-lifted-opt"),
-     "the stock fast-downward.py on the lifted domain (export-pddl --lifted; m(z) with 9 location bits)"),
+    ("lifted PDDL", ("fast-downward-lifted", "fast-downward-lifted-opt", "fast-downward-lifted-outcomes"),
+     "the stock fast-downward.py on the lifted domain (export-pddl; m(z) with 9 location bits)"),
     ("rules in process", ("rules-outcomes", "rules-bfs", "rules-astar"),
-     "search the exported rules (export-pddl) in this process; rules-bfs proves unreachable goals"),
+     "search the exported rules (export-pddl --rules) in this process; rules-bfs proves unreachable goals"),
     ("SAS+ on the rules", ("fast-downward-sas", "fast-downward-sas-opt", "fast-downward-sas-ms",
                            "fast-downward-sas-lama", "symk-sas", "symk-sas-topk"),
      "Fast Downward's or SymK's search on a SAS+ task written from the rules, no translator"),

@@ -55,7 +55,7 @@ from search.rules_search import plan_rules
 from search.sas_planners import solve_sas
 from search.up_problem import strips_problem
 from symlearn.planning.execution import PlannerFn
-from symlearn.planning.paths import path_under
+from symlearn.problems.paths import path_under
 from symlearn.planning.planner_catalogue import DESCRIPTIONS
 from symlearn.planning.recovery import roll
 
@@ -91,18 +91,18 @@ class PlannerContext:
             outcomes, outcomes_hash = load_outcomes(Path(run_dir))
             if outcomes_hash != model_hash:
                 raise ValueError(f"{Path(run_dir) / PDDL_DIR} holds rules.json and outcomes.json of different "
-                                 f"transition models; re-run 'symlearn export-pddl --run {run_dir}'")
+                                 f"transition models; re-run 'symlearn export-pddl --run {run_dir} --rules'")
         return PlannerContext(rules=rules, model_hash=model_hash, write_dir=write_dir, risk_weight=risk_weight,
                               outcomes=outcomes, lifted=lifted)
 
 
 def load_run_lifted(run_dir: Path) -> LiftedRules:
     """RUN/pddl/lifted.json, refused if missing or exported from another transition.pt than the run's."""
-    from symlearn.planning.lifted_export import LIFTED_FILE
+    from symlearn.export.lifted_export import LIFTED_FILE
 
     path = Path(run_dir) / PDDL_DIR / LIFTED_FILE
     if not path.is_file():
-        raise ValueError(f"no lifted domain at {path}; run 'symlearn export-pddl --run {run_dir} --lifted' "
+        raise ValueError(f"no lifted domain at {path}; run 'symlearn export-pddl --run {run_dir}' "
                          f"(it needs an m(z) on 9 location bits)")
     lifted = load_lifted(path)
     check_rules_current(Path(run_dir), lifted.model_hash, path)
@@ -120,7 +120,7 @@ def check_rules_current(run_dir: Path, model_hash: str, rules_path: Path | None 
     if not model_hash or model_hash != current:
         raise ValueError(f"{rules_path or Path(run_dir) / PDDL_DIR / RULES_FILE} was exported from another transition.pt "
                          f"(model_hash {model_hash or 'missing'}, {path.name} is {current}); "
-                         f"re-run 'symlearn export-pddl --run {run_dir}'")
+                         f"re-run 'symlearn export-pddl --run {run_dir} --rules'")
 
 
 @dataclass(frozen=True)
@@ -334,7 +334,7 @@ class _RulesOutcomesPlanner(_InProcessRulesPlanner):
 def _build_outcome_rules_planner(context: PlannerContext) -> PlannerFn:
     if context.rules is None or context.outcomes is None:
         raise ValueError(f"planner {OUTCOME_RULES_PLANNER!r} plans on the exported rules and their second outcomes "
-                         f"(RUN/pddl/rules.json and outcomes.json); run 'symlearn export-pddl' first")
+                         f"(RUN/pddl/rules.json and outcomes.json); run 'symlearn export-pddl --rules' first")
     return _RulesOutcomesPlanner(context.rules, context.outcomes, context.model_hash, context.risk_weight)
 
 
@@ -369,22 +369,23 @@ def make_pddl_planner(rules: RuleSet, model_hash: str, name: str, write_dir: Pat
 def _build_rules_planner(name: str, context: PlannerContext) -> PlannerFn:
     if context.rules is None:
         raise ValueError(f"planner {name!r} plans on the exported rules, and none were given; "
-                         f"run 'symlearn export-pddl' first")
+                         f"run 'symlearn export-pddl --rules' first")
     return make_pddl_planner(context.rules, context.model_hash, name, context.write_dir)
 
 
 # ------------------------------------------------------------------------------- stock planners, lifted domain
 
-# registry name -> search.stock_planners configuration
-LIFTED_PLANNERS = {"fast-downward-lifted": "fd-lama-first", "fast-downward-lifted-opt": "fd-lmcut"}
+# registry name -> (search.stock_planners configuration, whether it plans on the domain's all-outcomes cost form)
+LIFTED_PLANNERS = {"fast-downward-lifted": ("fd-lama-first", False), "fast-downward-lifted-opt": ("fd-lmcut", False),
+                   "fast-downward-lifted-outcomes": ("fd-lmcut", True)}
 
 
-def _build_lifted_planner(name: str, engine: str, context: PlannerContext) -> PlannerFn:
+def _build_lifted_planner(name: str, engine: str, costs: bool, context: PlannerContext) -> PlannerFn:
     if context.lifted is None:
         raise ValueError(f"planner {name!r} plans on the lifted domain (RUN/pddl/lifted.json); "
-                         f"run 'symlearn export-pddl --lifted' first")
+                         f"run 'symlearn export-pddl' first")
     from symlearn.planning.lifted_planner import LiftedPlanner
-    return LiftedPlanner(context.lifted, name, engine, context.write_dir)
+    return LiftedPlanner(context.lifted, name, engine, context.write_dir, costs=costs)
 
 
 # ------------------------------------------------------------------------------- the registry
@@ -400,8 +401,8 @@ def _registry() -> Mapping[str, PlannerSpec]:
     specs += [PlannerSpec(n, DESCRIPTIONS[n], True, partial(_build_rules_planner, n)) for n in _RULES_PLANNERS]
     specs.append(PlannerSpec(OUTCOME_RULES_PLANNER, DESCRIPTIONS[OUTCOME_RULES_PLANNER], True,
                              _build_outcome_rules_planner))
-    specs += [PlannerSpec(n, DESCRIPTIONS[n], False, partial(_build_lifted_planner, n, engine), needs_lifted=True)
-              for n, engine in LIFTED_PLANNERS.items()]
+    specs += [PlannerSpec(n, DESCRIPTIONS[n], False, partial(_build_lifted_planner, n, engine, costs),
+                          needs_lifted=True) for n, (engine, costs) in LIFTED_PLANNERS.items()]
     return types.MappingProxyType({s.name: s for s in specs})
 
 

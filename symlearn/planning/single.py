@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from symlearn.planning.execution import ExecutionConfig, ProblemRun
-from symlearn.planning.problem import Problem
+from symlearn.problems.problem import Problem
 
 DEFAULT_RECORD_SIZE = (320, 240)  # recorded frame width x height
 
@@ -64,9 +64,9 @@ def plan_problem(run_dir: Path, problem_file: Path, planner: str = "astar",
     the executed plan as that GIF and a filmstrip PNG beside it. Refusals (a bad path, an unknown planner, a
     malformed problem) are one-line ValueErrors raised before the simulator starts."""
     from symlearn.planning.execution import run_problem
-    from symlearn.planning.paths import path_under
+    from symlearn.problems.paths import path_under
     from symlearn.planning.planners import make_planners
-    from symlearn.planning.problem import load_problem
+    from symlearn.problems.problem import load_problem
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.learned_transition import planning_models
 

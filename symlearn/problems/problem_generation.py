@@ -4,7 +4,7 @@ A problem is generated in the simulator: a random scene of k objects is built by
 them (exploration.sample_scene_spec), a random sequence of L actions that each move something
 is executed, and the scene it ends in is the goal. The generator's actions are kept as a known
 valid plan (its length is a reference for plan lengths); the shortest plan is searched for in the
-symbolic model and recorded too (symlearn.planning.shortest).
+symbolic model and recorded too (symlearn.problems.shortest).
 
     >>> paths = generate_problems(Path("problems/p13"), n=20, objects=(1, 3), length=(1, 4), seed=0)  # doctest: +SKIP
 """
@@ -18,10 +18,10 @@ import numpy as np
 
 from pddl_export.bounded_json import JsonFileError, read_json_file
 from symlearn.folder_lock import LOCK_NAME, folder_lock
-from symlearn.planning.paths import path_under
-from symlearn.planning.problem import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems,
+from symlearn.problems.paths import path_under
+from symlearn.problems.problem import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems,
                                        save_problem)
-from symlearn.planning.shortest import with_shortest
+from symlearn.problems.shortest import with_shortest
 from symlearn.provenance import atomic_write_json
 from symlearn.sim.exploration import MAX_OBJECTS, ExplorationConfig, sample_action, sample_scene_spec
 from symlearn.world import Action, Scene, decode_action

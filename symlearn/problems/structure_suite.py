@@ -14,12 +14,12 @@ from pathlib import Path
 import numpy as np
 
 from symlearn.folder_lock import folder_lock
-from symlearn.planning.goal_problems import goal_file_problem, goal_problem
-from symlearn.planning.paths import path_under
-from symlearn.planning.problem import PROBLEM_VERSION, Problem, load_problem, save_problem
-from symlearn.planning.problem_generation import (MANIFEST_FORMAT, PROBLEMS_MANIFEST, _done,
+from symlearn.problems.goal_problems import goal_file_problem, goal_problem
+from symlearn.problems.paths import path_under
+from symlearn.problems.problem import PROBLEM_VERSION, Problem, load_problem, save_problem
+from symlearn.problems.problem_generation import (MANIFEST_FORMAT, PROBLEMS_MANIFEST, _done,
                                                   prepare_problem_dir)
-from symlearn.planning.structures import TEMPLATES, Template, structure_goal
+from symlearn.problems.structures import TEMPLATES, Template, structure_goal
 from symlearn.sim.exploration import MAX_OBJECTS
 
 SUITES = ("structures",)

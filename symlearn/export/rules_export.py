@@ -1,4 +1,4 @@
-"""`symlearn export-pddl`: distil a run's transition network into rules and a PDDL domain.
+"""`symlearn export-pddl --rules`: distil a run's transition network into rules and a PDDL domain.
 
 Steps: the vocabulary is every code the encoder gives a training object (before or after an
 action), with counts, optionally closed under the network; every multiset scene of 1..K objects

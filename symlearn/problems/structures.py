@@ -18,8 +18,8 @@ from typing import Callable
 
 import numpy as np
 
-from symlearn.planning.goals import Goal, check_goal
-from symlearn.planning.stacking import run_script, touched
+from symlearn.problems.goals import Goal, check_goal
+from symlearn.problems.stacking import run_script, touched
 from symlearn.world import FAR_ROW, N_LOCATIONS, NEAR_ROW, ObjectType, action_id
 
 C, S = ObjectType.CUBE, ObjectType.STICK

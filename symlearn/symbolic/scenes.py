@@ -1,15 +1,15 @@
-"""Scenes and their symbols: place a scene in the simulator, encode it, measure distance to a goal.
+"""Scenes and their symbols: place a scene in the simulator and encode it.
 
 Goal symbols are the effect model's codes of the goal scene, rendered by placing the objects
-at the goal poses; execution compares observed codes with them and judges success by
-max_goal_distance.
+at the goal poses; execution compares observed codes with them (and judges success by
+symlearn.problems.problem.max_goal_distance).
 """
 from __future__ import annotations
 
 import numpy as np
 
 from pddl_export.symbolic import SymbolicGoal
-from symlearn.planning.problem import Problem
+from symlearn.problems.problem import Problem
 from symlearn.world import Scene
 
 
@@ -35,13 +35,3 @@ def symbolic_goal(sim, encoder, problem: Problem) -> SymbolicGoal:
     """The problem's goal in codes: the goal scene's codes, None for the objects the goal leaves free."""
     codes = goal_codes(sim, encoder, problem)
     return SymbolicGoal(tuple(None if i in problem.free else int(c) for i, c in enumerate(codes)))
-
-
-def max_goal_distance(scene: Scene, goal: Scene, free: tuple[int, ...] = ()) -> float:
-    """Largest distance (m) between an object's position and its goal position, free objects not counted."""
-    if scene.k != goal.k:
-        raise ValueError(f"scene has {scene.k} objects, goal {goal.k}")
-    fixed = [i for i in range(scene.k) if i not in free]
-    if not fixed:
-        return 0.0
-    return float(np.linalg.norm(scene.positions()[fixed] - goal.positions()[fixed], axis=1).max())

@@ -1,4 +1,4 @@
-"""`symlearn export-pddl --lifted`: the lifted domain of a run's m(z), distilled on observed scenes.
+"""`symlearn export-pddl`: the lifted domain of a run's m(z), distilled on observed scenes.
 
 m(z) is asked for its likeliest next codes on every training scene of the given data sets (each state as the
 robot saw it, with the action it took); each answer is read as a move of pieces (pddl_export.lifted_rules)
@@ -29,6 +29,7 @@ from symlearn.provenance import atomic_write_json, versions
 
 LIFTED_FILE = "lifted.json"
 LIFTED_DIR = "lifted"
+COST_FORM_DIR = "costs"  # a problem folder's all-outcomes cost form (write_problem_folder)
 
 
 @dataclass(frozen=True)
@@ -180,7 +181,9 @@ MAX_DATA_OBJECTS = 5  # the most objects a scene of the data sets had: problems 
 
 
 def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None = None) -> dict:
-    """A standalone benchmark folder of a problem set: the lifted domain.pddl and one pNN.pddl per problem.
+    """A standalone benchmark folder of a problem set: the lifted domain.pddl and one pNN.pddl per problem, and
+    the same in the domain's all-outcomes cost form under costs/ (COST_FORM_DIR: `:action-costs`, for a cost-aware
+    search such as A* with LM-cut).
 
     Each problem's start and goal are the run's codes of its scenes (rendered in the simulator), as the
     planners see them; index.json maps pNN to the source problem, its object count and shortest plan length
@@ -189,8 +192,8 @@ def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None
     """
     from pddl_export.lifted_rules import load_lifted
     from pddl_export.lifted_writer import problem_pddl
-    from symlearn.planning.problem import load_problems
-    from symlearn.planning.scenes import scene_codes, symbolic_goal
+    from symlearn.problems.problem import load_problems
+    from symlearn.symbolic.scenes import scene_codes, symbolic_goal
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.learned_transition import planning_models
 
@@ -199,8 +202,8 @@ def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None
     problems = load_problems(problems_dir)  # refuses a missing or empty folder before any work
     out = Path(out_dir) if out_dir else run_dir / PDDL_DIR / LIFTED_DIR / problems_dir.name
     reader, _ = planning_models(run_dir)
-    index = {"domain": "domain.pddl", "model_hash": rules.model_hash, "source": str(problems_dir),
-             "problems": {}, "zero_shot": []}
+    index = {"domain": "domain.pddl", "cost_form": f"{COST_FORM_DIR}/domain.pddl", "model_hash": rules.model_hash,
+             "source": str(problems_dir), "problems": {}, "zero_shot": []}
     texts = {}
     sim = TabletopSimulator()
     try:
@@ -209,14 +212,16 @@ def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None
             goal = symbolic_goal(sim, reader, problem)
             start = scene_codes(sim, reader, problem.initial)
             texts[name] = problem_pddl(rules, [int(c) for c in start], goal, name)
+            texts[f"{COST_FORM_DIR}/{name}"] = problem_pddl(rules, [int(c) for c in start], goal, name, costs=True)
             index["problems"][name] = {"file": path.name, "objects": problem.k,
                                        "optimal_length": getattr(problem, "optimal_length", None)}
             if problem.k > MAX_DATA_OBJECTS:
                 index["zero_shot"].append(name)
     finally:
         sim.close()
-    out.mkdir(parents=True, exist_ok=True)
+    (out / COST_FORM_DIR).mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / "domain.pddl", domain_pddl(rules))
+    atomic_write_text(out / COST_FORM_DIR / "domain.pddl", domain_pddl(rules, costs=True))
     for name, text in texts.items():
         atomic_write_text(out / f"{name}.pddl", text)
     atomic_write_json(out / "index.json", index)

@@ -8,7 +8,7 @@ Scripts that leave these rules (a pick at an empty location or at a stick's end,
 standing objects, riders carried off the locations, anything put on the end of a stick that does not
 lie on the table, which tips it over) are refused with a ValueError. The simulator has the last
 word: goal_problems checks every scripted plan there, and tests/test_shortest.py the shortest
-plans that symlearn.planning.shortest searches over `successors`.
+plans that symlearn.problems.shortest searches over `successors`.
 
     >>> from symlearn.world import ObjectType as T
     >>> s = drop_all([(T.STICK, 4), (T.CUBE, 3)])
@@ -18,7 +18,7 @@ plans that symlearn.planning.shortest searches over `successors`.
 """
 from __future__ import annotations
 
-from symlearn.planning.goals import ObjectGoal, stick_covers
+from symlearn.problems.goals import ObjectGoal, stick_covers
 from symlearn.world import FAR_ROW, N_LOCATIONS, ObjectType
 
 State = tuple  # tuple[ObjectGoal | None, ...]: every placed object's location and support, in identity order

@@ -2,7 +2,7 @@
 
 `symlearn problems` (its default kind, stratified) fills the cells (k objects, 1-5) x (shortest plan 1-2, 3-4, 5-6,
 7-8, 9-12 actions), plus one "off" cell per object count: goals that leave a judged object off the table locations
-(no shortest length: symlearn.planning.shortest), kept apart from the on-location cells. Problem i of a cell
+(no shortest length: symlearn.problems.shortest), kept apart from the on-location cells. Problem i of a cell
 is the first of its draws (rng [seed, k, lo, hi, i, draw]; the off cell has lo = hi = 0) that falls in the
 cell and is not already in the cell or in an `exclude`d set (same initial and goal scene within 2 cm). Draws
 cycle over three sources:
@@ -30,13 +30,13 @@ from pathlib import Path
 
 import numpy as np
 
-from symlearn.planning.paths import path_under
-from symlearn.planning.problem import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems,
+from symlearn.problems.paths import path_under
+from symlearn.problems.problem import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems,
                                        save_problem)
-from symlearn.planning.problem_generation import (MANIFEST_FORMAT, ProblemConfig, _changing_action, _done,
+from symlearn.problems.problem_generation import (MANIFEST_FORMAT, ProblemConfig, _changing_action, _done,
                                                   _is_count, generate_problem, prepare_problem_dir)
-from symlearn.planning.shortest import NotCovered, scene_state, with_shortest
-from symlearn.planning.stacking import successors
+from symlearn.problems.shortest import NotCovered, scene_state, with_shortest
+from symlearn.problems.stacking import successors
 from symlearn.provenance import sha256_bytes
 from symlearn.sim.exploration import MAX_OBJECTS, ExplorationConfig, sample_scene_spec
 from symlearn.world import decode_action
@@ -149,7 +149,7 @@ def _aimed(sim, rng: np.random.Generator, cell: Cell, name: str, seed: int) -> P
 
 def draw(sim, cell: Cell, i: int, attempt: int, seed: int) -> Problem | None:
     """Draw `attempt` of problem i of a cell (None where the source gives nothing this time)."""
-    from symlearn.planning.structure_suite import fitting_templates, structure_problem
+    from symlearn.problems.structure_suite import fitting_templates, structure_problem
 
     rng = np.random.default_rng([seed, cell.k, cell.lo, cell.hi, i, attempt])
     source = "walk" if cell.off else SOURCES[attempt % len(SOURCES)]

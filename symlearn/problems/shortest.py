@@ -2,7 +2,7 @@
 
 A problem's depth is the length of the shortest plan that reaches its goal, not the length of the
 random walk that made it (a walk of 8 actions often ends one action from where it began). The search
-runs over symlearn.planning.stacking (which object stands on which, at which location; `successors`),
+runs over symlearn.problems.stacking (which object stands on which, at which location; `successors`),
 from the problem's initial scene read as a stacking state (`scene_state`), and stops at the first state
 whose judged objects (all but the goal's free ones) stand where the goal scene has them: at the same
 location and at the same height, i.e. on the same kind of support, which is what the 2 cm success test
@@ -29,9 +29,9 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from symlearn.planning.problem import OPTIMAL_REASONS, Problem
-from symlearn.planning.stacking import LAYERS, LEVEL_M, State, check_state, levels, successors
-from symlearn.planning.goals import MAX_TILT_DEG, ObjectGoal, stick_covers
+from symlearn.problems.problem import OPTIMAL_REASONS, Problem
+from symlearn.problems.stacking import LAYERS, LEVEL_M, State, check_state, levels, successors
+from symlearn.problems.goals import MAX_TILT_DEG, ObjectGoal, stick_covers
 from symlearn.world import LOCATIONS, OBJECT_SIZE, TABLE_TOP_Z, ObjectState, ObjectType, Scene
 
 POSE_TOLERANCE_M = 0.01  # an object this close (xy and z) to a model pose is in it; the simulator settles within 2 mm

@@ -1,8 +1,9 @@
 """Planning problems as JSON files: an initial scene, a goal scene, and the actions that made it.
 
-This module holds the problem format only: the Problem dataclass, its validation, and loading
-and saving. Problems are drawn in the simulator by symlearn.planning.problem_generation; scenes
-are placed and encoded by symlearn.planning.scenes.
+This module holds the problem format: the Problem dataclass, its validation, loading and saving,
+and the distance by which success is judged (max_goal_distance). Problems are drawn in the
+simulator by symlearn.problems.problem_generation; scenes are placed and encoded by
+symlearn.symbolic.scenes.
 
     >>> problem = load_problem(Path("problems/p13/problem_0000.json"))  # doctest: +SKIP
     >>> problem.generator_length, problem.initial.k                     # doctest: +SKIP
@@ -17,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from pddl_export.bounded_json import MiB, read_json_file
-from symlearn.planning.paths import check_safe_name, is_safe_name
+from symlearn.problems.paths import check_safe_name, is_safe_name
 from symlearn.sim.exploration import MAX_OBJECTS
 from symlearn.provenance import atomic_write_json
 from symlearn.world import LOCATIONS, N_ACTIONS, N_LOCATIONS, TABLE_TOP_Z, ObjectType, Scene, decode_action
@@ -25,7 +26,7 @@ from symlearn.world import LOCATIONS, N_ACTIONS, N_LOCATIONS, TABLE_TOP_Z, Objec
 PROBLEM_FORMAT = "symlearn-problem"
 PROBLEM_VERSION = 3  # 2 added "task" and "free", 3 the shortest plan; version 1 and 2 files still load (not computed)
 READABLE_VERSIONS = (1, 2, 3)
-# why a problem has no shortest-plan length (symlearn.planning.shortest explains each)
+# why a problem has no shortest-plan length (symlearn.problems.shortest explains each)
 OPTIMAL_REASONS = ("goal_off_locations", "pose_not_covered", "search_cap", "unreachable")
 RANDOM_WALK = "random-walk"  # the task of problems drawn by random actions
 GOAL_TOLERANCE_M = 0.02  # success: every object within this distance of its goal position
@@ -54,7 +55,7 @@ class Problem:
     goal: Scene  # poses the generator's actions ended in
     task: str = RANDOM_WALK  # what made it: "random-walk", or a structure suite's task name ("tower-2", ...)
     free: tuple[int, ...] = ()  # objects the goal leaves free: their goal poses and codes are not judged
-    # The shortest plan in the world (symlearn.planning.shortest): its length and one such plan, or no length
+    # The shortest plan in the world (symlearn.problems.shortest): its length and one such plan, or no length
     # and the reason (OPTIMAL_REASONS) the model cannot decide; all three None: not computed (a version 1-2 file).
     optimal_length: int | None = None
     optimal_reason: str | None = None
@@ -280,3 +281,13 @@ def load_problems(problems_dir: Path) -> list[tuple[Path, Problem]]:
     if not paths:
         raise ValueError(f"{problems_dir} holds no problem files (*.json)")
     return [(p, load_problem(p)) for p in paths]
+
+
+def max_goal_distance(scene: Scene, goal: Scene, free: tuple[int, ...] = ()) -> float:
+    """Largest distance (m) between an object's position and its goal position, free objects not counted."""
+    if scene.k != goal.k:
+        raise ValueError(f"scene has {scene.k} objects, goal {goal.k}")
+    fixed = [i for i in range(scene.k) if i not in free]
+    if not fixed:
+        return 0.0
+    return float(np.linalg.norm(scene.positions()[fixed] - goal.positions()[fixed], axis=1).max())

@@ -4,7 +4,7 @@ The arrangement is built by dropping the fixed objects in support order at their
 (free objects after them, at an empty location), letting them settle, and checking every fixed
 object against where the arrangement puts it (goals.arrangement_errors). A reference plan is run
 from the initial scene; its end scene is the problem's goal and must agree with the arrangement
-within 2 cm on the fixed objects; its shortest plan is recorded (symlearn.planning.shortest). The
+within 2 cm on the fixed objects; its shortest plan is recorded (symlearn.problems.shortest). The
 simulator is passed in; nothing here imports pybullet.
 
     >>> with TabletopSimulator() as sim:                                              # doctest: +SKIP
@@ -14,11 +14,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from symlearn.planning.goals import ARRANGEMENT_TOLERANCE_M, Goal, arrangement_errors, drop_order, load_goal
-from symlearn.planning.paths import check_safe_name
-from symlearn.planning.problem import Problem
-from symlearn.planning.scenes import max_goal_distance
-from symlearn.planning.shortest import with_shortest
+from symlearn.problems.goals import ARRANGEMENT_TOLERANCE_M, Goal, arrangement_errors, drop_order, load_goal
+from symlearn.problems.paths import check_safe_name
+from symlearn.problems.problem import Problem
+from symlearn.problems.problem import max_goal_distance
+from symlearn.problems.shortest import with_shortest
 from symlearn.world import FAR_ROW, N_LOCATIONS, ObjectType, Scene, decode_action
 
 
