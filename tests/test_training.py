@@ -184,6 +184,23 @@ def test_rider_weights_mark_exactly_the_riders(tiny_data):
     assert t.post_crops(torch.arange(3)).shape == t.batch(torch.arange(3))[0].shape
 
 
+def test_rider_scenes_are_drawn_as_often_as_asked(data, monkeypatch):
+    """rider_scene_repeat = 3: a scene holding a rider is drawn three times an epoch, every other scene once; with 1
+    the epoch's order is the plain index, so runs without the lever shuffle as they always did."""
+    import symlearn.learning.training as training
+
+    marked = lambda d: np.arange(len(d.mask))[:, None] % 5 == 0  # noqa: E731  (every fifth scene "has a rider")
+    monkeypatch.setattr(training, "rider_mask", marked)
+    cfg = TrainConfig.from_preset("quick", **TINY, rider_scene_repeat=3)
+    tr, _, _, _, order = training._load_training_splits(data, cfg)
+    counts = np.bincount(order.numpy(), minlength=len(tr))
+    assert np.array_equal(counts, np.where(np.arange(len(tr)) % 5 == 0, 3, 1))
+    plain = training._load_training_splits(data, TrainConfig.from_preset("quick", **TINY))[4]
+    assert np.array_equal(plain.numpy(), np.arange(len(tr)))
+    with pytest.raises(ValueError, match="rider_scene_repeat"):
+        TrainConfig.from_preset("quick", rider_scene_repeat=0)
+
+
 def test_levers_train_and_are_recorded(data, tmp_path):
     cfg = TrainConfig.from_preset("quick", **TINY, rider_weight=4.0, dynamics_weight=0.5, stability_weight=1.0,
                                   distinct_weight=0.5)

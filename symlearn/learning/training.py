@@ -63,6 +63,9 @@ class TrainConfig:
     compile: bool = False  # torch.compile the model
     max_train_samples: int | None = None  # a subset, for quick runs and tests
     rider_weight: float = 1.0  # loss weight of riders (objects carried by the held one; 1.5% of objects)
+    # each training scene with a rider is drawn this many times an epoch (1: once, as every scene): rider-rich
+    # sampling, the data-side alternative to rider_weight
+    rider_scene_repeat: int = 1
     dynamics_weight: float = 0.0  # weight of the joint next-code loss (needs model.dynamics_head)
     stability_weight: float = 0.0  # weight of the hinge keeping still objects' codes unchanged by an action
     stability_margin: float = 1.0  # logit distance from 0 the hinge asks of every bit of a still object
@@ -126,6 +129,8 @@ def _config_problem(c: TrainConfig) -> str | None:
         (_is_real(c.lr_min_ratio) and 0 <= c.lr_min_ratio <= 1, f"lr_min_ratio={c.lr_min_ratio!r} must be in [0, 1]"),
         (_is_int(c.seed) and c.seed >= 0, f"seed={c.seed!r} must be a non-negative integer"),
         (_is_real(c.rider_weight) and c.rider_weight > 0, f"rider_weight={c.rider_weight!r} must be finite and > 0"),
+        (_is_int(c.rider_scene_repeat) and c.rider_scene_repeat >= 1,
+         f"rider_scene_repeat={c.rider_scene_repeat!r} must be an integer >= 1"),
         (_is_real(c.dynamics_weight) and c.dynamics_weight >= 0,
          f"dynamics_weight={c.dynamics_weight!r} must be finite and >= 0"),
         (_is_real(c.stability_weight) and c.stability_weight >= 0,
@@ -274,6 +279,7 @@ class _Loop:
     std: np.ndarray
     meta: dict
     show_progress: bool
+    order: torch.Tensor  # the training split's sample indices an epoch draws from (rider scenes repeated)
 
 
 def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, show_progress: bool = True) -> dict:
@@ -283,7 +289,7 @@ def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, 
     check_run_dir(run_dir, Path(data_dir))
     device = torch.device("cuda", rank % torch.cuda.device_count()) if torch.cuda.is_available() else torch.device("cpu")
     fingerprint = data_fingerprint(data_dir)
-    tr, va, mean, std = _load_training_splits(data_dir, cfg)
+    tr, va, mean, std, order = _load_training_splits(data_dir, cfg)
     if device.type == "cuda":  # training batches are then built on the GPU: no per-step host work or copies
         tr = tr.to(device)
     torch.manual_seed(cfg.seed)
@@ -304,7 +310,7 @@ def train(data_dir: Path, run_dir: Path, cfg: TrainConfig, resume: bool = True, 
     if world > 1:
         net = torch.nn.parallel.DistributedDataParallel(model, device_ids=[device.index] if device.type == "cuda" else None)
     loop = _Loop(cfg, run_dir, model, torch.compile(net) if cfg.compile else net, opt, gen, noise_gen, device,
-                 rank, world, mean, std, meta, show_progress)
+                 rank, world, mean, std, meta, show_progress, order)
     try:
         best = _run_epochs(loop, tr, va, start_epoch, best, history)
     except BaseException:
@@ -353,8 +359,10 @@ def check_run_dir(run_dir: Path, data_dir: Path) -> None:
         raise TrainingError(f"--out {run_dir} holds {what} ({manifest}); choose a separate run folder")
 
 
-def _load_training_splits(data_dir: Path, cfg: TrainConfig) -> tuple[SplitTensors, SplitTensors, np.ndarray, np.ndarray]:
-    """The train and val splits as tensors, effects normalized with the training split's statistics."""
+def _load_training_splits(data_dir: Path, cfg: TrainConfig
+                          ) -> tuple[SplitTensors, SplitTensors, np.ndarray, np.ndarray, torch.Tensor]:
+    """The train and val splits as tensors, effects normalized with the training split's statistics, and the
+    training samples an epoch draws from: each once, a scene with a rider cfg.rider_scene_repeat times."""
     train_data = load_split(data_dir, "train")
     val_data = load_split(data_dir, "val")
     if cfg.max_train_samples:
@@ -364,7 +372,9 @@ def _load_training_splits(data_dir: Path, cfg: TrainConfig) -> tuple[SplitTensor
         raise TrainingError(f"data crops of {train_data.pre_depth.shape[-1]} px do not pool to the model's {cfg.model.crop} px")
     mean, std = effect_normalization(train_data)
     tr = to_tensors(train_data, mean, std, with_post=cfg.uses_post_crops, rider_weight=cfg.rider_weight)
-    return tr, to_tensors(val_data, mean, std), mean, std
+    repeats = np.where(rider_mask(train_data).any(1), cfg.rider_scene_repeat, 1)
+    order = torch.from_numpy(np.repeat(np.arange(len(repeats)), repeats))
+    return tr, to_tensors(val_data, mean, std), mean, std, order
 
 
 def _resume(run_dir: Path, cfg: TrainConfig, fingerprint: str, model: AttentiveDeepSym, opt: torch.optim.Optimizer,
@@ -390,7 +400,7 @@ def _train_epoch(loop: _Loop, tr: SplitTensors, epoch: int) -> tuple[float, int,
     for group in loop.opt.param_groups:
         group["lr"] = epoch_lr(cfg, epoch)
     loop.model.train()
-    perm = torch.randperm(len(tr), generator=loop.gen)
+    perm = loop.order[torch.randperm(len(loop.order), generator=loop.gen)]
     per_rank = len(perm) // world
     perm = perm[loop.rank * per_rank:(loop.rank + 1) * per_rank]
     n_batches = max(1, len(perm) // cfg.batch_size)
