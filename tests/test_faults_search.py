@@ -262,11 +262,10 @@ def test_domain_parse_counts_against_the_limit(rules):  # noqa: F811
     """With cache_domain, parsing a new domain is part of the call: a tiny limit stops it as a TIMEOUT."""
     domain, problem = _conditional(rules, UNCOVER_TWICE)
     solve_pddl(*_conditional(rules, UNCOVER_TWICE), planner="fast-downward", timeout_s=20)  # warm up
-    t0 = time.perf_counter()
     res = solve_pddl(domain + "\n; new text, new cache key\n", problem, planner="fast-downward", timeout_s=0.01,
                      cache_domain=True)
-    assert res.status is PlanStatus.TIMEOUT, res.message
-    assert time.perf_counter() - t0 < 0.5
+    # the limit stopped the parse itself (not a later stage): no wall-clock bound, which a busy machine breaks
+    assert res.status is PlanStatus.TIMEOUT and "reached while parsing the domain" in res.message, res.message
 
 
 # ------------------------------------------------------------------------------- 3. rules.json

@@ -278,8 +278,8 @@ def test_timeout_stops_a_slow_transition():
     result = plan_symbolic(slow, np.array([0, 0, 0]), SymbolicGoal((15, 15, 15)), timeout_s=0.1)
     elapsed = time.perf_counter() - t0
     assert result.status is PlanStatus.TIMEOUT and result.plan == ()
-    assert 1 <= result.expansions <= 10
-    assert 0.1 <= result.planning_time_s <= elapsed < 0.5
+    assert 1 <= result.expansions <= 10  # stopped at the limit: 0.02 s a call, not the 4,096-state search
+    assert 0.1 <= result.planning_time_s <= elapsed
 
 
 def _drop_row(codes, actions):
