@@ -17,7 +17,6 @@ PAPER_EFFECT_MAE_MM = {"x": 8.6, "y": 15.0, "z": 6.0}  # the paper's test error 
 PAPER_SYMBOLS_95 = 35  # the paper: 35 symbols cover 95% of the objects
 OBJECT_ORDER = (1, 0, 2)  # Table I's columns: first cube (green), stick (orange), second cube (red)
 OBJECT_NAMES = ("first cube", "stick", "second cube")
-TABLE1_ATTENTION = "table1_attention.png"  # written by symlearn table1 (symlearn.learning.table1.ATTENTION_FIGURE)
 SYMBOL_IMAGES = (("symbols.png", "Symbol prototypes (the paper's Fig. 4)"),
                  ("symbol_examples.png", "Examples of one symbol (the paper's Fig. 5)"))
 
@@ -125,7 +124,8 @@ def table1_section(t1: dict | None, why: str = "", run: Path | None = None) -> S
                 text.append(f"case {i + 1}: the rider (object {rider.get('object')}) puts "
                             f"{' / '.join(fmt(w) for w in rider['on_stick'])} of its attention on the stick, "
                             f"layer by layer")
-    figure = Path(run) / TABLE1_ATTENTION if run is not None else None
+    name = t1.get("attention_figure")  # the figure table1 drew and recorded in table1.json (a bare file name)
+    figure = Path(run) / name if run is not None and isinstance(name, str) and Path(name).name == name else None
     images = [Image("table1_attention", "Attention of each object on each object in the three cases (rows: who "
                     "attends), per layer", figure)] if figure is not None and figure.is_file() else []
     return Section("table1", title, marks=marks, text=text, images=images,
