@@ -5,8 +5,7 @@ OUT/problems.
 The presets (PRESETS): `recommended`, the default, is the recipe that plans best (its run is shipped as
 pretrained/recommended, whose README gives the commands): the paper-size data set plus a set of 1-5-object
 scenes that only m(z) and the export read, the quick effect model with the stability loss and the action on the
-held object's token only, m(z) on 9 location
-bits, the lifted PDDL domain, problems stratified by shortest-plan length, astar-outcomes and stock Fast Downward
+held object's token only, m(z) on 9 location bits, the lifted PDDL domain, problems stratified by shortest-plan length, astar-outcomes and stock Fast Downward
 on the lifted domain, closed loop. `demo` is the same recipe at a small scale (minutes on 2 cores: `make demo`);
 `paper` is the paper-faithful setup (its model sizes, learned codes only, the rules export, random-walk problems,
 open loop).
@@ -61,9 +60,9 @@ class PipelinePreset:
     """One named preset of the whole pipeline.
 
     The networks take the named presets of TrainConfig and TransitionConfig called `models`; a value left None is
-    the default of the config (or library function) that holds it. Only what no config holds (the recipe's
-    stability weight, which data sets and problems, which planners) and a small preset's smaller sizes are
-    numbers here, and `demo` is `recommended` with smaller sizes, so each value has one definition.
+    the default of the config (or library function) that holds it. Only what no config holds (which data sets
+    and problems, which planners, closed loop and the time limit) and a small preset's smaller sizes are numbers
+    here, and `demo` is `recommended` with smaller sizes, so each value has one definition.
     """
 
     models: str  # TrainConfig.from_preset and TransitionConfig.from_preset name
@@ -457,7 +456,7 @@ def _benchmark(out: Path, cfg: BenchmarkStageConfig, s: PipelineSettings) -> Non
                         record_dir=run / "recordings", risk_weight=ex.risk_weight)
         print(format_table(res))
         planner = cfg.planners[0]
-        done = plan_problem(run, _first_problem(out), planner, ex, record=run / "plan.gif", risk_weight=ex.risk_weight)
+        done = plan_problem(run, _first_problem(out), planner, ex, record=run / "plan.gif")
     row = done.row
     print(f"{done.problem.name} [{planner}]: found {row.found} ({row.status}), length {row.plan_length}, "
           f"success {row.success}; wrote {done.gif} ({done.frames} frames)")

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 import os
 
 
@@ -65,28 +64,6 @@ def non_negative_int(text: str) -> int:
     return value
 
 
-def positive_finite_float(text: str) -> float:
-    """'5e-4' -> 0.0005; zero, negatives, inf and nan are argparse errors naming the text."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not math.isfinite(value) or value <= 0:
-        raise argparse.ArgumentTypeError(f"{text!r} must be a positive finite number")
-    return value
-
-
-def non_negative_finite_float(text: str) -> float:
-    """'0.5' -> 0.5, '0' -> 0.0; negatives, inf and nan are argparse errors naming the text."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not math.isfinite(value) or value < 0:
-        raise argparse.ArgumentTypeError(f"{text!r} must be a non-negative finite number")
-    return value
-
-
 class OneLineParser(argparse.ArgumentParser):
     """An ArgumentParser whose refusals are one line, 'PROG: error: MESSAGE (see PROG --help)', exit code 2."""
 
@@ -116,13 +93,6 @@ def add_config_flag(c: argparse.ArgumentParser, tables: str) -> None:
     """--config FILE.toml: the levers that are not flags (symlearn.config_file); `tables` says which it reads."""
     c.add_argument("--config", metavar="FILE.toml",
                    help=f"settings file (docs/CONFIG.md): {tables}; flags given here win over it")
-
-
-def read_config_file(path: str | None) -> dict:
-    """The checked tables of --config (symlearn.config_file.read_config_file), {} without one."""
-    from symlearn.config_file import read_config_file as read
-
-    return read(path)
 
 
 THREADS_HELP = ("torch CPU threads (default: torch's, one per core); use 1 per process when other jobs share the "

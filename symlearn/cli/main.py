@@ -14,11 +14,11 @@ import time
 from pathlib import Path
 
 from symlearn.cli.args import (THREADS_HELP, TRAIN_PRESET_NAMES, OneLineParser, add_config_flag, add_ray_flag,
-                               int_range, non_negative_int, positive_int, ray_engine, read_config_file, set_threads,
-                               thread_count)
+                               int_range, non_negative_int, positive_int, ray_engine, set_threads, thread_count)
 from symlearn.cli.pipeline import add_pipeline_command
 from symlearn.cli.planning import add_planning_commands
 from symlearn.cli.report import add_plots_command, add_report_command
+from symlearn.config_file import read_config_file
 from symlearn.outputs import folder_output
 
 

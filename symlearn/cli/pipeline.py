@@ -10,7 +10,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from symlearn.cli.args import add_config_flag, non_negative_int, positive_int, read_config_file
+from symlearn.cli.args import add_config_flag, non_negative_int, positive_int
+from symlearn.config_file import read_config_file
 from symlearn.pipeline import DEFAULT_PRESET, PRESETS, PipelineSettings, run_pipeline
 
 PRESETS_HELP = ("recommended (default): the recipe that plans best, at full scale (a paper-style data set and a "

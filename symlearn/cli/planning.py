@@ -30,8 +30,8 @@ import sys
 from pathlib import Path
 
 from symlearn.cli.args import (THREADS_HELP, TRAIN_PRESET_NAMES, add_config_flag, add_ray_flag, int_range,
-                               non_negative_int, planner_list, positive_int, ray_engine, read_config_file,
-                               set_threads, thread_count)
+                               non_negative_int, planner_list, positive_int, ray_engine, set_threads, thread_count)
+from symlearn.config_file import read_config_file
 from symlearn.planning.planner_catalogue import DEFAULT_PLANNER, planners_help
 
 
@@ -203,8 +203,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     set_threads(args.threads)
     note_rule_loading(Path(args.run), [args.planner])
     done = plan_problem(Path(args.run), Path(args.problem), args.planner, cfg,
-                        record=Path(args.record) if args.record else None, record_size=args.record_size,
-                        risk_weight=cfg.risk_weight)
+                        record=Path(args.record) if args.record else None, record_size=args.record_size)
     problem, row = done.problem, done.row
     if done.gif is not None:
         print(f"wrote {done.gif} ({done.frames} frames) and {done.filmstrip}")

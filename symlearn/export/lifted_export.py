@@ -210,9 +210,9 @@ def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None
         for n, (path, problem) in enumerate(problems):
             name = f"p{n + 1:02d}"
             goal = symbolic_goal(sim, reader, problem)
-            start = scene_codes(sim, reader, problem.initial)
-            texts[name] = problem_pddl(rules, [int(c) for c in start], goal, name)
-            texts[f"{COST_FORM_DIR}/{name}"] = problem_pddl(rules, [int(c) for c in start], goal, name, costs=True)
+            start = [int(c) for c in scene_codes(sim, reader, problem.initial)]
+            texts[name] = problem_pddl(rules, start, goal, name)
+            texts[f"{COST_FORM_DIR}/{name}"] = problem_pddl(rules, start, goal, name, costs=True)
             index["problems"][name] = {"file": path.name, "objects": problem.k,
                                        "optimal_length": getattr(problem, "optimal_length", None)}
             if problem.k > MAX_DATA_OBJECTS:

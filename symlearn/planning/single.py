@@ -59,9 +59,9 @@ def check_writable(folder: Path) -> None:
 
 def plan_problem(run_dir: Path, problem_file: Path, planner: str = "astar",
                  config: ExecutionConfig = ExecutionConfig(), record: Path | None = None,
-                 record_size: tuple[int, int] = DEFAULT_RECORD_SIZE, risk_weight: float = 1.0) -> PlannedProblem:
-    """Plan `problem_file` with `planner` on RUN's models, execute it in the simulator and, with `record`, save
-    the executed plan as that GIF and a filmstrip PNG beside it. Refusals (a bad path, an unknown planner, a
+                 record_size: tuple[int, int] = DEFAULT_RECORD_SIZE) -> PlannedProblem:
+    """Plan `problem_file` with `planner` on RUN's models (the risk planners with config.risk_weight), execute it
+    in the simulator and, with `record`, save the executed plan as that GIF and a filmstrip PNG beside it. Refusals (a bad path, an unknown planner, a
     malformed problem) are one-line ValueErrors raised before the simulator starts."""
     from symlearn.planning.execution import run_problem
     from symlearn.problems.paths import path_under
@@ -75,7 +75,7 @@ def plan_problem(run_dir: Path, problem_file: Path, planner: str = "astar",
     problem = load_problem(Path(problem_file))
     write_dir = path_under(run_dir / "pddl" / "problems", problem.name)  # the name is checked at load
     check_writable(write_dir)
-    fn = make_planners([planner], run_dir, write_dir=write_dir, risk_weight=risk_weight)[planner]
+    fn = make_planners([planner], run_dir, write_dir=write_dir, risk_weight=config.risk_weight)[planner]
     encoder, transition = planning_models(run_dir)
     recorder = None
     if gif is not None:

@@ -30,7 +30,6 @@ from symlearn.world import LOCATIONS, TABLE_TOP_Z
 
 LOCATION_BITS = (4, 5, 6, 7, 9)  # sizes m(z) accepts: 3 bits of nearest location, an off flag, direction or
 # place; with 7 the off flag and 3 bits of height, with 9 the place and 3 bits of height
-DEFAULT_LOCATION_BITS = 7  # what the bare --location-bits means
 OFF_LOCATION_M = 0.05  # as Problem.goal_off_locations: more than 5 cm (xy) from every location is off
 UNSEEN = 7  # the nearest-location field of an object with no visible pixel (its off field is all ones)
 OFF_DIRECTIONS = ("on", "-y", "+y", "x")  # the 2-bit off field of N = 5, in value order
