@@ -18,6 +18,9 @@ $(BIN)/python:
 $(VENV)/.installed: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q torch==$(TORCH_VERSION) $(TORCH_FLAGS)
 	$(BIN)/pip install -q -e '.[dev,ray]'
+	# pddlgym (the tests load the lifted domain with it) pins pillow<10, which the plan recordings' pillow does not
+	# need; its other dependencies are in the dev extra
+	$(BIN)/pip install -q --no-deps pddlgym==0.0.7 gym==0.26.2 gym-notices==0.1.0
 	touch $@
 
 # The recommended recipe at the demo preset (symlearn/pipeline.py): a paper-style data set and a 1-5-object one,

@@ -28,7 +28,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Iterable, Sequence
 
 from pddl_export.lifted_rules import LiftedRules, Rule
 from pddl_export.lifted_scene import FAR_ROW, NEAR_ROW, N_LOCATIONS, neighbours, read_scene, top_of
@@ -287,7 +287,7 @@ def schemas(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
     deletes, the negation of the other clauses' conditions: a 4-object task did not translate in 10 minutes.)
     """
     if not costs:
-        return tuple(rule_schema(rules, r, i) for i, r in enumerate(rules.rules))
+        return _distinct(rule_schema(rules, r, i) for i, r in enumerate(rules.rules))
     out = []
     for i, r in enumerate(rules.rules):
         for j, (_, share) in enumerate(r.outcomes()):
@@ -297,6 +297,31 @@ def schemas(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
                 if j == 0:  # the rule's own outcome always writes (export_lifted checks it)
                     raise
                 # an alternative whose heights cannot be stated from the rule's key: no action for it
+    return _distinct(out)
+
+
+def _cost(schema: Schema) -> int:
+    last = schema.eff[-1] if schema.eff else ""
+    return int(last.split()[-1].rstrip(")")) if last.startswith("(increase (total-cost)") else 0
+
+
+def _distinct(found: Iterable[Schema]) -> tuple[Schema, ...]:
+    """One schema per action: rules whose keys differ only in what the PDDL does not state (whether a piece
+    stands on top at the pick or release location) write the same parameters, preconditions and effects; the
+    copies would only multiply the translator's grounded operators. The cheapest copy stays (the first among
+    equals), in the place of the first, and its comment names the rules it stands for."""
+    kept: dict[tuple, list[Schema]] = {}
+    for s in found:
+        body = (s.params, s.pre, tuple(e for e in s.eff if not e.startswith("(increase (total-cost)")))
+        kept.setdefault(body, []).append(s)
+    out = []
+    for copies in kept.values():
+        best = min(copies, key=_cost)
+        if len(copies) > 1:
+            others = ", ".join(c.name for c in copies if c is not best)
+            head, rest = best.text.split("\n", 1)
+            best = dataclasses.replace(best, text=f"{head}; it also stands for {others}\n{rest}")
+        out.append(best)
     return tuple(out)
 
 
@@ -335,7 +360,8 @@ def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
             f"; Blocks stand at locations l0-l5 (far row l0-l2, near row l3-l5) on a support, at a level (5 cm layers).\n"
             f"(define (domain {domain_name(rules)})\n"
             f"  (:requirements {requirements})\n"
-            "  (:types block location layer position - object cube stick - block)\n"
+            # one line per parent type: pddlgym's parser reads a parent's name up to the end of its line
+            "  (:types\n    block location layer position - object\n    cube stick - block)\n"
             f"  (:constants {locs} - location {lvls} - layer {' '.join(PLACES)} - position)\n"
             "  (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer) (rests ?b - block ?h - layer)\n"
             "               (height ?l - location ?h - layer) (beneath ?l - location ?h - layer) (place ?b - block ?p - position)\n"

@@ -151,6 +151,21 @@ def test_the_domain_is_small_plain_strips(world_rules):
         assert word not in text
 
 
+def test_rules_that_write_the_same_action_write_it_once(world_rules):
+    """Rules whose keys differ only in what the PDDL leaves unsaid give one schema, which names the others."""
+    from pddl_export.lifted_writer import rule_schema, schemas
+    written = schemas(world_rules)
+    bodies = [(s.params, s.pre, s.eff) for s in written]
+    assert len(set(bodies)) == len(bodies)
+    every = [rule_schema(world_rules, r, i) for i, r in enumerate(world_rules.rules)]
+    assert {(s.params, s.pre, s.eff) for s in every} == set(bodies)
+    dropped = {s.name for s in every} - {s.name for s in written}
+    assert len(dropped) == len(every) - len(written)
+    named = [n for s in written if "stands for " in s.text.split("\n", 1)[0]
+             for n in s.text.split("\n", 1)[0].split("stands for ", 1)[1].split(", ")]
+    assert sorted(named) == sorted(dropped)
+
+
 def test_pddl_successors_are_the_rules(pair_rules):
     """Every applicable ground action of the PDDL leads where the rules lead, for every action of sampled states."""
     from unified_planning.io import PDDLReader
@@ -212,6 +227,44 @@ def test_stock_planners_plan_a_tower_the_rules_build(world_rules, tmp_path, plan
         pieces, rule = world_rules.step_pieces(pieces, a)
         assert rule is not None
     assert [(p.loc, p.level) for p in pieces[1:]] == [(0, 2), (0, 4)]
+
+
+def _pddlgym_env(domain, problems_dir):
+    import warnings
+    with warnings.catch_warnings():  # gym 0.26 warns on import that it is unmaintained
+        warnings.simplefilter("ignore")
+        from pddlgym.core import PDDLEnv
+    return PDDLEnv(str(domain), str(problems_dir), operators_as_actions=True, dynamic_action_space=True)
+
+
+def test_pddlgym_loads_the_domain_and_steps_to_the_goal_as_the_rules_do(world_rules, tmp_path):
+    """pddlgym (its own parser and successor function) reads the lifted domain; the ground actions it offers at
+    the start are the robot actions the rules allow; Fast Downward's plan, stepped in pddlgym, reaches the goal."""
+    from search.stock_planners import solve_files
+    types = [ObjectType.CUBE, ObjectType.CUBE, ObjectType.STICK]
+    start_state = drop_all([(t, loc) for t, loc in zip(types, (3, 4, 1))])
+    goal_state = act(act(start_state, types, 4, 3), types, 1, 5)
+    start = [located_code(start_state, types, i) for i in range(3)]
+    goal = SymbolicGoal(tuple(located_code(goal_state, types, i) for i in range(3)))
+    (tmp_path / "problems").mkdir()
+    (tmp_path / "domain.pddl").write_text(domain_pddl(world_rules))
+    (tmp_path / "problems" / "p01.pddl").write_text(problem_pddl(world_rules, start, goal, "p01"))
+    env = _pddlgym_env(tmp_path / "domain.pddl", tmp_path / "problems")
+    obs, _ = env.reset()
+    offered = env.action_space.all_ground_literals(obs)
+    step = lambda lit: f"({lit.predicate.name} {' '.join(v.name for v in lit.variables)})"  # noqa: E731
+    allowed = {a for a in range(36) if world_rules.step_pieces(world_rules.pieces(start), a)[1] is not None}
+    assert {plan_actions(world_rules, [step(lit)])[0] for lit in offered} == allowed
+    res = solve_files(tmp_path / "domain.pddl", tmp_path / "problems" / "p01.pddl", "fd-lama-first",
+                      timeout_s=120, action_id=lambda s: plan_actions(world_rules, [s])[0])
+    assert res.found and len(res.steps) == 2, res.message
+    done = False
+    for text in res.steps:
+        by_text = {step(lit).lower(): lit for lit in env.action_space.all_ground_literals(obs)}
+        obs, reward, done, *_ = env.step(by_text[" ".join(text.lower().split())])
+    assert done and reward == 1.0
+    facts = {str(lit) for lit in obs.literals}
+    assert "at(o0:cube,l3:location)" in facts and "at(o2:stick,l5:location)" in facts
 
 
 def test_export_lifted_and_plan_with_stock_fast_downward_on_a_tiny_run(tiny_run_copy, tiny_data, tmp_path):

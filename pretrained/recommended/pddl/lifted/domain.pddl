@@ -2,7 +2,9 @@
 ; Blocks stand at locations l0-l5 (far row l0-l2, near row l3-l5) on a support, at a level (5 cm layers).
 (define (domain symlearn-18611ae04934889b)
   (:requirements :strips :typing)
-  (:types block location layer position - object cube stick - block)
+  (:types
+    block location layer position - object
+    cube stick - block)
   (:constants l0 l1 l2 l3 l4 l5 - location h0 h1 h2 h3 h4 h5 h6 h7 - layer on-spot minus-y-near minus-y-mid minus-y-far plus-y-near plus-y-mid plus-y-far off-x - position)
   (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer) (rests ?b - block ?h - layer)
                (height ?l - location ?h - layer) (beneath ?l - location ?h - layer) (place ?b - block ?p - position)
@@ -56,36 +58,8 @@
       (height ?from h0)
       (not (height ?to h0))
       (height ?to h2)))
-  ; rule of 135 observed moves; a cube lands on its release location at level 3
+  ; rule of 135 observed moves; a cube lands on its release location at level 3; it also stands for pick-release-cube-3
   (:action pick-release-cube-2
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and
-      (at ?o ?from)
-      (level ?o h2)
-      (rests ?o h0)
-      (place ?o on-spot)
-      (differ ?from ?to)
-      (height ?from h2)
-      (height ?to h1))
-    :effect (and
-      (not (at ?o ?from))
-      (at ?o ?to)
-      (not (rests ?o h0))
-      (rests ?o h1)
-      (not (level ?o h2))
-      (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (no-bit-5 ?o)
-      (not (bit-5 ?o))
-      (not (height ?from h2))
-      (height ?from h0)
-      (not (height ?to h1))
-      (height ?to h3)))
-  ; rule of 808 observed moves; a cube lands on its release location at level 3
-  (:action pick-release-cube-3
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -276,7 +250,7 @@
       (height ?from h0)
       (not (height ?to h0))
       (height ?to h2)))
-  ; rule of 53 observed moves; a cube lands on its release location at level 2
+  ; rule of 53 observed moves; a cube lands on its release location at level 2; it also stands for pick-release-cube-11
   (:action pick-release-cube-10
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
@@ -304,35 +278,7 @@
       (height ?from h1)
       (not (height ?to h0))
       (height ?to h2)))
-  ; rule of 574 observed moves; a cube lands on its release location at level 2
-  (:action pick-release-cube-11
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and
-      (at ?o ?from)
-      (level ?o h3)
-      (rests ?o h1)
-      (place ?o on-spot)
-      (differ ?from ?to)
-      (height ?from h3)
-      (height ?to h0))
-    :effect (and
-      (not (at ?o ?from))
-      (at ?o ?to)
-      (not (rests ?o h1))
-      (rests ?o h0)
-      (not (level ?o h3))
-      (level ?o h2)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (no-bit-5 ?o)
-      (not (bit-5 ?o))
-      (not (height ?from h3))
-      (height ?from h1)
-      (not (height ?to h0))
-      (height ?to h2)))
-  ; rule of 14 observed moves; a cube lands on its release location at level 3
+  ; rule of 14 observed moves; a cube lands on its release location at level 3; it also stands for pick-release-cube-13
   (:action pick-release-cube-12
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
@@ -356,60 +302,8 @@
       (height ?from h1)
       (not (height ?to h1))
       (height ?to h3)))
-  ; rule of 21 observed moves; a cube lands on its release location at level 3
-  (:action pick-release-cube-13
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and
-      (at ?o ?from)
-      (level ?o h3)
-      (rests ?o h1)
-      (place ?o on-spot)
-      (differ ?from ?to)
-      (height ?from h3)
-      (height ?to h1))
-    :effect (and
-      (not (at ?o ?from))
-      (at ?o ?to)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (no-bit-5 ?o)
-      (not (bit-5 ?o))
-      (not (height ?from h3))
-      (height ?from h1)
-      (not (height ?to h1))
-      (height ?to h3)))
-  ; rule of 18 observed moves; a cube lands on its release location at level 4
+  ; rule of 18 observed moves; a cube lands on its release location at level 4; it also stands for pick-release-cube-15
   (:action pick-release-cube-14
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and
-      (at ?o ?from)
-      (level ?o h3)
-      (rests ?o h1)
-      (place ?o on-spot)
-      (differ ?from ?to)
-      (height ?from h3)
-      (height ?to h2))
-    :effect (and
-      (not (at ?o ?from))
-      (at ?o ?to)
-      (not (rests ?o h1))
-      (rests ?o h2)
-      (not (level ?o h3))
-      (level ?o h4)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (no-bit-5 ?o)
-      (not (bit-5 ?o))
-      (not (height ?from h3))
-      (height ?from h1)
-      (not (height ?to h2))
-      (height ?to h4)))
-  ; rule of 126 observed moves; a cube lands on its release location at level 4
-  (:action pick-release-cube-15
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -464,36 +358,8 @@
       (height ?from h2)
       (not (height ?to h0))
       (height ?to h2)))
-  ; rule of 31 observed moves; a cube lands on its release location at level 3
+  ; rule of 31 observed moves; a cube lands on its release location at level 3; it also stands for pick-release-cube-18
   (:action pick-release-cube-17
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and
-      (at ?o ?from)
-      (level ?o h4)
-      (rests ?o h2)
-      (place ?o on-spot)
-      (differ ?from ?to)
-      (height ?from h4)
-      (height ?to h1))
-    :effect (and
-      (not (at ?o ?from))
-      (at ?o ?to)
-      (not (rests ?o h2))
-      (rests ?o h1)
-      (not (level ?o h4))
-      (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (no-bit-5 ?o)
-      (not (bit-5 ?o))
-      (not (height ?from h4))
-      (height ?from h2)
-      (not (height ?to h1))
-      (height ?to h3)))
-  ; rule of 114 observed moves; a cube lands on its release location at level 3
-  (:action pick-release-cube-18
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
