@@ -1,14 +1,18 @@
-"""Whole-call planning time of the learned-net A* and the rule-based planners where search is hard.
+"""Whole-call planning time of a learned-net A* and the rule-based planners where search is hard.
 
-On problems of 4-5 objects and reference plans of 5 or more actions, every planner plans from the
-same start and goal codes (each problem's scenes are encoded once in the simulator), and the whole
-planner call is timed: writing the task, starting the process, searching and reading the plan back.
-Reports per planner the median whole-call time (time-outs count as their time), the number solved,
-the ratio A* median / planner median and the fastest rule-based planner. Without --problems, a small
-set is generated into OUT's folder first.
+On problems of 4-5 objects and reference plans of 5 or more actions (or, with --by shortest, shortest plans
+of that length), every planner plans from the same start and goal codes (each problem's scenes are encoded
+once in the simulator), and the whole planner call is timed: writing the task, starting the process,
+searching and reading the plan back. Reports per planner the median whole-call time (time-outs count as
+their time), the number solved, the ratio baseline median / planner median (the baseline: --baseline, the
+learned-net `astar` unless told) and the fastest other planner; and the same medians per cell of object
+count x plan length, to show how each grows and where they cross. Without --problems, a small set is
+generated into OUT's folder first.
 
     python bench/depth_speed.py --run pretrained/quick-authors12k --timeout 30 --out bench/results/depth_speed.json
     python bench/depth_speed.py --run runs/paper --problems problems/o4-l5,problems/o5-l7 --out depth.json
+    python bench/depth_speed.py --run RUN --problems problems/test,problems/zeroshot --objects 1-8 --by shortest \
+        --min-length 1 --baseline astar-outcomes --planners fast-downward-lifted --timeout 10 --out scale.json
 """
 from __future__ import annotations
 
@@ -26,14 +30,21 @@ def _range(text: str) -> tuple[int, int]:
     return int(lo), int(hi or lo)
 
 
-def select(folders: list[Path], objects: tuple[int, int], min_length: int) -> list[tuple[str, object]]:
-    """(label, problem) for the problems of the folders with objects[0]..objects[1] objects and a long reference."""
+def plan_length(problem, by: str) -> int | None:
+    """The length a problem is placed by: its reference (generator) plan's, or its shortest plan's (None: unknown)."""
+    return problem.generator_length if by == "reference" else problem.optimal_length
+
+
+def select(folders: list[Path], objects: tuple[int, int], min_length: int,
+           by: str = "reference") -> list[tuple[str, object]]:
+    """(label, problem) for the problems of the folders with objects[0]..objects[1] objects and a long plan."""
     from symlearn.problems.problem import load_problems
 
     out = []
     for d in folders:
         for _, p in load_problems(d):
-            if objects[0] <= p.k <= objects[1] and p.generator_length >= min_length:
+            length = plan_length(p, by)
+            if objects[0] <= p.k <= objects[1] and length is not None and length >= min_length:
                 out.append((f"{d.name}/{p.name}" if len(folders) > 1 else p.name, p))
     return out
 
@@ -58,6 +69,7 @@ def time_planners(run: Path, problems: list, planners: list[str], timeout_s: flo
             goal = symbolic_goal(sim, encoder, problem)
             start = scene_codes(sim, encoder, problem.initial)
             rec = {"problem": label, "n_objects": problem.k, "reference_length": problem.generator_length,
+                   "shortest_length": problem.optimal_length,
                    "start": [int(c) for c in start], "goal": list(goal.codes), "planners": {}}
             for name in planners:
                 t = time.perf_counter()
@@ -72,8 +84,7 @@ def time_planners(run: Path, problems: list, planners: list[str], timeout_s: flo
     return records
 
 
-def summarize(records: list[dict], planners: list[str]) -> dict:
-    """Per planner: median whole-call time, solved count, median over solved calls; ratios to A*; the fastest."""
+def _medians(records: list[dict], planners: list[str], baseline: str) -> dict:
     per = {}
     for name in planners:
         runs = [r["planners"][name] for r in records]
@@ -81,12 +92,29 @@ def summarize(records: list[dict], planners: list[str]) -> dict:
         per[name] = {"n": len(runs), "solved": len(solved),
                      "median_time_s": round(statistics.median(x["time_s"] for x in runs), 4) if runs else None,
                      "median_solved_time_s": round(statistics.median(solved), 4) if solved else None}
-    base = per["astar"]["median_time_s"]
+    base = per[baseline]["median_time_s"]
     for name, s in per.items():
-        s["astar_over_planner"] = round(base / s["median_time_s"], 3) if base and s["median_time_s"] else None
-    rules = [n for n in planners if n != "astar" and per[n]["median_time_s"] is not None]
-    fastest = min(rules, key=lambda n: (per[n]["median_time_s"], -per[n]["solved"])) if rules else None
-    return {"planners": per, "fastest_rule_planner": fastest}
+        s["baseline_over_planner"] = round(base / s["median_time_s"], 3) if base and s["median_time_s"] else None
+    return per
+
+
+LENGTH_CELLS = ((1, 2), (3, 4), (5, 6), (7, 8), (9, 12))
+
+
+def summarize(records: list[dict], planners: list[str], baseline: str = "astar", by: str = "reference") -> dict:
+    """Per planner: median whole-call time, solved count, median over solved calls; ratios to the baseline; the
+    fastest other planner; the same medians per cell of object count x plan length (`by_cell`)."""
+    per = _medians(records, planners, baseline)
+    others = [n for n in planners if n != baseline and per[n]["median_time_s"] is not None]
+    fastest = min(others, key=lambda n: (per[n]["median_time_s"], -per[n]["solved"])) if others else None
+    key = "reference_length" if by == "reference" else "shortest_length"
+    cells = {}
+    for k in sorted({r["n_objects"] for r in records}):
+        for lo, hi in LENGTH_CELLS:
+            rows = [r for r in records if r["n_objects"] == k and r[key] is not None and lo <= r[key] <= hi]
+            if rows:
+                cells[f"k{k} {lo}-{hi}"] = _medians(rows, planners, baseline)
+    return {"baseline": baseline, "planners": per, "fastest_other_planner": fastest, "by_cell": cells}
 
 
 def main() -> None:
@@ -95,7 +123,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--run", type=Path, required=True, help="run with best.pt, transition.pt and pddl/rules.json")
     ap.add_argument("--problems", help="comma-separated problem folders (default: generate a set beside --out)")
-    ap.add_argument("--planners", default=",".join(RULE_PLANNERS), help="rule-based planners (astar always runs)")
+    ap.add_argument("--planners", default=",".join(RULE_PLANNERS), help="planners timed against the baseline")
+    ap.add_argument("--baseline", default="astar", help="the planner the others are compared with (default astar)")
+    ap.add_argument("--by", choices=("reference", "shortest"), default="reference",
+                    help="place problems by their reference plan's length or their shortest plan's")
     ap.add_argument("--objects", type=_range, default=(4, 5), help="objects per problem, e.g. 4-5")
     ap.add_argument("--length", type=_range, default=(5, 8), help="reference lengths generated, e.g. 5-8")
     ap.add_argument("--min-length", type=int, default=5, help="shortest reference length kept")
@@ -108,7 +139,7 @@ def main() -> None:
     import torch
 
     torch.set_num_threads(1)
-    planners = ["astar"] + [p for p in args.planners.split(",") if p and p != "astar"]
+    planners = [args.baseline] + [p for p in args.planners.split(",") if p and p != args.baseline]
     if args.problems:
         folders = [Path(p) for p in args.problems.split(",") if p]
     else:
@@ -116,23 +147,26 @@ def main() -> None:
 
         folders = [args.out.parent / f"{args.out.stem}_problems"]
         generate_problems(folders[0], args.n, objects=args.objects, length=args.length, seed=args.seed)
-    problems = select(folders, args.objects, args.min_length)
+    problems = select(folders, args.objects, args.min_length, args.by)
     if not problems:
-        raise SystemExit(f"no problem of {args.objects[0]}-{args.objects[1]} objects and reference length "
+        raise SystemExit(f"no problem of {args.objects[0]}-{args.objects[1]} objects and {args.by} length "
                          f">= {args.min_length} in {', '.join(map(str, folders))}")
     t0 = time.perf_counter()
     records = time_planners(args.run, problems, planners, args.timeout, args.budget)
     result = {"run": str(args.run), "problems": [str(d) for d in folders], "n_selected": len(problems),
               "n_timed": len(records), "objects": list(args.objects), "min_length": args.min_length,
-              "timeout_s": args.timeout, "torch_threads": 1, "wall_time_s": round(time.perf_counter() - t0, 1),
-              **bench_context(), **summarize(records, planners), "records": records}
+              "by": args.by, "timeout_s": args.timeout, "torch_threads": 1,
+              "wall_time_s": round(time.perf_counter() - t0, 1), **bench_context(),
+              **summarize(records, planners, args.baseline, args.by), "records": records}
     atomic_write_json(args.out, result)
-    print(f"\n{'planner':<24}{'solved':>8}{'median s':>10}{'solved med s':>14}{'A*/planner':>12}")
-    for name, s in result["planners"].items():
-        cells = [f"{s['solved']}/{s['n']}", s["median_time_s"], s["median_solved_time_s"], s["astar_over_planner"]]
-        print(f"{name:<24}{cells[0]:>8}" + "".join(f"{'-' if v is None else f'{v:.3f}':>{w}}"
-                                                  for v, w in zip(cells[1:], (10, 14, 12))))
-    print(f"fastest rule-based planner: {result['fastest_rule_planner']}\nwrote {args.out}")
+    for title, per in [("all", result["planners"])] + list(result["by_cell"].items()):
+        print(f"\n{title}\n{'planner':<32}{'solved':>8}{'median s':>10}{'solved med s':>14}{'base/planner':>14}")
+        for name, s in per.items():
+            cells = [f"{s['solved']}/{s['n']}", s["median_time_s"], s["median_solved_time_s"],
+                     s["baseline_over_planner"]]
+            print(f"{name:<32}{cells[0]:>8}" + "".join(f"{'-' if v is None else f'{v:.3f}':>{w}}"
+                                                      for v, w in zip(cells[1:], (10, 14, 14))))
+    print(f"fastest planner against {args.baseline}: {result['fastest_other_planner']}\nwrote {args.out}")
 
 
 if __name__ == "__main__":

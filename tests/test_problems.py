@@ -102,7 +102,7 @@ def test_on_locations_redraws_a_walk_that_leaves_a_stick_off_the_locations(tmp_p
         generate_problems(tmp_path / "on", 1, objects=(1, 1), length=(1, 2), seed=0, sim=sim, stratify=True)
 
 
-@pytest.mark.parametrize("objects, length", [((0, 2), (1, 2)), ((3, 6), (1, 2)), ((2, 1), (1, 2)),
+@pytest.mark.parametrize("objects, length", [((0, 2), (1, 2)), ((3, 9), (1, 2)), ((2, 1), (1, 2)),
                                              ((1, 3), (0, 2)), ((1, 3), (3, 2))])
 def test_problem_config_refuses_bad_ranges(objects, length):
     with pytest.raises(ValueError, match="range"):

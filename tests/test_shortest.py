@@ -1,4 +1,4 @@
-"""Shortest plans: the stacking model's rules, scenes read as states, the breadth-first search, the problem
+"""Shortest plans: the stacking model's rules, scenes read as states, the A* search, the problem
 file's fields, the check against the simulator, and stratified sets (cells, dev/test disjoint, resume)."""
 from __future__ import annotations
 
@@ -114,6 +114,49 @@ def test_free_objects_are_not_judged_and_any_of_them_may_hold_a_judged_one_up():
     sp = shortest_plan(_problem(spec, goal, free=(1, 2)))
     assert sp.length == 2  # any cube to 1, then object 0 onto it
     assert shortest_plan(_problem(spec, goal)).length == 3  # all judged: 1 to location 1, 0 onto it, 2 to 4
+
+
+def _bfs_length(start, types, want, max_length=12):
+    """The shortest plan's length by plain breadth-first search (the reference the A* search must match)."""
+    meets = lambda st: all(st[i].location == loc and levels(st, types)[i] == layer  # noqa: E731
+                           for i, (loc, layer) in want.items())
+    seen, frontier = {start}, [start]
+    for depth in range(max_length + 1):
+        if any(meets(st) for st in frontier):
+            return depth
+        nxt = [c for st in frontier for _, c in successors(st, types) if c not in seen]
+        seen.update(nxt)
+        frontier = list(dict.fromkeys(nxt))
+    return None
+
+
+def test_the_a_star_search_finds_what_breadth_first_search_finds_and_its_bound_holds():
+    """On random problems of 1-5 objects (sticks, riders, free objects), the A* search's length is the
+    breadth-first one, and the lower bound it is guided by never exceeds the actions still needed."""
+    import numpy as np
+
+    from symlearn.problems.shortest import lower_bound
+    rng = np.random.default_rng(7)
+    checked = 0
+    while checked < 40:
+        k = int(rng.integers(1, 6))
+        types = [S if i == 0 and rng.random() < 0.6 else C for i in range(k)]
+        spec = [(t, int(rng.choice((3, 4, 5)))) for t in types]
+        goal = drop_all(spec)
+        for _ in range(int(rng.integers(1, 9))):
+            moves = list(successors(goal, types))
+            goal = moves[int(rng.integers(len(moves)))][1] if moves else goal
+        free = tuple(i for i in range(1, k) if rng.random() < 0.2)  # object 0 always judged
+        p = _problem(spec, goal, free=free)
+        want = {i: (goal[i].location, levels(goal, types)[i]) for i in range(k) if i not in free}
+        sp = shortest_plan(p)
+        assert sp.length == _bfs_length(drop_all(spec), types, want), (spec, goal, free)
+        state = drop_all(spec)  # along the plan, the bound never exceeds the actions left
+        for n, a in enumerate(sp.plan):
+            assert lower_bound(state, types, want) <= sp.length - n
+            state = act(state, types, a // 6, a % 6)
+        assert lower_bound(state, types, want) == 0
+        checked += 1
 
 
 def test_undecidable_problems_say_why_and_have_no_length():

@@ -60,7 +60,7 @@ def drop_all(spec) -> State:
     return tuple(state)
 
 
-def _carried(state: State, i: int) -> list[int]:
+def carried(state: State, i: int) -> list[int]:
     """Everything standing on object i, directly or not."""
     out, frontier = [], [i]
     while frontier:
@@ -77,7 +77,7 @@ def act(state: State, types, pick: int, release: int) -> State:
     if held is None or held[1]:
         raise ValueError(f"pick at {pick} takes nothing, or a stick by its end")
     i = held[0]
-    riders = _carried(state, i)
+    riders = carried(state, i)
     new = list(state)
     for r in riders:
         g = state[r]

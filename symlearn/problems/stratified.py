@@ -50,6 +50,7 @@ OFF_WALK_LENGTH = (1, 8)  # walk lengths drawn for the off-location cell
 SOURCES = ("walk", "structure", "aimed")
 AIMED_WALK = "aimed-walk"  # the task of a walk aimed at a state of the model
 AIMED_START_WALK = 8  # an aimed walk starts after 0..8 random actions from the dropped scene
+AIMED_MAX_STATES = 200_000  # an aimed walk lists the model's states up to cell.hi actions away, at most this many
 PER_CELL = 10  # problems per cell unless asked otherwise (`symlearn problems`, the recommended pipeline)
 OBJECTS = (1, 5)  # the object range stratified unless asked otherwise: every scene size the data sets hold
 
@@ -130,6 +131,8 @@ def _aimed(sim, rng: np.random.Generator, cell: Cell, name: str, seed: int) -> P
                 if child not in parent:
                     parent[child] = (state, a)
                     nxt.append(child)
+        if len(parent) > AIMED_MAX_STATES:  # 6-8 objects: the states within reach are too many to list
+            return None
         if depth >= cell.lo:
             deep += nxt
         frontier = nxt
@@ -161,6 +164,8 @@ def draw(sim, cell: Cell, i: int, attempt: int, seed: int) -> Problem | None:
             return generate_problem(sim, rng, cfg, name, seed)
         if source == "structure":
             templates = fitting_templates((cell.k, cell.k))
+            if not templates:  # the suite's tasks hold at most 5 objects
+                return None
             template = templates[int(rng.integers(len(templates)))]
             return structure_problem(sim, template, (cell.k, cell.k), rng, name, seed)
         return _aimed(sim, rng, cell, name, seed)
