@@ -22,7 +22,7 @@ import numpy as np
 from pddl_export.files import atomic_write_text, sha256_file
 from pddl_export.lifted_rules import LiftedRules, build_codebook, distil_lifted, observed_moves, stick_reader
 from pddl_export.lifted_scene import FIELD_BITS, CodeLayout, kept_bits
-from pddl_export.lifted_writer import domain_pddl
+from pddl_export.lifted_writer import domain_pddl, schemas
 from pddl_export.rules_io import PDDL_DIR
 from pddl_export.symbolic import bits_from_codes
 from symlearn.provenance import atomic_write_json, versions
@@ -159,7 +159,7 @@ def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = 
               "data_fingerprint": data_fingerprint(data_dir), "extra_data": data_records(extra_data),
               "kept_bits": list(layout.kept), "position_bits": [b for b in range(code_bits) if b not in layout.kept],
               "moves_not_described": dict(why), "checks_test_split": checks, "domain_bytes": len(domain.encode()),
-              "n_schemas": len(rules.rules), "seconds": round(time.perf_counter() - t0, 1),
+              "n_schemas": len(schemas(rules)), "seconds": round(time.perf_counter() - t0, 1),
               "distil_seconds": round(t_distil, 1), "versions": versions()}
     codebook = build_codebook(probe, np.concatenate([_pad(s.before, width) for s in train]
                                                     + [_pad(s.after, width) for s in train]),

@@ -171,6 +171,10 @@ def draw(sim, cell: Cell, i: int, attempt: int, seed: int) -> Problem | None:
         return _aimed(sim, rng, cell, name, seed)
     except RuntimeError:  # a walk or a task with no valid draw this time (the simulator refused it)
         return None
+    except ValueError as e:  # a scene the problem format refuses: with 6-8 objects, one pushed out of reach
+        if "out of the table's reach" in str(e):
+            return None
+        raise
 
 
 def _settings(n: int, objects: tuple[int, int], seed: int, exclude: list[tuple[str, str]]) -> dict:
