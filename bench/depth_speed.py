@@ -51,16 +51,14 @@ def select(folders: list[Path], objects: tuple[int, int], min_length: int,
 
 def time_planners(run: Path, problems: list, planners: list[str], timeout_s: float, budget_s: float) -> list[dict]:
     """One record per problem: each planner's status, whole-call time, plan length; stops at the time budget."""
-    from symlearn.learning.checkpoint import load_effect_model
     from symlearn.planning.execution import safe_plan
     from symlearn.planning.planners import make_planners
     from symlearn.symbolic.scenes import scene_codes, symbolic_goal
     from symlearn.sim.simulator import TabletopSimulator
-    from symlearn.symbolic.learned_transition import LearnedTransition
+    from symlearn.symbolic.learned_transition import planning_models
 
     fns = make_planners(planners, run)
-    encoder, _ = load_effect_model(run)
-    transition = LearnedTransition.from_run(run)
+    encoder, transition = planning_models(run)  # the codes m(z) plans over: with its location bits, if any
     records, t0 = [], time.perf_counter()
     with TabletopSimulator() as sim:
         for label, problem in problems:

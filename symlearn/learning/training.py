@@ -41,8 +41,10 @@ TRAIN_PRESETS = {
     "paper": dict(epochs=60, batch_size=128, lr=5e-4),
     "quick": dict(epochs=40, batch_size=64, lr=1e-3),
     # the recipe that plans best (pretrained/recommended): quick, with the stability loss that keeps the codes of
-    # objects an action left in place unchanged (docs/RESULTS.md, "Levers for symbols that plan")
-    "recommended": dict(epochs=40, batch_size=64, lr=1e-3, stability_weight=0.1),
+    # objects an action left in place unchanged (docs/RESULTS.md, "Levers for symbols that plan"), and each scene
+    # with a rider drawn three times an epoch, so that riders learn through attention (docs/RESULTS.md, "Riders");
+    # in float32, as the pipeline trains on a CPU: the setting whose three seeds met every target of Table I
+    "recommended": dict(epochs=40, batch_size=64, lr=1e-3, stability_weight=0.1, rider_scene_repeat=3, bf16=False),
 }
 
 

@@ -1,6 +1,6 @@
-; A lifted domain distilled from the transition model 18611ae04934889b by symlearn.
+; A lifted domain distilled from the transition model ef601c919d80ef7a by symlearn.
 ; Blocks stand at locations l0-l5 (far row l0-l2, near row l3-l5) on a support, at a level (5 cm layers).
-(define (domain symlearn-18611ae04934889b)
+(define (domain symlearn-ef601c919d80ef7a)
   (:requirements :strips :typing)
   (:types
     block location layer position - object
@@ -9,33 +9,9 @@
   (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer) (rests ?b - block ?h - layer)
                (height ?l - location ?h - layer) (beneath ?l - location ?h - layer) (place ?b - block ?p - position)
                (near ?l - location) (differ ?a - location ?b - location)
-               (bit-0 ?b - block) (no-bit-0 ?b - block) (bit-2 ?b - block) (no-bit-2 ?b - block) (bit-5 ?b - block) (no-bit-5 ?b - block))
-  ; rule of 19 observed moves; a cube lands on its release location at level 1
+               (bit-0 ?b - block) (no-bit-0 ?b - block) (bit-5 ?b - block) (no-bit-5 ?b - block))
+  ; rule of 4111 observed moves; a cube lands on its release location at level 2
   (:action pick-release-cube-0
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and
-      (at ?o ?from)
-      (level ?o h1)
-      (rests ?o h0)
-      (place ?o on-spot)
-      (differ ?from ?to)
-      (height ?from h1)
-      (height ?to h0))
-    :effect (and
-      (not (at ?o ?from))
-      (at ?o ?to)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (no-bit-5 ?o)
-      (not (bit-5 ?o))
-      (not (height ?from h1))
-      (height ?from h0)
-      (not (height ?to h0))
-      (height ?to h1)))
-  ; rule of 4110 observed moves; a cube lands on its release location at level 2
-  (:action pick-release-cube-1
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -50,16 +26,14 @@
       (at ?o ?to)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h2))
       (height ?from h0)
       (not (height ?to h0))
       (height ?to h2)))
-  ; rule of 135 observed moves; a cube lands on its release location at level 3; it also stands for pick-release-cube-3
-  (:action pick-release-cube-2
+  ; rule of 127 observed moves; a cube lands on its release location at level 3; it also stands for pick-release-cube-2
+  (:action pick-release-cube-1
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -78,16 +52,14 @@
       (level ?o h3)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h2))
       (height ?from h0)
       (not (height ?to h1))
       (height ?to h3)))
-  ; rule of 823 observed moves; a cube lands on its release location at level 4
-  (:action pick-release-cube-4
+  ; rule of 807 observed moves; a cube lands on its release location at level 4
+  (:action pick-release-cube-3
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -104,18 +76,16 @@
       (rests ?o h2)
       (not (level ?o h2))
       (level ?o h4)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h2))
       (height ?from h0)
       (not (height ?to h2))
       (height ?to h4)))
-  ; rule of 332 observed moves; a cube lands on its release location at level 5
-  (:action pick-release-cube-5
+  ; rule of 285 observed moves; a cube lands on its release location at level 5
+  (:action pick-release-cube-4
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -132,18 +102,16 @@
       (rests ?o h3)
       (not (level ?o h2))
       (level ?o h5)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h2))
       (height ?from h0)
       (not (height ?to h3))
       (height ?to h5)))
-  ; rule of 81 observed moves; a cube lands on its release location at level 6
-  (:action pick-release-cube-6
+  ; rule of 82 observed moves; a cube lands on its release location at level 6
+  (:action pick-release-cube-5
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -160,18 +128,16 @@
       (rests ?o h4)
       (not (level ?o h2))
       (level ?o h6)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h2))
       (height ?from h0)
       (not (height ?to h4))
       (height ?to h6)))
-  ; rule of 14 observed moves; a cube lands on its release location at level 7
-  (:action pick-release-cube-7
+  ; rule of 39 observed moves; a cube lands on its release location at level 5
+  (:action pick-release-cube-6
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -187,19 +153,15 @@
       (not (rests ?o h0))
       (rests ?o h5)
       (not (level ?o h2))
-      (level ?o h7)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
+      (level ?o h5)
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h2))
-      (height ?from h0)
-      (not (height ?to h5))
-      (height ?to h7)))
-  ; rule of 108 observed moves; a cube lands on its release location at level 2
-  (:action pick-release-cube-8
+      (height ?from h0)))
+  ; rule of 72 observed moves; a cube lands on its release location at level 2
+  (:action pick-release-cube-7
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -216,21 +178,19 @@
       (rests ?o h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h2))
       (height ?from h1)
       (not (height ?to h0))
       (height ?to h2)))
-  ; rule of 15 observed moves; a cube lands on its release location at level 2
-  (:action pick-release-cube-9
+  ; rule of 52 observed moves; a cube lands on its release location at level 2; it also stands for pick-release-cube-9
+  (:action pick-release-cube-8
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
       (level ?o h3)
-      (rests ?o h0)
+      (rests ?o h1)
       (place ?o on-spot)
       (differ ?from ?to)
       (height ?from h3)
@@ -238,19 +198,19 @@
     :effect (and
       (not (at ?o ?from))
       (at ?o ?to)
+      (not (rests ?o h1))
+      (rests ?o h0)
       (not (level ?o h3))
       (level ?o h2)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h3))
-      (height ?from h0)
+      (height ?from h1)
       (not (height ?to h0))
       (height ?to h2)))
-  ; rule of 53 observed moves; a cube lands on its release location at level 2; it also stands for pick-release-cube-11
+  ; rule of 16 observed moves; a cube lands on its release location at level 3; it also stands for pick-release-cube-11
   (:action pick-release-cube-10
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
@@ -260,25 +220,19 @@
       (place ?o on-spot)
       (differ ?from ?to)
       (height ?from h3)
-      (height ?to h0))
+      (height ?to h1))
     :effect (and
       (not (at ?o ?from))
       (at ?o ?to)
-      (not (rests ?o h1))
-      (rests ?o h0)
-      (not (level ?o h3))
-      (level ?o h2)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h3))
       (height ?from h1)
-      (not (height ?to h0))
-      (height ?to h2)))
-  ; rule of 14 observed moves; a cube lands on its release location at level 3; it also stands for pick-release-cube-13
+      (not (height ?to h1))
+      (height ?to h3)))
+  ; rule of 16 observed moves; a cube lands on its release location at level 4; it also stands for pick-release-cube-13
   (:action pick-release-cube-12
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
@@ -288,30 +242,6 @@
       (place ?o on-spot)
       (differ ?from ?to)
       (height ?from h3)
-      (height ?to h1))
-    :effect (and
-      (not (at ?o ?from))
-      (at ?o ?to)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (no-bit-5 ?o)
-      (not (bit-5 ?o))
-      (not (height ?from h3))
-      (height ?from h1)
-      (not (height ?to h1))
-      (height ?to h3)))
-  ; rule of 18 observed moves; a cube lands on its release location at level 4; it also stands for pick-release-cube-15
-  (:action pick-release-cube-14
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and
-      (at ?o ?from)
-      (level ?o h3)
-      (rests ?o h1)
-      (place ?o on-spot)
-      (differ ?from ?to)
-      (height ?from h3)
       (height ?to h2))
     :effect (and
       (not (at ?o ?from))
@@ -320,18 +250,16 @@
       (rests ?o h2)
       (not (level ?o h3))
       (level ?o h4)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h3))
       (height ?from h1)
       (not (height ?to h2))
       (height ?to h4)))
-  ; rule of 758 observed moves; a cube lands on its release location at level 2
-  (:action pick-release-cube-16
+  ; rule of 780 observed moves; a cube lands on its release location at level 2
+  (:action pick-release-cube-14
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -350,16 +278,14 @@
       (level ?o h2)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h4))
       (height ?from h2)
       (not (height ?to h0))
       (height ?to h2)))
-  ; rule of 31 observed moves; a cube lands on its release location at level 3; it also stands for pick-release-cube-18
-  (:action pick-release-cube-17
+  ; rule of 24 observed moves; a cube lands on its release location at level 3; it also stands for pick-release-cube-16
+  (:action pick-release-cube-15
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -378,16 +304,14 @@
       (level ?o h3)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h4))
       (height ?from h2)
       (not (height ?to h1))
       (height ?to h3)))
-  ; rule of 79 observed moves; a cube lands on its release location at level 4
-  (:action pick-release-cube-19
+  ; rule of 81 observed moves; a cube lands on its release location at level 4
+  (:action pick-release-cube-17
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -400,18 +324,16 @@
     :effect (and
       (not (at ?o ?from))
       (at ?o ?to)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h4))
       (height ?from h2)
       (not (height ?to h2))
       (height ?to h4)))
-  ; rule of 23 observed moves; a cube lands on its release location at level 5
-  (:action pick-release-cube-20
+  ; rule of 12 observed moves; a cube lands on its release location at level 5
+  (:action pick-release-cube-18
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -428,18 +350,16 @@
       (rests ?o h3)
       (not (level ?o h4))
       (level ?o h5)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h4))
       (height ?from h2)
       (not (height ?to h3))
       (height ?to h5)))
-  ; rule of 220 observed moves; a cube lands on its release location at level 2
-  (:action pick-release-cube-21
+  ; rule of 214 observed moves; a cube lands on its release location at level 2
+  (:action pick-release-cube-19
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -458,44 +378,40 @@
       (level ?o h2)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (no-bit-5 ?o)
       (not (bit-5 ?o))
       (not (height ?from h5))
       (height ?from h3)
       (not (height ?to h0))
       (height ?to h2)))
-  ; rule of 16 observed moves; a cube lands on its release location at level 4
-  (:action pick-release-cube-22
+  ; rule of 55 observed moves; a cube lands on its release location at level 1
+  (:action pick-release-cube-20
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
       (level ?o h5)
-      (rests ?o h3)
+      (rests ?o h4)
       (place ?o on-spot)
       (differ ?from ?to)
       (height ?from h5)
-      (height ?to h2))
+      (height ?to h0))
     :effect (and
       (not (at ?o ?from))
       (at ?o ?to)
-      (not (rests ?o h3))
-      (rests ?o h2)
+      (not (rests ?o h4))
+      (rests ?o h0)
       (not (level ?o h5))
-      (level ?o h4)
+      (level ?o h1)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (no-bit-5 ?o)
-      (not (bit-5 ?o))
+      (bit-5 ?o)
+      (not (no-bit-5 ?o))
       (not (height ?from h5))
-      (height ?from h3)
-      (not (height ?to h2))
-      (height ?to h4)))
-  ; rule of 72 observed moves; a cube lands on its release location at level 2
-  (:action pick-release-cube-23
+      (height ?from h4)
+      (not (height ?to h0))
+      (height ?to h1)))
+  ; rule of 38 observed moves; a cube lands on its release location at level 2
+  (:action pick-release-cube-21
     :parameters (?o - cube ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -503,6 +419,8 @@
       (rests ?o h4)
       (place ?o on-spot)
       (differ ?from ?to)
+      (no-bit-0 ?o)
+      (no-bit-5 ?o)
       (height ?from h6)
       (height ?to h0))
     :effect (and
@@ -514,15 +432,69 @@
       (level ?o h2)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (no-bit-5 ?o)
-      (not (bit-5 ?o))
       (not (height ?from h6))
       (height ?from h4)
       (not (height ?to h0))
       (height ?to h2)))
-  ; rule of 211 observed moves; a stick lands on its release location at level 1
+  ; rule of 33 observed moves; a cube lands on its release location at level 2
+  (:action pick-release-cube-22
+    :parameters (?o - cube ?from - location ?to - location ?u - block)
+    :precondition (and
+      (at ?o ?from)
+      (level ?o h6)
+      (rests ?o h4)
+      (place ?o on-spot)
+      (differ ?from ?to)
+      (no-bit-0 ?o)
+      (no-bit-5 ?o)
+      (height ?from h6)
+      (height ?to h0)
+      (at ?u ?from)
+      (level ?u h4)
+      (bit-0 ?u)
+      (no-bit-5 ?u))
+    :effect (and
+      (not (at ?o ?from))
+      (at ?o ?to)
+      (not (rests ?o h4))
+      (rests ?o h0)
+      (not (level ?o h6))
+      (level ?o h2)
+      (bit-0 ?o)
+      (not (no-bit-0 ?o))
+      (no-bit-0 ?u)
+      (not (bit-0 ?u))
+      (not (height ?from h6))
+      (height ?from h4)
+      (not (height ?to h0))
+      (height ?to h2)))
+  ; rule of 27 observed moves; a cube lands on its release location at level 2
+  (:action pick-release-cube-23
+    :parameters (?o - cube ?from - location ?to - location)
+    :precondition (and
+      (at ?o ?from)
+      (level ?o h7)
+      (rests ?o h5)
+      (place ?o on-spot)
+      (differ ?from ?to)
+      (height ?from h7)
+      (height ?to h0))
+    :effect (and
+      (not (at ?o ?from))
+      (at ?o ?to)
+      (not (rests ?o h5))
+      (rests ?o h0)
+      (not (level ?o h7))
+      (level ?o h2)
+      (bit-0 ?o)
+      (not (no-bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
+      (not (height ?from h7))
+      (height ?from h5)
+      (not (height ?to h0))
+      (height ?to h2)))
+  ; rule of 318 observed moves; a stick lands on its release location at level 1
   (:action pick-release-stick-24
     :parameters (?o - stick ?from - location ?to - location)
     :precondition (and
@@ -533,47 +505,21 @@
       (differ ?from ?to)
       (near ?from)
       (near ?to)
-      (bit-0 ?o)
-      (no-bit-2 ?o)
-      (bit-5 ?o)
       (height ?from h1)
       (height ?to h0))
     :effect (and
       (not (at ?o ?from))
       (at ?o ?to)
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (not (height ?from h1))
-      (height ?from h0)
-      (not (height ?to h0))
-      (height ?to h1)))
-  ; rule of 107 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-25
-    :parameters (?o - stick ?from - location ?to - location)
-    :precondition (and
-      (at ?o ?from)
-      (level ?o h1)
-      (rests ?o h0)
-      (place ?o on-spot)
-      (differ ?from ?to)
-      (near ?from)
-      (near ?to)
-      (bit-0 ?o)
-      (bit-2 ?o)
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
-      (height ?from h1)
-      (height ?to h0))
-    :effect (and
-      (not (at ?o ?from))
-      (at ?o ?to)
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (not (no-bit-5 ?o))
       (not (height ?from h1))
       (height ?from h0)
       (not (height ?to h0))
       (height ?to h1)))
   ; rule of 251 observed moves; a stick lands on its release location at level 3
-  (:action pick-release-stick-26
+  (:action pick-release-stick-25
     :parameters (?o - stick ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -592,18 +538,16 @@
       (rests ?o h2)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height ?from h1))
       (height ?from h0)
       (not (height ?to h2))
       (height ?to h3)))
   ; rule of 61 observed moves; a stick lands on its release location at level 5
-  (:action pick-release-stick-27
+  (:action pick-release-stick-26
     :parameters (?o - stick ?from - location ?to - location)
     :precondition (and
       (at ?o ?from)
@@ -622,17 +566,43 @@
       (rests ?o h4)
       (not (level ?o h1))
       (level ?o h5)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height ?from h1))
       (height ?from h0)
       (not (height ?to h4))
       (height ?to h5)))
-  ; rule of 117 observed moves; a stick lands on its release location at level 1
+  ; rule of 34 observed moves; a stick lands on its release location at level 2
+  (:action pick-release-stick-27
+    :parameters (?o - stick ?from - location ?to - location)
+    :precondition (and
+      (at ?o ?from)
+      (level ?o h3)
+      (rests ?o h1)
+      (place ?o on-spot)
+      (differ ?from ?to)
+      (near ?from)
+      (near ?to)
+      (height ?from h3)
+      (height ?to h0))
+    :effect (and
+      (not (at ?o ?from))
+      (at ?o ?to)
+      (not (rests ?o h1))
+      (rests ?o h0)
+      (not (level ?o h3))
+      (level ?o h2)
+      (bit-0 ?o)
+      (not (no-bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
+      (not (height ?from h3))
+      (height ?from h1)
+      (not (height ?to h0))
+      (height ?to h2)))
+  ; rule of 116 observed moves; a stick lands on its release location at level 1
   (:action pick-release-stick-28
     :parameters (?o - stick ?from - location ?to - location)
     :precondition (and
@@ -652,10 +622,8 @@
       (rests ?o h0)
       (not (level ?o h3))
       (level ?o h1)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height ?from h3))
@@ -678,74 +646,16 @@
     :effect (and
       (not (at ?o ?from))
       (at ?o ?to)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height ?from h3))
       (height ?from h2)
       (not (height ?to h2))
       (height ?to h3)))
-  ; rule of 33 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-30
-    :parameters (?o - stick ?from - location ?to - location)
-    :precondition (and
-      (at ?o ?from)
-      (level ?o h5)
-      (rests ?o h4)
-      (place ?o on-spot)
-      (differ ?from ?to)
-      (near ?from)
-      (near ?to)
-      (height ?from h5)
-      (height ?to h0))
-    :effect (and
-      (not (at ?o ?from))
-      (at ?o ?to)
-      (not (rests ?o h4))
-      (rests ?o h0)
-      (not (level ?o h5))
-      (level ?o h1)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
-      (not (height ?from h5))
-      (height ?from h4)
-      (not (height ?to h0))
-      (height ?to h1)))
-  ; rule of 37 observed moves; a stick ends off its release location at level 1
-  (:action pick-release-stick-31
-    :parameters (?o - stick ?from - location ?to - location)
-    :precondition (and
-      (at ?o ?from)
-      (level ?o h1)
-      (rests ?o h0)
-      (place ?o plus-y-mid)
-      (differ ?from ?to)
-      (near ?from)
-      (near ?to)
-      (height ?from h1)
-      (height ?to h0))
-    :effect (and
-      (not (at ?o ?from))
-      (at ?o ?to)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
-      (not (height ?from h1))
-      (height ?from h0)
-      (not (height ?to h0))
-      (height ?to h1)))
-  ; rule of 17 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l1-32
+  ; rule of 18 observed moves; a stick lands on its release location at level 1
+  (:action pick-release-stick-l0-l1-30
     :parameters (?o - stick)
     :precondition (and
       (at ?o l0)
@@ -764,14 +674,12 @@
       (beneath l2 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l2 h0))
       (height l2 h1)))
-  ; rule of 32 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l2-33
+  ; rule of 31 observed moves; a stick lands on its release location at level 1
+  (:action pick-release-stick-l0-l2-31
     :parameters (?o - stick)
     :precondition (and
       (at ?o l0)
@@ -787,8 +695,6 @@
       (at ?o l2)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l0 h1))
@@ -796,7 +702,7 @@
       (not (height l2 h0))
       (height l2 h1)))
   ; rule of 5 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l2-34
+  (:action pick-release-stick-l0-l2-32
     :parameters (?o - stick ?r0 - block)
     :precondition (and
       (at ?o l0)
@@ -816,16 +722,14 @@
       (at ?o l2)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (rests ?r0 h1))
       (rests ?r0 h0)
+      (not (place ?r0 on-spot))
+      (place ?r0 plus-y-far)
       (bit-0 ?r0)
       (not (no-bit-0 ?r0))
-      (bit-2 ?r0)
-      (not (no-bit-2 ?r0))
       (no-bit-5 ?r0)
       (not (bit-5 ?r0))
       (not (height l0 h1))
@@ -833,7 +737,7 @@
       (not (height l2 h0))
       (height l2 h1)))
   ; rule of 11 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l3-35
+  (:action pick-release-stick-l0-l3-33
     :parameters (?o - stick)
     :precondition (and
       (at ?o l0)
@@ -848,10 +752,8 @@
       (not (beneath l1 h0))
       (not (at ?o l0))
       (at ?o l3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l0 h1))
@@ -860,8 +762,48 @@
       (height l1 h0)
       (not (height l3 h0))
       (height l3 h1)))
-  ; rule of 13 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l4-36
+  ; rule of 3 observed moves; a stick lands on its release location at level 1
+  (:action pick-release-stick-l0-l3-34
+    :parameters (?o - stick ?r0 - block)
+    :precondition (and
+      (at ?o l0)
+      (level ?o h1)
+      (rests ?o h0)
+      (place ?o on-spot)
+      (at ?r0 l1)
+      (level ?r0 h3)
+      (rests ?r0 h1)
+      (place ?r0 on-spot)
+      (beneath l1 h0)
+      (height l0 h1)
+      (height l1 h3)
+      (height l3 h0))
+    :effect (and
+      (not (beneath l1 h0))
+      (not (at ?o l0))
+      (at ?o l3)
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (bit-5 ?o)
+      (not (no-bit-5 ?o))
+      (not (rests ?r0 h1))
+      (rests ?r0 h0)
+      (not (at ?r0 l1))
+      (at ?r0 l4)
+      (not (place ?r0 on-spot))
+      (place ?r0 minus-y-mid)
+      (bit-0 ?r0)
+      (not (no-bit-0 ?r0))
+      (no-bit-5 ?r0)
+      (not (bit-5 ?r0))
+      (not (height l0 h1))
+      (height l0 h0)
+      (not (height l1 h3))
+      (height l1 h0)
+      (not (height l3 h0))
+      (height l3 h1)))
+  ; rule of 14 observed moves; a stick lands on its release location at level 1
+  (:action pick-release-stick-l0-l4-35
     :parameters (?o - stick)
     :precondition (and
       (at ?o l0)
@@ -876,10 +818,8 @@
       (not (beneath l1 h0))
       (not (at ?o l0))
       (at ?o l4)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l0 h1))
@@ -889,7 +829,7 @@
       (not (height l4 h0))
       (height l4 h1)))
   ; rule of 4 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l4-37
+  (:action pick-release-stick-l0-l4-36
     :parameters (?o - stick ?r0 - block)
     :precondition (and
       (at ?o l0)
@@ -908,10 +848,8 @@
       (not (beneath l1 h0))
       (not (at ?o l0))
       (at ?o l4)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (rests ?r0 h1))
@@ -922,8 +860,6 @@
       (place ?r0 minus-y-mid)
       (bit-0 ?r0)
       (not (no-bit-0 ?r0))
-      (bit-2 ?r0)
-      (not (no-bit-2 ?r0))
       (no-bit-5 ?r0)
       (not (bit-5 ?r0))
       (not (height l0 h1))
@@ -933,7 +869,7 @@
       (not (height l4 h0))
       (height l4 h1)))
   ; rule of 10 observed moves; a stick lands on its release location at level 3
-  (:action pick-release-stick-l0-l4-38
+  (:action pick-release-stick-l0-l4-37
     :parameters (?o - stick)
     :precondition (and
       (at ?o l0)
@@ -952,12 +888,10 @@
       (rests ?o h2)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height l0 h1))
       (height l0 h0)
       (not (height l1 h1))
@@ -965,7 +899,7 @@
       (not (height l4 h2))
       (height l4 h3)))
   ; rule of 14 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l5-39
+  (:action pick-release-stick-l0-l5-38
     :parameters (?o - stick)
     :precondition (and
       (at ?o l0)
@@ -980,10 +914,8 @@
       (not (beneath l1 h0))
       (not (at ?o l0))
       (at ?o l5)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l0 h1))
@@ -992,7 +924,43 @@
       (height l1 h0)
       (not (height l5 h0))
       (height l5 h1)))
-  ; rule of 20 observed moves; a stick lands on its release location at level 1
+  ; rule of 3 observed moves; a stick lands on its release location at level 1
+  (:action pick-release-stick-l0-l5-39
+    :parameters (?o - stick ?r0 - block)
+    :precondition (and
+      (at ?o l0)
+      (level ?o h1)
+      (rests ?o h0)
+      (place ?o on-spot)
+      (at ?r0 l1)
+      (level ?r0 h3)
+      (rests ?r0 h1)
+      (place ?r0 on-spot)
+      (beneath l1 h0)
+      (height l0 h1)
+      (height l1 h3)
+      (height l5 h0))
+    :effect (and
+      (not (beneath l1 h0))
+      (not (at ?o l0))
+      (at ?o l5)
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (bit-5 ?o)
+      (not (no-bit-5 ?o))
+      (not (rests ?r0 h1))
+      (rests ?r0 h0)
+      (not (place ?r0 on-spot))
+      (place ?r0 plus-y-far)
+      (bit-0 ?r0)
+      (not (no-bit-0 ?r0))
+      (no-bit-5 ?r0)
+      (not (bit-5 ?r0))
+      (not (height l0 h1))
+      (height l0 h0)
+      (not (height l5 h0))
+      (height l5 h1)))
+  ; rule of 21 observed moves; a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l0-40
     :parameters (?o - stick)
     :precondition (and
@@ -1013,13 +981,11 @@
       (beneath l1 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l2 h1))
       (height l2 h0)))
-  ; rule of 24 observed moves; a stick lands on its release location at level 1
+  ; rule of 25 observed moves; a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l2-41
     :parameters (?o - stick)
     :precondition (and
@@ -1040,13 +1006,11 @@
       (beneath l1 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l0 h1))
       (height l0 h0)))
-  ; rule of 4 observed moves; a stick lands on its release location at level 1
+  ; rule of 3 observed moves; a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l2-42
     :parameters (?o - stick ?r0 - block)
     :precondition (and
@@ -1071,18 +1035,14 @@
       (beneath l1 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (rests ?r0 h1))
       (rests ?r0 h0)
       (not (place ?r0 on-spot))
-      (place ?r0 plus-y-near)
-      (bit-0 ?r0)
-      (not (no-bit-0 ?r0))
-      (bit-2 ?r0)
-      (not (no-bit-2 ?r0))
+      (place ?r0 plus-y-far)
+      (no-bit-0 ?r0)
+      (not (bit-0 ?r0))
       (no-bit-5 ?r0)
       (not (bit-5 ?r0))
       (not (height l0 h1))
@@ -1106,10 +1066,8 @@
       (not (beneath l2 h0))
       (not (at ?o l1))
       (at ?o l3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l1 h1))
@@ -1139,10 +1097,8 @@
       (not (beneath l2 h0))
       (not (at ?o l1))
       (at ?o l4)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l1 h1))
@@ -1153,41 +1109,8 @@
       (height l2 h0)
       (not (height l4 h0))
       (height l4 h1)))
-  ; rule of 10 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l1-l5-45
-    :parameters (?o - stick)
-    :precondition (and
-      (at ?o l1)
-      (level ?o h1)
-      (rests ?o h0)
-      (place ?o on-spot)
-      (beneath l0 h0)
-      (beneath l2 h0)
-      (height l1 h1)
-      (height l0 h1)
-      (height l2 h1)
-      (height l5 h0))
-    :effect (and
-      (not (beneath l0 h0))
-      (not (beneath l2 h0))
-      (not (at ?o l1))
-      (at ?o l5)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
-      (not (height l1 h1))
-      (height l1 h0)
-      (not (height l0 h1))
-      (height l0 h0)
-      (not (height l2 h1))
-      (height l2 h0)
-      (not (height l5 h0))
-      (height l5 h1)))
   ; rule of 23 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l0-46
+  (:action pick-release-stick-l2-l0-45
     :parameters (?o - stick)
     :precondition (and
       (at ?o l2)
@@ -1203,8 +1126,6 @@
       (at ?o l0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l2 h1))
@@ -1212,7 +1133,7 @@
       (not (height l0 h0))
       (height l0 h1)))
   ; rule of 3 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l0-47
+  (:action pick-release-stick-l2-l0-46
     :parameters (?o - stick ?r0 - block)
     :precondition (and
       (at ?o l2)
@@ -1230,10 +1151,8 @@
     :effect (and
       (not (at ?o l2))
       (at ?o l0)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (rests ?r0 h1))
@@ -1242,8 +1161,6 @@
       (place ?r0 minus-y-far)
       (bit-0 ?r0)
       (not (no-bit-0 ?r0))
-      (bit-2 ?r0)
-      (not (no-bit-2 ?r0))
       (no-bit-5 ?r0)
       (not (bit-5 ?r0))
       (not (height l2 h1))
@@ -1251,7 +1168,7 @@
       (not (height l0 h0))
       (height l0 h1)))
   ; rule of 21 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l1-48
+  (:action pick-release-stick-l2-l1-47
     :parameters (?o - stick)
     :precondition (and
       (at ?o l2)
@@ -1270,13 +1187,47 @@
       (beneath l2 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l0 h0))
       (height l0 h1)))
-  ; rule of 12 observed moves; a stick lands on its release location at level 1
+  ; rule of 6 observed moves; a stick lands on its release location at level 1
+  (:action pick-release-stick-l2-l1-48
+    :parameters (?o - stick ?r0 - block)
+    :precondition (and
+      (at ?o l2)
+      (level ?o h1)
+      (rests ?o h0)
+      (place ?o on-spot)
+      (at ?r0 l1)
+      (level ?r0 h3)
+      (rests ?r0 h1)
+      (place ?r0 on-spot)
+      (beneath l1 h0)
+      (height l2 h1)
+      (height l1 h3)
+      (height l0 h0))
+    :effect (and
+      (not (beneath l1 h0))
+      (not (at ?o l2))
+      (at ?o l1)
+      (beneath l0 h0)
+      (beneath l2 h0)
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (bit-5 ?o)
+      (not (no-bit-5 ?o))
+      (not (at ?r0 l1))
+      (at ?r0 l0)
+      (bit-0 ?r0)
+      (not (no-bit-0 ?r0))
+      (no-bit-5 ?r0)
+      (not (bit-5 ?r0))
+      (not (height l1 h3))
+      (height l1 h1)
+      (not (height l0 h0))
+      (height l0 h3)))
+  ; rule of 13 observed moves; a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l3-49
     :parameters (?o - stick)
     :precondition (and
@@ -1292,10 +1243,8 @@
       (not (beneath l1 h0))
       (not (at ?o l2))
       (at ?o l3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l2 h1))
@@ -1304,7 +1253,7 @@
       (height l1 h0)
       (not (height l3 h0))
       (height l3 h1)))
-  ; rule of 4 observed moves; a stick lands on its release location at level 1
+  ; rule of 4 observed moves; a stick lands on its release location at level 3
   (:action pick-release-stick-l2-l3-50
     :parameters (?o - stick ?r0 - block)
     :precondition (and
@@ -1324,10 +1273,10 @@
       (not (beneath l1 h0))
       (not (at ?o l2))
       (at ?o l3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
+      (not (level ?o h1))
+      (level ?o h3)
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (rests ?r0 h1))
@@ -1336,16 +1285,44 @@
       (place ?r0 minus-y-far)
       (bit-0 ?r0)
       (not (no-bit-0 ?r0))
-      (bit-2 ?r0)
-      (not (no-bit-2 ?r0))
       (no-bit-5 ?r0)
       (not (bit-5 ?r0))
       (not (height l2 h1))
       (height l2 h0)
       (not (height l3 h0))
-      (height l3 h1)))
-  ; rule of 3 observed moves; a stick lands on its release location at level 5
+      (height l3 h3)))
+  ; rule of 10 observed moves; a stick lands on its release location at level 3
   (:action pick-release-stick-l2-l3-51
+    :parameters (?o - stick)
+    :precondition (and
+      (at ?o l2)
+      (level ?o h1)
+      (rests ?o h0)
+      (place ?o on-spot)
+      (beneath l1 h0)
+      (height l2 h1)
+      (height l1 h1)
+      (height l3 h2))
+    :effect (and
+      (not (beneath l1 h0))
+      (not (at ?o l2))
+      (at ?o l3)
+      (not (rests ?o h0))
+      (rests ?o h2)
+      (not (level ?o h1))
+      (level ?o h3)
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
+      (not (height l2 h1))
+      (height l2 h0)
+      (not (height l1 h1))
+      (height l1 h0)
+      (not (height l3 h2))
+      (height l3 h3)))
+  ; rule of 3 observed moves; a stick lands on its release location at level 5
+  (:action pick-release-stick-l2-l3-52
     :parameters (?o - stick ?r0 - block)
     :precondition (and
       (at ?o l2)
@@ -1368,20 +1345,16 @@
       (rests ?o h2)
       (not (level ?o h1))
       (level ?o h5)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (rests ?r0 h1))
       (rests ?r0 h0)
       (not (place ?r0 on-spot))
       (place ?r0 minus-y-far)
       (bit-0 ?r0)
       (not (no-bit-0 ?r0))
-      (bit-2 ?r0)
-      (not (no-bit-2 ?r0))
       (no-bit-5 ?r0)
       (not (bit-5 ?r0))
       (not (height l2 h1))
@@ -1389,7 +1362,7 @@
       (not (height l3 h2))
       (height l3 h5)))
   ; rule of 13 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l4-52
+  (:action pick-release-stick-l2-l4-53
     :parameters (?o - stick)
     :precondition (and
       (at ?o l2)
@@ -1404,10 +1377,8 @@
       (not (beneath l1 h0))
       (not (at ?o l2))
       (at ?o l4)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l2 h1))
@@ -1417,7 +1388,7 @@
       (not (height l4 h0))
       (height l4 h1)))
   ; rule of 7 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l4-53
+  (:action pick-release-stick-l2-l4-54
     :parameters (?o - stick ?r0 - block)
     :precondition (and
       (at ?o l2)
@@ -1436,10 +1407,8 @@
       (not (beneath l1 h0))
       (not (at ?o l2))
       (at ?o l4)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (rests ?r0 h1))
@@ -1447,11 +1416,9 @@
       (not (at ?r0 l1))
       (at ?r0 l3)
       (not (place ?r0 on-spot))
-      (place ?r0 minus-y-near)
+      (place ?r0 plus-y-mid)
       (bit-0 ?r0)
       (not (no-bit-0 ?r0))
-      (bit-2 ?r0)
-      (not (no-bit-2 ?r0))
       (no-bit-5 ?r0)
       (not (bit-5 ?r0))
       (not (height l2 h1))
@@ -1461,7 +1428,7 @@
       (not (height l4 h0))
       (height l4 h1)))
   ; rule of 14 observed moves; a stick lands on its release location at level 3
-  (:action pick-release-stick-l2-l4-54
+  (:action pick-release-stick-l2-l4-55
     :parameters (?o - stick)
     :precondition (and
       (at ?o l2)
@@ -1480,20 +1447,18 @@
       (rests ?o h2)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height l2 h1))
       (height l2 h0)
       (not (height l1 h1))
       (height l1 h0)
       (not (height l4 h2))
       (height l4 h3)))
-  ; rule of 23 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l5-55
+  ; rule of 25 observed moves; a stick lands on its release location at level 1
+  (:action pick-release-stick-l2-l5-56
     :parameters (?o - stick)
     :precondition (and
       (at ?o l2)
@@ -1508,10 +1473,8 @@
       (not (beneath l1 h0))
       (not (at ?o l2))
       (at ?o l5)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l2 h1))
@@ -1521,7 +1484,7 @@
       (not (height l5 h0))
       (height l5 h1)))
   ; rule of 5 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l5-56
+  (:action pick-release-stick-l2-l5-57
     :parameters (?o - stick ?r0 - block)
     :precondition (and
       (at ?o l2)
@@ -1540,28 +1503,24 @@
       (not (beneath l1 h0))
       (not (at ?o l2))
       (at ?o l5)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (rests ?r0 h1))
       (rests ?r0 h0)
       (not (place ?r0 on-spot))
-      (place ?r0 off-x)
-      (bit-0 ?r0)
-      (not (no-bit-0 ?r0))
-      (bit-2 ?r0)
-      (not (no-bit-2 ?r0))
+      (place ?r0 plus-y-mid)
+      (no-bit-0 ?r0)
+      (not (bit-0 ?r0))
       (no-bit-5 ?r0)
       (not (bit-5 ?r0))
       (not (height l2 h1))
       (height l2 h0)
       (not (height l5 h0))
       (height l5 h1)))
-  ; rule of 79 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l3-l0-57
+  ; rule of 80 observed moves; a stick lands on its release location at level 1
+  (:action pick-release-stick-l3-l0-58
     :parameters (?o - stick)
     :precondition (and
       (at ?o l3)
@@ -1577,8 +1536,6 @@
       (beneath l1 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l3 h1))
@@ -1588,7 +1545,7 @@
       (not (height l1 h0))
       (height l1 h1)))
   ; rule of 13 observed moves; a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l0-58
+  (:action pick-release-stick-l3-l0-59
     :parameters (?o - stick)
     :precondition (and
       (at ?o l3)
@@ -1604,10 +1561,8 @@
       (beneath l1 h2)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l3 h1))
@@ -1617,7 +1572,7 @@
       (not (height l1 h2))
       (height l1 h3)))
   ; rule of 17 observed moves; a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l0-59
+  (:action pick-release-stick-l3-l0-60
     :parameters (?o - stick)
     :precondition (and
       (at ?o l3)
@@ -1635,12 +1590,10 @@
       (beneath l1 h0)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height l3 h1))
       (height l3 h0)
       (not (height l0 h2))
@@ -1648,7 +1601,7 @@
       (not (height l1 h0))
       (height l1 h3)))
   ; rule of 21 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l3-l0-60
+  (:action pick-release-stick-l3-l0-61
     :parameters (?o - stick)
     :precondition (and
       (at ?o l3)
@@ -1668,8 +1621,6 @@
       (level ?o h1)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l3 h3))
@@ -1678,8 +1629,8 @@
       (height l0 h1)
       (not (height l1 h0))
       (height l1 h1)))
-  ; rule of 50 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l3-l1-61
+  ; rule of 51 observed moves; a stick lands on its release location at level 1
+  (:action pick-release-stick-l3-l1-62
     :parameters (?o - stick)
     :precondition (and
       (at ?o l3)
@@ -1697,8 +1648,6 @@
       (beneath l2 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l3 h1))
@@ -1710,7 +1659,7 @@
       (not (height l2 h0))
       (height l2 h1)))
   ; rule of 15 observed moves; a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l1-62
+  (:action pick-release-stick-l3-l1-63
     :parameters (?o - stick)
     :precondition (and
       (at ?o l3)
@@ -1728,10 +1677,8 @@
       (beneath l2 h2)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l3 h1))
@@ -1743,7 +1690,7 @@
       (not (height l2 h2))
       (height l2 h3)))
   ; rule of 11 observed moves; a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l1-63
+  (:action pick-release-stick-l3-l1-64
     :parameters (?o - stick)
     :precondition (and
       (at ?o l3)
@@ -1761,10 +1708,8 @@
       (beneath l2 h0)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l3 h1))
@@ -1775,8 +1720,8 @@
       (height l0 h3)
       (not (height l2 h0))
       (height l2 h3)))
-  ; rule of 13 observed moves; a stick lands on its release location at level 7
-  (:action pick-release-stick-l3-l1-64
+  ; rule of 13 observed moves; a stick lands on its release location at level 3
+  (:action pick-release-stick-l3-l1-65
     :parameters (?o - stick)
     :precondition (and
       (at ?o l3)
@@ -1795,23 +1740,21 @@
       (beneath l0 h0)
       (beneath l2 h0)
       (not (level ?o h1))
-      (level ?o h7)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (level ?o h3)
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height l3 h1))
       (height l3 h0)
       (not (height l1 h2))
-      (height l1 h7)
+      (height l1 h3)
       (not (height l0 h0))
-      (height l0 h7)
+      (height l0 h3)
       (not (height l2 h0))
-      (height l2 h7)))
+      (height l2 h3)))
   ; rule of 12 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l3-l1-65
+  (:action pick-release-stick-l3-l1-66
     :parameters (?o - stick)
     :precondition (and
       (at ?o l3)
@@ -1833,8 +1776,6 @@
       (level ?o h1)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l3 h3))
@@ -1846,7 +1787,7 @@
       (not (height l2 h0))
       (height l2 h1)))
   ; rule of 69 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l3-l2-66
+  (:action pick-release-stick-l3-l2-67
     :parameters (?o - stick)
     :precondition (and
       (at ?o l3)
@@ -1862,8 +1803,6 @@
       (beneath l1 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l3 h1))
@@ -1873,7 +1812,7 @@
       (not (height l1 h0))
       (height l1 h1)))
   ; rule of 15 observed moves; a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l2-67
+  (:action pick-release-stick-l3-l2-68
     :parameters (?o - stick)
     :precondition (and
       (at ?o l3)
@@ -1889,10 +1828,8 @@
       (beneath l1 h2)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l3 h1))
@@ -1902,7 +1839,7 @@
       (not (height l1 h2))
       (height l1 h3)))
   ; rule of 12 observed moves; a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l2-68
+  (:action pick-release-stick-l3-l2-69
     :parameters (?o - stick)
     :precondition (and
       (at ?o l3)
@@ -1920,12 +1857,10 @@
       (beneath l1 h0)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height l3 h1))
       (height l3 h0)
       (not (height l2 h2))
@@ -1933,7 +1868,7 @@
       (not (height l1 h0))
       (height l1 h3)))
   ; rule of 17 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l3-l2-69
+  (:action pick-release-stick-l3-l2-70
     :parameters (?o - stick)
     :precondition (and
       (at ?o l3)
@@ -1953,8 +1888,6 @@
       (level ?o h1)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l3 h3))
@@ -1964,7 +1897,7 @@
       (not (height l1 h0))
       (height l1 h1)))
   ; rule of 65 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l4-l0-70
+  (:action pick-release-stick-l4-l0-71
     :parameters (?o - stick)
     :precondition (and
       (at ?o l4)
@@ -1980,8 +1913,6 @@
       (beneath l1 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l4 h1))
@@ -1991,7 +1922,7 @@
       (not (height l1 h0))
       (height l1 h1)))
   ; rule of 10 observed moves; a stick lands on its release location at level 3
-  (:action pick-release-stick-l4-l0-71
+  (:action pick-release-stick-l4-l0-72
     :parameters (?o - stick)
     :precondition (and
       (at ?o l4)
@@ -2007,10 +1938,8 @@
       (beneath l1 h2)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l4 h1))
@@ -2020,7 +1949,7 @@
       (not (height l1 h2))
       (height l1 h3)))
   ; rule of 18 observed moves; a stick lands on its release location at level 3
-  (:action pick-release-stick-l4-l0-72
+  (:action pick-release-stick-l4-l0-73
     :parameters (?o - stick)
     :precondition (and
       (at ?o l4)
@@ -2038,12 +1967,10 @@
       (beneath l1 h0)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height l4 h1))
       (height l4 h0)
       (not (height l0 h2))
@@ -2051,7 +1978,7 @@
       (not (height l1 h0))
       (height l1 h3)))
   ; rule of 21 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l4-l0-73
+  (:action pick-release-stick-l4-l0-74
     :parameters (?o - stick)
     :precondition (and
       (at ?o l4)
@@ -2071,8 +1998,6 @@
       (level ?o h1)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l4 h3))
@@ -2082,7 +2007,7 @@
       (not (height l1 h0))
       (height l1 h1)))
   ; rule of 56 observed moves; a stick lands on its release location at level 1
-  (:action pick-release-stick-l4-l1-74
+  (:action pick-release-stick-l4-l1-75
     :parameters (?o - stick)
     :precondition (and
       (at ?o l4)
@@ -2100,8 +2025,6 @@
       (beneath l2 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l4 h1))
@@ -2113,7 +2036,7 @@
       (not (height l2 h0))
       (height l2 h1)))
   ; rule of 17 observed moves; a stick lands on its release location at level 3
-  (:action pick-release-stick-l4-l1-75
+  (:action pick-release-stick-l4-l1-76
     :parameters (?o - stick)
     :precondition (and
       (at ?o l4)
@@ -2131,10 +2054,8 @@
       (beneath l2 h2)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l4 h1))
@@ -2144,41 +2065,6 @@
       (not (height l0 h0))
       (height l0 h3)
       (not (height l2 h2))
-      (height l2 h3)))
-  ; rule of 10 observed moves; a stick lands on its release location at level 3
-  (:action pick-release-stick-l4-l1-76
-    :parameters (?o - stick)
-    :precondition (and
-      (at ?o l4)
-      (level ?o h1)
-      (rests ?o h0)
-      (place ?o on-spot)
-      (height l4 h1)
-      (height l1 h2)
-      (height l0 h0)
-      (height l2 h0))
-    :effect (and
-      (not (at ?o l4))
-      (at ?o l1)
-      (not (rests ?o h0))
-      (rests ?o h2)
-      (beneath l0 h0)
-      (beneath l2 h0)
-      (not (level ?o h1))
-      (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
-      (not (height l4 h1))
-      (height l4 h0)
-      (not (height l1 h2))
-      (height l1 h3)
-      (not (height l0 h0))
-      (height l0 h3)
-      (not (height l2 h0))
       (height l2 h3)))
   ; rule of 14 observed moves; a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l1-77
@@ -2203,8 +2089,6 @@
       (level ?o h1)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l4 h3))
@@ -2215,7 +2099,7 @@
       (height l0 h1)
       (not (height l2 h0))
       (height l2 h1)))
-  ; rule of 54 observed moves; a stick lands on its release location at level 1
+  ; rule of 53 observed moves; a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l2-78
     :parameters (?o - stick)
     :precondition (and
@@ -2232,8 +2116,6 @@
       (beneath l1 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l4 h1))
@@ -2259,10 +2141,8 @@
       (beneath l1 h2)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l4 h1))
@@ -2290,12 +2170,10 @@
       (beneath l1 h0)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height l4 h1))
       (height l4 h0)
       (not (height l2 h2))
@@ -2323,8 +2201,6 @@
       (level ?o h1)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l4 h3))
@@ -2350,8 +2226,6 @@
       (beneath l1 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l5 h1))
@@ -2377,12 +2251,10 @@
       (beneath l1 h2)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height l5 h1))
       (height l5 h0)
       (not (height l0 h0))
@@ -2408,12 +2280,10 @@
       (beneath l1 h0)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height l5 h1))
       (height l5 h0)
       (not (height l0 h2))
@@ -2441,8 +2311,6 @@
       (level ?o h1)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l5 h3))
@@ -2470,8 +2338,6 @@
       (beneath l2 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l5 h1))
@@ -2501,12 +2367,10 @@
       (beneath l2 h2)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height l5 h1))
       (height l5 h0)
       (not (height l1 h0))
@@ -2536,12 +2400,10 @@
       (beneath l2 h0)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height l5 h1))
       (height l5 h0)
       (not (height l1 h2))
@@ -2573,8 +2435,6 @@
       (level ?o h1)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l5 h3))
@@ -2602,8 +2462,6 @@
       (beneath l1 h0)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l5 h1))
@@ -2629,10 +2487,8 @@
       (beneath l1 h2)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l5 h1))
@@ -2660,12 +2516,10 @@
       (beneath l1 h0)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height l5 h1))
       (height l5 h0)
       (not (height l2 h2))
@@ -2691,20 +2545,47 @@
       (beneath l1 h2)
       (not (level ?o h1))
       (level ?o h3)
-      (bit-0 ?o)
-      (not (no-bit-0 ?o))
-      (no-bit-2 ?o)
-      (not (bit-2 ?o))
-      (bit-5 ?o)
-      (not (no-bit-5 ?o))
+      (no-bit-0 ?o)
+      (not (bit-0 ?o))
+      (no-bit-5 ?o)
+      (not (bit-5 ?o))
       (not (height l5 h1))
       (height l5 h0)
       (not (height l2 h2))
       (height l2 h3)
       (not (height l1 h2))
       (height l1 h3)))
-  ; rule of 19 observed moves; a stick lands on its release location at level 1
+  ; rule of 11 observed moves; a stick lands on its release location at level 2
   (:action pick-release-stick-l5-l2-94
+    :parameters (?o - stick)
+    :precondition (and
+      (at ?o l5)
+      (level ?o h3)
+      (rests ?o h1)
+      (place ?o on-spot)
+      (height l5 h3)
+      (height l2 h0)
+      (height l1 h0))
+    :effect (and
+      (not (at ?o l5))
+      (at ?o l2)
+      (not (rests ?o h1))
+      (rests ?o h0)
+      (beneath l1 h0)
+      (not (level ?o h3))
+      (level ?o h2)
+      (bit-0 ?o)
+      (not (no-bit-0 ?o))
+      (bit-5 ?o)
+      (not (no-bit-5 ?o))
+      (not (height l5 h3))
+      (height l5 h1)
+      (not (height l2 h0))
+      (height l2 h2)
+      (not (height l1 h0))
+      (height l1 h2)))
+  ; rule of 19 observed moves; a stick lands on its release location at level 1
+  (:action pick-release-stick-l5-l2-95
     :parameters (?o - stick)
     :precondition (and
       (at ?o l5)
@@ -2724,8 +2605,6 @@
       (level ?o h1)
       (bit-0 ?o)
       (not (no-bit-0 ?o))
-      (bit-2 ?o)
-      (not (no-bit-2 ?o))
       (bit-5 ?o)
       (not (no-bit-5 ?o))
       (not (height l5 h3))
