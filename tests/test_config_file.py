@@ -101,8 +101,9 @@ def test_the_presets_the_cli_lists_are_the_configs_presets():
     assert set(TRAIN_PRESET_NAMES) == set(TRAIN_PRESETS) == set(TRANSITION_PRESETS) == set(PRESETS)
     rec = TrainConfig.from_preset("recommended")
     quick = TrainConfig.from_preset("quick")
-    assert (rec.stability_weight, rec.model.action_per_object) == (0.1, True)  # the recipe
-    assert dataclasses.replace(rec, preset="quick", stability_weight=0.0,
+    # the recipe: the stability loss, the action on the held object, rider scenes three times an epoch, float32
+    assert (rec.stability_weight, rec.model.action_per_object, rec.rider_scene_repeat, rec.bf16) == (0.1, True, 3, False)
+    assert dataclasses.replace(rec, preset="quick", stability_weight=0.0, rider_scene_repeat=1, bf16=True,
                                model=dataclasses.replace(rec.model, action_per_object=False)) == quick
 
 
