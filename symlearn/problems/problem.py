@@ -217,8 +217,13 @@ class Problem:
             raise ValueError(msg if msg.startswith(p) else f"{p}: {msg}") from None
 
 
+class OutOfReach(ValueError):
+    """A scene with an object past the table's reach: refused as a problem; a generator draws again instead."""
+
+
 def check_scene(scene: Scene, where: str) -> None:
-    """Refuse (one-line ValueError) non-finite poses, non-unit quaternions and positions out of the table's reach."""
+    """Refuse (one-line ValueError) non-finite poses, non-unit quaternions and positions out of the table's reach
+    (OutOfReach)."""
     for i, o in enumerate(scene.objects):
         pos, quat = np.asarray(o.position, np.float64), np.asarray(o.orientation, np.float64)
         if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(quat))):
@@ -229,7 +234,7 @@ def check_scene(scene: Scene, where: str) -> None:
                              f"(norm {norm:.4g})")
         x, y, z = pos
         if not (abs(x - REACH_CENTER_X) < REACH_HALF_X and abs(y) < REACH_HALF_Y and TABLE_TOP_Z <= z <= REACH_Z_MAX):
-            raise ValueError(f"{where}: object {i} position {list(o.position)} is out of the table's reach "
+            raise OutOfReach(f"{where}: object {i} position {list(o.position)} is out of the table's reach "
                              f"(|x-{REACH_CENTER_X:.2f}| < {REACH_HALF_X}, |y| < {REACH_HALF_Y}, "
                              f"{TABLE_TOP_Z} <= z <= {REACH_Z_MAX})")
 

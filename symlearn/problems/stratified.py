@@ -31,8 +31,8 @@ from pathlib import Path
 import numpy as np
 
 from symlearn.problems.paths import path_under
-from symlearn.problems.problem import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems,
-                                       save_problem)
+from symlearn.problems.problem import (GOAL_TOLERANCE_M, PROBLEM_VERSION, OutOfReach, Problem, load_problem,
+                                       load_problems, save_problem)
 from symlearn.problems.problem_generation import (MANIFEST_FORMAT, ProblemConfig, _changing_action, _done,
                                                   _is_count, generate_problem, prepare_problem_dir)
 from symlearn.problems.shortest import NotCovered, scene_state, with_shortest
@@ -171,10 +171,8 @@ def draw(sim, cell: Cell, i: int, attempt: int, seed: int) -> Problem | None:
         return _aimed(sim, rng, cell, name, seed)
     except RuntimeError:  # a walk or a task with no valid draw this time (the simulator refused it)
         return None
-    except ValueError as e:  # a scene the problem format refuses: with 6-8 objects, one pushed out of reach
-        if "out of the table's reach" in str(e):
-            return None
-        raise
+    except OutOfReach:  # a scene the problem format refuses: with 6-8 objects, one pushed out of reach
+        return None
 
 
 def _settings(n: int, objects: tuple[int, int], seed: int, exclude: list[tuple[str, str]]) -> dict:
