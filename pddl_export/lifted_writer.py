@@ -70,6 +70,7 @@ class Schema:
     pre: tuple = ()
     eff: tuple = ()
     alternative: int = 0  # which of its rule's outcomes (0: the rule's own)
+    cost: int | None = None  # the cost form's action cost (its last effect increases total-cost by it)
 
 
 def _bit_literals(rules: LiftedRules, term: str, kind: int, present: bool = True) -> list[str]:
@@ -171,12 +172,13 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
     # beneath facts a landing re-adds where it also lifted them cancel out; keep the effects consistent
     eff = _net_effects(eff)
     if cost is not None:
-        eff.append(f"(increase (total-cost) {int(cost)})")
+        cost = int(cost)
+        eff.append(f"(increase (total-cost) {cost})")
 
     name = (f"pick-release-{'stick' if f['o.stick'] else 'cube'}{f'-{frm}-{to}' if concrete else ''}-{index}"
             + (f"-alt{alternative}" if alternative else ""))
     text = _schema_text(name, params, pre, eff, _comment(rule, f, alternative))
-    return Schema(name, pick, release, text, tuple(params), tuple(dict.fromkeys(pre)), tuple(eff), alternative)
+    return Schema(name, pick, release, text, tuple(params), tuple(dict.fromkeys(pre)), tuple(eff), alternative, cost)
 
 
 PLACES = ("on-spot", "minus-y-near", "minus-y-mid", "minus-y-far", "plus-y-near", "plus-y-mid", "plus-y-far", "off-x")
@@ -300,11 +302,6 @@ def schemas(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
     return _distinct(out)
 
 
-def _cost(schema: Schema) -> int:
-    last = schema.eff[-1] if schema.eff else ""
-    return int(last.split()[-1].rstrip(")")) if last.startswith("(increase (total-cost)") else 0
-
-
 def _distinct(found: Iterable[Schema]) -> tuple[Schema, ...]:
     """One schema per action: rules whose keys differ only in what the PDDL does not state (whether a piece
     stands on top at the pick or release location) write the same parameters, preconditions and effects; the
@@ -312,11 +309,11 @@ def _distinct(found: Iterable[Schema]) -> tuple[Schema, ...]:
     equals), in the place of the first, and its comment names the rules it stands for."""
     kept: dict[tuple, list[Schema]] = {}
     for s in found:
-        body = (s.params, s.pre, tuple(e for e in s.eff if not e.startswith("(increase (total-cost)")))
+        body = (s.params, s.pre, s.eff if s.cost is None else s.eff[:-1])
         kept.setdefault(body, []).append(s)
     out = []
     for copies in kept.values():
-        best = min(copies, key=_cost)
+        best = min(copies, key=lambda c: c.cost or 0)
         if len(copies) > 1:
             others = ", ".join(c.name for c in copies if c is not best)
             head, rest = best.text.split("\n", 1)
