@@ -166,18 +166,20 @@ def shortest_plan(problem: Problem, max_length: int = MAX_PLAN_LENGTH, max_state
         return ShortestPlan(None, None, "pose_not_covered", f"goal scene: {e}")
     types = tuple(problem.initial.objects[i].type for i in range(problem.k))
 
-    pruned = []
+    needs = lower_bound(start, types, want)
+    if needs > max_length:
+        return ShortestPlan(None, None, "search_cap", f"no plan of at most {max_length} actions (it needs at "
+                                                      f"least {needs})", 0)
+    pruned = False  # a state was cut off for needing more than max_length: exhausting the rest proves nothing
 
     def h(state: State) -> float:
+        nonlocal pruned
         bound = lower_bound(state, types, want)
         if bound <= max_length:
             return float(bound)
-        pruned.append(state)  # no plan within max_length from here; the search is then no proof of unreachability
+        pruned = True
         return math.inf
 
-    if h(start) == math.inf:
-        return ShortestPlan(None, None, "search_cap", f"no plan of at most {max_length} actions (it needs at "
-                                                      f"least {lower_bound(start, types, want)})", 0)
     out = astar(start, lambda s: lower_bound(s, types, want) == 0,
                 lambda s: ((a, child, 1.0) for a, child in successors(s, types)), h,
                 max_expansions=max_states, timeout_s=SEARCH_TIMEOUT_S)
