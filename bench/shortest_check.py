@@ -16,8 +16,7 @@ from pathlib import Path
 
 
 def main(argv: list[str] | None = None) -> int:
-    from symlearn.problems.problem import GOAL_TOLERANCE_M, load_problems
-    from symlearn.problems.problem import max_goal_distance
+    from symlearn.problems.problem import GOAL_TOLERANCE_M, load_problems, max_goal_distance
     from symlearn.provenance import atomic_write_json
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.world import decode_action

@@ -12,8 +12,7 @@ import pytest
 from conftest import cli
 from symlearn.problems.goal_problems import goal_file_problem, goal_problem
 from symlearn.problems.goals import Goal, ObjectGoal, arrangement_errors, drop_order, load_goal, parse_goal, save_goal
-from symlearn.problems.problem import load_problem, load_problems
-from symlearn.problems.problem import max_goal_distance
+from symlearn.problems.problem import load_problem, load_problems, max_goal_distance
 from symlearn.problems.stacking import run_script
 from symlearn.problems.structure_suite import fitting_templates
 from symlearn.problems.structures import TEMPLATES, structure_goal

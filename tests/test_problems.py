@@ -8,10 +8,10 @@ import re
 import numpy as np
 import pytest
 
-from symlearn.problems.problem import GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems, save_problem
+from symlearn.problems.problem import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems,
+                                       max_goal_distance, save_problem)
 from symlearn.problems.problem_generation import MAX_ACTION_DRAWS, ProblemConfig, _changing_action, generate_problems
 from symlearn.sim.exploration import ExplorationConfig
-from symlearn.problems.problem import max_goal_distance
 from symlearn.world import N_LOCATIONS, ObjectType, Scene, decode_action
 
 

@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 
 from symlearn.problems.goals import ObjectGoal
-from symlearn.problems.problem import PROBLEM_VERSION, Problem, load_problem, load_problems, save_problem
+from symlearn.problems.problem import (PROBLEM_VERSION, Problem, load_problem, load_problems, max_goal_distance,
+                                       save_problem)
 from symlearn.problems.problem_generation import add_shortest_plans, generate_problems
-from symlearn.problems.problem import max_goal_distance
 from symlearn.problems.shortest import (NotCovered, scene_state, shortest_plan, state_scene, with_shortest)
 from symlearn.problems.stacking import act, check_state, drop_all, levels, successors
 from symlearn.problems.stratified import MODEL_MAX_LENGTH, same_problem

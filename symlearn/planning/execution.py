@@ -39,9 +39,8 @@ import numpy as np
 from search.result import PlanResult, PlanStatus, failed
 from pddl_export.rules import RuleSet, apply_rules
 from pddl_export.symbolic import SymbolicGoal, TransitionFn, bits_from_codes
-from symlearn.problems.problem import GOAL_TOLERANCE_M, Problem
+from symlearn.problems.problem import GOAL_TOLERANCE_M, Problem, max_goal_distance
 from symlearn.planning.recovery import Progress, Segment, recover, replanned
-from symlearn.problems.problem import max_goal_distance
 from symlearn.symbolic.scenes import place_scene, symbolic_goal
 from symlearn.symbolic.transition_data import encode_observation
 from symlearn.world import decode_action

@@ -16,8 +16,7 @@ from pathlib import Path
 
 from symlearn.problems.goals import ARRANGEMENT_TOLERANCE_M, Goal, arrangement_errors, drop_order, load_goal
 from symlearn.problems.paths import check_safe_name
-from symlearn.problems.problem import Problem
-from symlearn.problems.problem import max_goal_distance
+from symlearn.problems.problem import Problem, max_goal_distance
 from symlearn.problems.shortest import with_shortest
 from symlearn.world import FAR_ROW, N_LOCATIONS, ObjectType, Scene, decode_action
 
