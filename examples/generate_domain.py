@@ -39,7 +39,7 @@ def main() -> None:
     print(f"\n{'problem':<8} {'objects':>7} {'shortest plan':>13}  source")
     for name, p in index["problems"].items():
         print(f"{name:<8} {p['objects']:>7} {str(p['optimal_length']):>13}  {p['file']}")
-    first = domain.index("  ; rule")
+    first = domain.index("\n  ; ") + 1  # the first schema's comment (how many moves it rests on)
     print("\nthe first rule:\n" + domain[first:domain.index("\n  ;", first + 1)])
 
 

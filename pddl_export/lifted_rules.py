@@ -8,9 +8,11 @@ change on what the move leaves on top at p and on what it lands on at r.
 
 A rule's `key` keeps the structure of the move (`STRUCTURE`: the move's class, o's type, place and level, the
 levels left at p and found at r, the riders' sides, places and levels, the levels under and beside a far-row
-stick's ends, whether a piece stands on top at p and at r) and only the learned bits its outcome depends on:
-`REFINEMENTS` are added in order and the coarsest key under which every observed description agrees on one
-outcome is kept (a greedy decision list). Wherever two rules match, they give one outcome.
+stick's ends, whether a piece stands on top at p and at r) and only the refinements its outcome depends on
+(`REFINEMENTS`: where it releases, the learned bits of o, of what it lands on, of what it leaves on top, of the
+riders): `distil_lifted` grows a decision tree per structure, splitting on the refinement that explains the most
+further moves. Rules under a split on the release location that share an outcome are one rule naming all their
+locations. The leaves partition the moves: wherever a rule matches, no other does.
 
 The class of a move is "cube" for a cube (lifted over both locations), "near" for a stick moved within the near
 row (nothing covers a neighbour there), and the concrete (p, r) pair otherwise: a far-row stick's ends cover its
@@ -34,7 +36,7 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from pddl_export.bounded_json import read_json_file
-from pddl_export.lifted_scene import FAR_ROW, NEAR_ROW, CodeLayout, Piece, SceneGraph, neighbours, read_scene, \
+from pddl_export.lifted_scene import FAR_ROW, N_LOCATIONS, NEAR_ROW, CodeLayout, Piece, SceneGraph, neighbours, read_scene, \
     top_of
 
 LIFTED_KIND = "symlearn-lifted-rules"
@@ -42,7 +44,8 @@ LIFTED_VERSION = 1
 MAX_LIFTED_BYTES = 64 << 20  # a lifted rules file is kilobytes; refuse anything near this
 STRUCTURE = ("cls", "o.stick", "o.place", "o.level", "u.level", "v.level", "riders.sides", "riders.place",
              "riders.level", "beneath", "landing", "u.at", "v.at")
-REFINEMENTS = (("o.kind",), ("v.kind",), ("u.kind",), ("riders.kind",))
+REFINEMENTS = (("to",), ("o.kind",), ("v.kind",), ("u.kind",), ("riders.kind",))
+MIN_GAIN = 0.02  # a split must explain this share of its node's moves more (distil_lifted)
 ALTERNATIVE_MIN_SHARE = 0.1  # an outcome this often m(z)'s answer among a rule's moves becomes an alternative
 MAX_ALTERNATIVES = 2  # per rule, the most frequent ones (the cost form writes 1 + this many actions per rule)
 WHERE = ("to", "from", "stay", "shift")  # where a piece ends, relative to the action; an int is a location
@@ -108,7 +111,7 @@ def signature(graph: SceneGraph, m: Move) -> dict:
     """Every described field of a move (STRUCTURE and REFINEMENTS name them): what a lifted action can test."""
     ps = graph.pieces
     o = ps[m.o]
-    return {"cls": move_class(o, m.pick, m.release), "o.stick": o.stick, "o.kind": o.kind, "o.level": o.level,
+    return {"cls": move_class(o, m.pick, m.release), "to": m.release, "o.stick": o.stick, "o.kind": o.kind, "o.level": o.level,
             "o.place": o.place, "riders.place": tuple(ps[j].place for j in m.riders),
             "u.level": m.under, "v.level": 0 if m.v is None else ps[m.v].level,
             "riders.sides": tuple(ps[j].loc - m.pick for j in m.riders),
@@ -117,6 +120,14 @@ def signature(graph: SceneGraph, m: Move) -> dict:
             "u.at": m.below is not None, "v.at": m.v_at is not None,
             "u.kind": None if m.below is None else ps[m.below].kind,
             "v.kind": None if m.v_at is None else ps[m.v_at].kind}
+
+
+def _scalar_keys(key: tuple) -> list[tuple]:
+    """A key with a tuple of release locations ("to") as one key per location; any other key as it is."""
+    for i, (name, value) in enumerate(key):
+        if name == "to" and isinstance(value, tuple):
+            return [key[:i] + (("to", v),) + key[i + 1:] for v in value]
+    return [key]
 
 
 def key_of(sig: dict, depth: int) -> tuple:
@@ -197,10 +208,14 @@ class LiftedRules:
     codebook: dict = field(default_factory=dict, hash=False)
 
     def __post_init__(self) -> None:
-        index = {}
+        index, splits = {}, {}
         for r in self.rules:
-            index[(r.depth, r.key)] = r
+            for key in _scalar_keys(r.key):  # a rule naming several release locations answers for each
+                index[key] = r
+                for n in range(len(STRUCTURE), len(key)):  # every shorter key of a rule was split on its next field
+                    splits[key[:n]] = key[n][0]
         object.__setattr__(self, "_index", index)
+        object.__setattr__(self, "_splits", splits)
 
     def is_stick(self, code: int) -> bool:
         """The type a located code reads as: the data's majority for its learned code and level (else level 1)."""
@@ -214,12 +229,14 @@ class LiftedRules:
         return tuple(self.layout.piece(c, self.is_stick(c)) for c in codes)
 
     def rule_for(self, sig: dict) -> Rule | None:
-        """The coarsest rule whose key the signature has, or None."""
-        for depth in range(len(REFINEMENTS) + 1):
-            r = self._index.get((depth, key_of(sig, depth)))
-            if r is not None:
-                return r
-        return None
+        """The rule whose key the signature has (the leaf of its structure's tree), or None."""
+        key = key_of(sig, 0)
+        while key not in self._index:
+            name = self._splits.get(key)
+            if name is None:
+                return None
+            key = key + ((name, sig[name]),)
+        return self._index[key]
 
     def step_pieces(self, pieces: Sequence[Piece], action: int, alternative: int = 0
                     ) -> tuple[tuple[Piece, ...], Rule | None]:
@@ -311,42 +328,139 @@ def observed_moves(rules_like: LiftedRules, before: np.ndarray, after: np.ndarra
 
 
 def distil_lifted(layout: CodeLayout, stick_of: dict, moves: Sequence[tuple[dict, Outcome]], min_count: int = 3,
-                  model_hash: str = "", rider_min_count: int | None = None) -> LiftedRules:
-    """Rules from observed (signature, outcome) moves: each full description's majority outcome (seen at least
-    min_count times; rider_min_count times where the outcome moves riders, which are rare in any data), kept at the
-    coarsest key under which all descriptions agree."""
-    full = len(REFINEMENTS)
-    tally: dict = defaultdict(Counter)
-    for sig, out in moves:
-        tally[key_of(sig, full)][out] += 1
-    majority = {k: c.most_common(1)[0] for k, c in tally.items()}
+                  model_hash: str = "", rider_min_count: int | None = None,
+                  pair_min_count: int | None = None, min_gain: float = MIN_GAIN) -> LiftedRules:
+    """Rules from (signature, outcome) moves, as a decision tree per move structure.
+
+    The moves of one STRUCTURE key are a node. A node becomes a rule (its majority outcome) unless some refinement
+    field (REFINEMENTS) tells its outcomes apart: splitting on the field whose values' own majorities explain the
+    most further moves, when that gain is at least `min_gain` of the node's moves (and at least 2 moves), makes one
+    node per value, refined in turn. A condition stays only where the outcome depends on it.
+
+    A node needs `min_count` moves to become a rule (rider_min_count where its outcome moves riders, which are rare
+    in any data; pair_min_count where the move's class names its two locations, a far-row stick's, whose schema
+    grounds to a handful of actions however many objects a task has). A value with fewer moves under a split node
+    takes the node's majority: too few to tell it apart.
+    """
     rider_min = min_count if rider_min_count is None else rider_min_count
-    majority = {k: (out, n) for k, (out, n) in majority.items() if n >= (rider_min if len(out) > 3 else min_count)}
-    sigs = {k: dict(k) for k in majority}
-    groups: dict = defaultdict(set)
-    support: Counter = Counter()
-    for k, sig in sigs.items():
-        for d in range(full + 1):
-            groups[(d, key_of(sig, d))].add(majority[k][0])
-            support[(d, key_of(sig, d))] += sum(tally[k].values())
-    rules, unwritable = {}, 0
-    answers: dict = defaultdict(Counter)  # a rule's key -> m(z)'s answers over all moves of its descriptions
-    for k, sig in sigs.items():
-        for d in range(full + 1):
-            g = (d, key_of(sig, d))
-            if len(groups[g]) == 1:
-                if writable(majority[k][0]):
-                    rules[g] = Rule(d, g[1], majority[k][0], support[g])
-                    answers[g].update(tally[k])
-                else:
-                    unwritable += 1
-                break
-    rules = {g: _with_alternatives(r, answers[g]) for g, r in rules.items()}
-    stats = {"moves": len(moves), "descriptions": len(tally), "kept_descriptions": len(majority),
-             "rules": len(rules), "descriptions_without_move": unwritable,
-             "agreement": _agreement(tally, majority)}
-    return LiftedRules(layout, stick_of, tuple(sorted(rules.values(), key=lambda r: (repr(r.key), r.depth))),
+    pair_min = min_count if pair_min_count is None else pair_min_count
+    groups: dict = defaultdict(list)
+    for sig, out in moves:
+        groups[key_of(sig, 0)].append((sig, out))
+    rules: list[Rule] = []
+    unwritable = 0
+
+    def needed(key: tuple, out: Outcome) -> int:
+        base = pair_min if isinstance(dict(key)["cls"], tuple) else min_count
+        return min(base, rider_min) if len(out) > 3 else base
+
+    def leaf(key: tuple, tally: Counter, outcome: Outcome) -> None:
+        nonlocal unwritable
+        if not writable(outcome):
+            unwritable += 1
+            return
+        rules.append(_with_alternatives(Rule(len(key) - len(STRUCTURE), key, outcome, sum(tally.values())), tally))
+
+    def grow(key: tuple, node: list, used: tuple[str, ...]) -> None:
+        tally = Counter(out for _, out in node)
+        best, n_best = tally.most_common(1)[0]
+        least = needed(key, best)
+        split, gain = None, 0
+        for (name,) in REFINEMENTS:
+            if name in used:
+                continue
+            parts: dict = defaultdict(Counter)
+            for sig, out in node:
+                parts[sig[name]][out] += 1
+            # a value with too few moves keeps the node's answer (below), so it explains no more than that
+            g = sum(c.most_common(1)[0][1] if sum(c.values()) >= least else c[best] for c in parts.values()) - n_best
+            if g > gain:
+                split, gain = name, g
+        if split is None or gain < max(2, min_gain * len(node)):
+            leaf(key, tally, best)
+            return
+        parts: dict = defaultdict(list)
+        for sig, out in node:
+            parts[sig[split]].append((sig, out))
+        first = len(rules)
+        for value, part in sorted(parts.items(), key=lambda kv: repr(kv[0])):
+            child = key + ((split, value),)
+            if len(part) >= least:
+                grow(child, part, used + (split,))
+            else:
+                leaf(child, Counter(out for _, out in part), best)
+        if split == "to":
+            rules[first:] = _merge_destinations(key, rules[first:], best)
+
+    for key, node in groups.items():
+        out = Counter(o for _, o in node).most_common(1)[0][0]
+        if len(node) >= needed(key, out):
+            grow(key, node, ())
+    covered = {r.key: r.outcome for r in rules}
+    lookup = LiftedRules(layout, stick_of, tuple(rules))
+    hits = [lookup.rule_for(sig) for sig, _ in moves]
+    agree = sum(h is not None and h.outcome == out for h, (_, out) in zip(hits, moves))
+    n_covered = sum(h is not None for h in hits)
+    stats = {"moves": len(moves), "structures": len(groups), "rules": len(covered),
+             "structures_without_move": unwritable, "covered_moves": n_covered,
+             "agreement": round(agree / n_covered, 4) if n_covered else 0.0}
+    return LiftedRules(layout, stick_of, tuple(sorted(rules, key=lambda r: (repr(r.key), r.depth))),
                        model_hash, stats)
+
+
+def _destinations(key: tuple) -> tuple[int, ...]:
+    """Where a move of a lifted class can release: any location for a cube, the near row for a near-row stick."""
+    return tuple(range(N_LOCATIONS)) if dict(key)["cls"] == "cube" else NEAR_ROW
+
+
+def _merge_destinations(key: tuple, children: list[Rule], best: Outcome) -> list[Rule]:
+    """The rules under a node split on where the move releases, with the leaves of one outcome merged into one rule
+    whose "to" names all their locations (a schema with `?to` and `(differ ?to l)` for the others, not one per
+    location). Locations no move released at join the node's own answer, as the unsplit node would have had it."""
+    depth = len(key) - len(STRUCTURE) + 1
+    leaves = [r for r in children if len(r.key) == len(key) + 1]
+    seen = {r.key[-1][1] for r in children}
+    by_outcome: dict = defaultdict(list)
+    for r in leaves:
+        by_outcome[r.outcome].append(r)
+    unseen = tuple(d for d in _destinations(key) if d not in seen)
+    if unseen and best not in by_outcome and writable(best):
+        by_outcome[best] = []
+    merged = []
+    for outcome, group in by_outcome.items():
+        where = tuple(sorted({r.key[-1][1] for r in group} | (set(unseen) if outcome == best else set())))
+        support = sum(r.support for r in group)
+        share = sum(r.share * r.support for r in group) / support if support else 1.0
+        alts: Counter = Counter()
+        for r in group:
+            for o, p in r.alternatives:
+                alts[o] += p * r.support
+        alternatives = tuple((o, round(w / support, 4)) for o, w in alts.most_common(MAX_ALTERNATIVES)
+                             if w / support >= ALTERNATIVE_MIN_SHARE) if support else ()
+        merged.append(Rule(depth, key + (("to", where),), outcome, support, round(share, 4), alternatives))
+    return merged + [r for r in children if len(r.key) > len(key) + 1]
+
+
+def with_network_answers(rules: LiftedRules, answers: Sequence[tuple[dict, Outcome]]) -> LiftedRules:
+    """The rules with each one's share and alternatives recounted over m(z)'s answers (signature, outcome) on the
+    moves it covers: rules distilled from observed outcomes state what the world did; the cost form then weighs
+    each outcome by how often m(z) gives it."""
+    tallies: dict = defaultdict(Counter)
+    for sig, out in answers:
+        r = rules.rule_for(sig)
+        if r is not None:
+            tallies[r.key][out] += 1
+    redone = []
+    for r in rules.rules:
+        t = tallies.get(r.key)
+        if not t:
+            redone.append(r)
+            continue
+        r2 = _with_alternatives(dataclasses.replace(r, share=1.0, alternatives=()), t)
+        if r2.share == 0:  # m(z) never answered the rule's own outcome: it keeps share 1/(n+1) beside its answers
+            r2 = dataclasses.replace(r2, share=round(1 / (sum(t.values()) + 1), 4))
+        redone.append(r2)
+    return dataclasses.replace(rules, rules=tuple(redone))
 
 
 def _with_alternatives(rule: Rule, answers: Counter) -> Rule:
@@ -358,12 +472,6 @@ def _with_alternatives(rule: Rule, answers: Counter) -> Rule:
     alts = tuple((out, round(n / total, 4)) for out, n in answers.most_common()
                  if out != rule.outcome and writable(out) and n / total >= ALTERNATIVE_MIN_SHARE)[:MAX_ALTERNATIVES]
     return dataclasses.replace(rule, share=round(answers[rule.outcome] / total, 4), alternatives=alts)
-
-
-def _agreement(tally: dict, majority: dict) -> float:
-    """Share of observed moves of kept descriptions whose outcome is their description's majority."""
-    total = sum(sum(tally[k].values()) for k in majority)
-    return round(sum(n for _, n in majority.values()) / total, 4) if total else 0.0
 
 
 def load_lifted(path) -> LiftedRules:
@@ -385,8 +493,13 @@ def load_lifted(path) -> LiftedRules:
             if not all(0 < share <= 1 for _, share in r.outcomes()):
                 raise ValueError(f"a rule's outcome shares {[share for _, share in r.outcomes()]} must lie in (0, 1]")
             names = tuple(k for k, _ in r.key)
-            if names[:len(STRUCTURE)] != STRUCTURE or not 0 <= r.depth <= len(REFINEMENTS):
+            if names[:len(STRUCTURE)] != STRUCTURE:
                 raise ValueError(f"a rule's key names {names[:len(STRUCTURE)]}, expected {STRUCTURE}")
+            extra = names[len(STRUCTURE):]
+            if len(set(extra)) != len(extra) or not set(extra) <= {n for (n,) in REFINEMENTS} \
+                    or r.depth != len(extra):
+                raise ValueError(f"a rule's refinements {extra} must be distinct fields of {REFINEMENTS}, "
+                                 f"as many as its depth {r.depth}")
     except (KeyError, TypeError, ValueError, OverflowError) as e:
         raise ValueError(f"{path}: malformed lifted rules ({str(e).splitlines()[0][:200]})") from None
     return LiftedRules(layout, stick_of, rules, str(d.get("model_hash", "")), dict(d.get("stats", {})), codebook)

@@ -63,8 +63,8 @@ class Schema:
     """One action schema: its name, the robot action it stands for, its parts and its PDDL text."""
 
     name: str
-    pick: int | None  # None: lifted (?from is the first parameter after the blocks)
-    release: int | None
+    pick: int | None  # None: lifted (?from is the first parameter after the block)
+    release: int | None  # None: lifted (?to follows ?from); a lifted schema refined on where it releases fixes it
     text: str
     params: tuple = ()
     pre: tuple = ()
@@ -103,19 +103,25 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
     f = rule.fields()
     cls = f["cls"]
     concrete = isinstance(cls, tuple)
-    pick, release = (cls if concrete else (None, None))
-    frm, to = (loc_name(pick), loc_name(release)) if concrete else ("?from", "?to")
+    pick, release = (cls if concrete else (None, f.get("to")))  # a lifted rule refined on where it releases
+    others: tuple = ()  # where a rule naming several release locations may not release
+    if isinstance(release, tuple):
+        allowed = set(range(N_LOCATIONS)) if cls == "cube" else set(NEAR_ROW)
+        release, others = (release[0], ()) if len(release) == 1 else (None, tuple(sorted(allowed - set(release))))
+    frm = loc_name(pick) if concrete else "?from"
+    to = "?to" if release is None else loc_name(release)
     ho, hu, hv = level_name(f["o.level"]), level_name(f["u.level"]), level_name(f["v.level"])
     params: list[tuple[str, str]] = [("?o", "stick" if f["o.stick"] else "cube")]
     if not concrete:
-        params += [("?from", "location"), ("?to", "location")]
+        params += [("?from", "location")] + ([("?to", "location")] if release is None else [])
     pre: list[str] = [f"(at ?o {frm})", f"(level ?o {ho})", f"(rests ?o {hu})",
                       f"(place ?o {place_name(f['o.place'])})"]
     eff: list[str] = []
     if not concrete:
-        pre.append("(differ ?from ?to)")
+        pre.append(f"(differ ?from {to})")
         if cls == "near":
-            pre += ["(near ?from)", "(near ?to)"]
+            pre += ["(near ?from)"] + (["(near ?to)"] if release is None else [])
+        pre += [f"(differ ?to {loc_name(x)})" for x in others]
     if f.get("o.kind") is not None:
         pre += _bit_literals(rules, "?o", f["o.kind"])
     outcome = rule.outcomes()[alternative][0]
@@ -175,7 +181,8 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
         cost = int(cost)
         eff.append(f"(increase (total-cost) {cost})")
 
-    name = (f"pick-release-{'stick' if f['o.stick'] else 'cube'}{f'-{frm}-{to}' if concrete else ''}-{index}"
+    where = f"-{frm}-{to}" if concrete else (f"-to-{to}" if release is not None else "")
+    name = (f"pick-release-{'stick' if f['o.stick'] else 'cube'}{where}-{index}"
             + (f"-alt{alternative}" if alternative else ""))
     text = _schema_text(name, params, pre, eff, _comment(rule, f, alternative))
     return Schema(name, pick, release, text, tuple(params), tuple(dict.fromkeys(pre)), tuple(eff), alternative, cost)
@@ -267,18 +274,31 @@ def _net_effects(eff: list[str]) -> list[str]:
 def _comment(rule: Rule, f: dict, alternative: int = 0) -> str:
     outcome, share = rule.outcomes()[alternative]
     o = outcome[0]
-    which = f"alternative {alternative} of the rule, m(z)'s answer {share:.0%} of the time" if alternative else \
-        f"rule of {rule.support} observed moves"
-    return (f"; {which}; {'a stick' if f['o.stick'] else 'a cube'} "
-            f"{'lands on its release location' if o[1] == 0 else 'ends off its release location'} at level {o[2]}")
+    which = f"alternative {alternative}, {share:.0%} of the moves" if alternative else f"{rule.support} moves"
+    return (f"; {which}: {'a stick' if f['o.stick'] else 'a cube'} "
+            f"{'lands on' if o[1] == 0 else 'ends off'} its release location at level {o[2]}")
+
+
+TEXT_WIDTH = 110  # literals are packed into lines of at most this many characters
+
+
+def _wrapped(literals, indent: str) -> str:
+    """Literals joined by spaces, a new line (at indent) before one that would pass TEXT_WIDTH."""
+    lines, line = [], ""
+    for lit in literals:
+        if line and len(indent) + len(line) + 1 + len(lit) > TEXT_WIDTH - (20 if not lines else 0):
+            lines.append(line)
+            line = lit
+        else:
+            line = f"{line} {lit}" if line else lit
+    return f"\n{indent}".join(lines + [line])
 
 
 def _schema_text(name: str, params, pre, eff, comment: str) -> str:
     ps = " ".join(f"{p} - {t}" for p, t in params)
-    pre_s = "\n      ".join(pre)
-    eff_s = "\n      ".join(eff)
-    return (f"  {comment}\n  (:action {name}\n    :parameters ({ps})\n    :precondition (and\n      {pre_s})\n"
-            f"    :effect (and\n      {eff_s}))\n")
+    pad = " " * 6
+    return (f"  {comment}\n  (:action {name}\n    :parameters ({ps})\n"
+            f"    :precondition (and {_wrapped(pre, pad)})\n    :effect (and {_wrapped(eff, pad)}))\n")
 
 
 def schemas(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
@@ -334,8 +354,9 @@ def step_decoder(rules: LiftedRules, costs: bool = False):
         s = by_name[words[0].lower()]
         if s.pick is not None:
             return s.pick * N_LOCATIONS + s.release, s.alternative
-        frm, to = words[2].lower(), words[3].lower()
-        return int(frm[1:]) * N_LOCATIONS + int(to[1:]), s.alternative
+        frm = int(words[2].lower()[1:])
+        to = s.release if s.release is not None else int(words[3].lower()[1:])  # a schema refined on ?to fixes it
+        return frm * N_LOCATIONS + to, s.alternative
     return decode
 
 

@@ -397,7 +397,7 @@ def _export_lifted(out: Path, cfg: LiftedStageConfig, s: PipelineSettings) -> No
     from symlearn.export.lifted_export import export_lifted
 
     rep = export_lifted(out / RUN, out / DATA, tuple(out / d for d in cfg.extra_data), cfg.lifted)
-    print(f"kept learned bits {rep['kept_bits']}; {rep['moves']} moves of m(z) on observed scenes -> "
+    print(f"kept learned bits {rep['kept_bits']}; {rep['moves']} moves ({rep['config']['source']} outcomes) -> "
           f"{rep['rules']} lifted rules ({rep['domain_bytes']} bytes of PDDL)")
     for data, checks in rep["checks_test_split"].items():
         for group, c in checks.items():

@@ -427,3 +427,57 @@ def test_a_rule_keeps_its_outcome_share_and_the_cost_form_plans_on_its_alternati
             g if g is not None else c for c, g in zip(target, goal.codes))
     only_own = dataclasses.replace(rule, alternatives=())
     assert domain_pddl(dataclasses.replace(rules, rules=(only_own,)), costs=True).count("(:action") == 1
+
+
+def test_a_kind_that_follows_the_release_location_splits_the_rule_there_and_the_pddl_does_the_same():
+    """The kept bits of a moved object can follow where it lands (as the trained encoders' do). Moves whose cube
+    takes another kind when released at l2: the tree refines on the release location, the other locations keep
+    one lifted rule (`?to` with `(differ ?to l2)`), and every ground action of the PDDL sets the bits the rules set."""
+    from unified_planning.io import PDDLReader
+    from unified_planning.shortcuts import SequentialSimulator, get_environment
+    get_environment().credits_stream = None
+    before, actions, after, mask, stick = _arrays(world_moves(400, seed=3, objects=(2, 2)))
+    objs = before[mask]
+    layout = CodeLayout(8, kept_bits((objs[:, None] >> (9 + np.arange(7, -1, -1))) & 1, (objs >> 6) & 7))
+    stick_of = stick_reader(before, mask, stick, layout)
+    moves, _ = observed_moves(LiftedRules(layout, stick_of), before, after, actions, mask)
+    flip = 1 << (len(layout.kept) - 1)  # the first kept bit
+
+    def relabel(sig, out):
+        if sig["cls"] == "cube" and sig["to"] == 2:
+            o = out[0]
+            return sig, ((o[0], o[1], o[2], o[3] ^ flip), *out[1:])
+        return sig, out
+    rules = distil_lifted(layout, stick_of, [relabel(*m) for m in moves], min_count=1, model_hash="ab" * 8)
+    cube_to = [dict(r.key)["to"] for r in rules.rules if dict(r.key)["cls"] == "cube" and "to" in dict(r.key)]
+    assert (2,) in cube_to and any(len(t) > 1 and 2 not in t for t in cube_to), cube_to
+    domain = domain_pddl(rules)
+    assert "(differ ?to l2)" in domain and "pick-release-cube-to-l2-" in domain
+    checked = 0
+    for start in [m[0] for m in world_moves(6, seed=5, objects=(2, 2))]:
+        problem = PDDLReader().parse_problem_string(domain, problem_pddl(rules, start, SymbolicGoal(tuple(start)), "p"))
+        pieces = rules.pieces(start)
+        with SequentialSimulator(problem) as sim:
+            state = sim.get_initial_state()
+            for action, params in sim.get_applicable_actions(state):
+                a = plan_actions(rules, [f"({action.name} {' '.join(str(p) for p in params)})"])[0]
+                want, rule = rules.step_pieces(pieces, a)
+                assert rule is not None, f"the PDDL offers action {a} from {start}, no rule does"
+                nxt = sim.apply(state, action, params)
+                for i, p in enumerate(want):
+                    o = problem.object(object_name(i))
+                    kind = 0
+                    for b in layout.kept:
+                        kind = (kind << 1) | int(nxt.get_value(problem.fluent(f"bit-{b}")(o)).bool_constant_value())
+                    assert kind == p.kind, f"object {i}'s kept bits after action {a} from {start}"
+                checked += 1
+    assert checked >= 6
+
+
+@pytest.mark.parametrize("change, message", [({"source": "net"}, "source='net' must be one of observed, network"),
+                                             ({"pair_min_count": 0}, "pair_min_count=0 must be a positive integer"),
+                                             ({"min_gain": 1.0}, "min_gain=1.0 must lie in [0, 1)")])
+def test_lifted_settings_are_refused_in_one_line(change, message):
+    from symlearn.export.lifted_export import LiftedConfig
+    with pytest.raises(ValueError, match=message.replace("[", r"\[").replace("(", r"\(").replace(")", r"\)")):
+        LiftedConfig(**change)

@@ -147,7 +147,7 @@ def cmd_export_lifted(args: argparse.Namespace) -> int:
     rep = export_lifted(Path(args.run), Path(args.data), tuple(Path(d) for d in args.extra_data), cfg, out)
     where = out or Path(args.run) / "pddl"
     print(f"kept learned bits {rep['kept_bits']} (bits {rep['position_bits']} track the location); "
-          f"{rep['moves']} moves of m(z) on observed scenes -> {rep['rules']} lifted rules "
+          f"{rep['moves']} moves on training scenes ({rep['config']['source']} outcomes) -> {rep['rules']} lifted rules "
           f"({rep['domain_bytes']} bytes of PDDL)")
     for data, checks in rep["checks_test_split"].items():
         for group, c in checks.items():
@@ -156,7 +156,7 @@ def cmd_export_lifted(args: argparse.Namespace) -> int:
                   f"m(z) {c['accuracy_net']:.3f}")
     print(f"wrote {where / LIFTED_DIR / 'domain.pddl'} and {where / LIFTED_FILE}")
     for d in args.problems or []:
-        index = write_problem_folder(Path(args.run), Path(d))
+        index = write_problem_folder(Path(args.run), Path(d), pddl_dir=out)
         folder = where / LIFTED_DIR / Path(d).name
         print(f"wrote {folder}: domain.pddl and {len(index['problems'])} problems (p01.pddl ...), index.json")
         if index["zero_shot"]:

@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 
 from pddl_export.files import atomic_write_text, sha256_file
-from pddl_export.lifted_rules import LiftedRules, build_codebook, distil_lifted, observed_moves, stick_reader
+from pddl_export.lifted_rules import LiftedRules, build_codebook, distil_lifted, observed_moves, stick_reader, \
+    with_network_answers
 from pddl_export.lifted_scene import FIELD_BITS, CodeLayout, kept_bits
 from pddl_export.lifted_writer import domain_pddl, schemas
 from pddl_export.rules_io import PDDL_DIR
@@ -32,23 +33,39 @@ LIFTED_DIR = "lifted"
 COST_FORM_DIR = "costs"  # a problem folder's all-outcomes cost form (write_problem_folder)
 
 
+SOURCES = ("observed", "network")
+
+
 @dataclass(frozen=True)
 class LiftedConfig:
     """How the lifted rules are distilled."""
 
-    # a description of a move becomes a rule once m(z) answered it this often: 10 keeps the domain under 100 KB
-    # and Fast Downward 3-8x faster than 3 for 0.01-0.02 of accuracy (docs/DOMAIN.md)
-    min_count: int = 10
+    # whose next codes a move's outcome is: what the robot observed next ("observed"), or m(z)'s likeliest answer
+    # ("network"). The kept learned bits of a moved object follow where it lands, which a lifted rule sees only
+    # through its release location; rules of the observed outcomes are the more accurate on the held-out
+    # splits (docs/DOMAIN.md), and m(z)'s answers still give each rule its share and alternatives
+    source: str = "observed"
+    # a move structure becomes a rule once it was seen this often: each lifted cube rule grounds to every cube and
+    # pair of locations, so this sets Fast Downward's translator time (25: as many ground actions as the earlier
+    # export's 10 per description, with 0.07-0.10 more accuracy on the validation splits; docs/DOMAIN.md)
+    min_count: int = 25
     # a move that carries riders needs only this many: riders are 1.5% of objects, and without these rules the
     # domain could not state what Table I is about (a stick carries what stands on it)
     rider_min_count: int = 3
+    # a far-row stick's move names its two locations and grounds to a few actions: it needs only this many
+    pair_min_count: int = 6
+    min_gain: float = 0.05  # a refinement must explain this share of a node's moves more (distil_lifted)
     min_info: float = 0.25  # a learned bit with this much mutual information (bits) with the location tracks it
 
     def __post_init__(self) -> None:
-        for name in ("min_count", "rider_min_count"):
+        for name in ("min_count", "rider_min_count", "pair_min_count"):
             v = getattr(self, name)
             if not (isinstance(v, int) and not isinstance(v, bool) and v >= 1):
                 raise ValueError(f"{name}={v!r} must be a positive integer")
+        if self.source not in SOURCES:
+            raise ValueError(f"source={self.source!r} must be one of {', '.join(SOURCES)}")
+        if not 0 <= self.min_gain < 1:
+            raise ValueError(f"min_gain={self.min_gain!r} must lie in [0, 1)")
         if not 0 < self.min_info <= 3:
             raise ValueError(f"min_info={self.min_info!r} must lie in (0, 3]")
 
@@ -142,13 +159,19 @@ def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = 
                             np.concatenate([_pad(s.mask, width) for s in train]),
                             np.concatenate([_pad(s.stick, width) for s in train]), layout)
     probe = LiftedRules(layout, stick_of)
-    moves, why = [], Counter()
+    moves, answers, why = [], [], Counter()
     for s in train:
-        m, w = observed_moves(probe, s.before, network_steps(transition, s.before, s.action, s.mask), s.action, s.mask)
+        net = network_steps(transition, s.before, s.action, s.mask)
+        m, w = observed_moves(probe, s.before, s.after if cfg.source == "observed" else net, s.action, s.mask)
         moves += m
         why.update(w)
+        if cfg.source == "observed":
+            answers += observed_moves(probe, s.before, net, s.action, s.mask)[0]
     rules = distil_lifted(layout, stick_of, moves, cfg.min_count, model_hash,
-                          rider_min_count=min(cfg.rider_min_count, cfg.min_count))
+                          rider_min_count=min(cfg.rider_min_count, cfg.min_count),
+                          pair_min_count=cfg.pair_min_count, min_gain=cfg.min_gain)
+    if answers:  # each rule's share and alternatives are m(z)'s answers on the moves it covers
+        rules = with_network_answers(rules, answers)
     t_distil = time.perf_counter() - t0
     checks = {}
     for d in sets:
@@ -180,14 +203,16 @@ def _pad(a: np.ndarray, k: int) -> np.ndarray:
 MAX_DATA_OBJECTS = 5  # the most objects a scene of the data sets had: problems beyond it are zero-shot
 
 
-def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None = None) -> dict:
+def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None = None,
+                         pddl_dir: Path | None = None) -> dict:
     """A standalone benchmark folder of a problem set: the lifted domain.pddl and one pNN.pddl per problem, and
     the same in the domain's all-outcomes cost form under costs/ (COST_FORM_DIR: `:action-costs`, for a cost-aware
     search such as A* with LM-cut).
 
     Each problem's start and goal are the run's codes of its scenes (rendered in the simulator), as the
     planners see them; index.json maps pNN to the source problem, its object count and shortest plan length
-    where the problem file records it. Loading the folder needs no torch, no pybullet: only a PDDL planner.
+    where the problem file records it. Loading the folder needs no torch, no pybullet: only a PDDL planner. The
+    rules are read from pddl_dir (default RUN/pddl: export-pddl's --out), and the folder goes beside them.
     Returns the index; problems with more objects than the data ever showed are listed under `zero_shot`.
     """
     from pddl_export.lifted_rules import load_lifted
@@ -198,9 +223,10 @@ def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None
     from symlearn.symbolic.learned_transition import planning_models
 
     run_dir, problems_dir = Path(run_dir), Path(problems_dir)
-    rules = load_lifted(run_dir / PDDL_DIR / LIFTED_FILE)
+    pddl_dir = Path(pddl_dir) if pddl_dir else run_dir / PDDL_DIR  # where export_lifted wrote (its out_dir)
+    rules = load_lifted(pddl_dir / LIFTED_FILE)
     problems = load_problems(problems_dir)  # refuses a missing or empty folder before any work
-    out = Path(out_dir) if out_dir else run_dir / PDDL_DIR / LIFTED_DIR / problems_dir.name
+    out = Path(out_dir) if out_dir else pddl_dir / LIFTED_DIR / problems_dir.name
     reader, _ = planning_models(run_dir)
     index = {"domain": "domain.pddl", "cost_form": f"{COST_FORM_DIR}/domain.pddl", "model_hash": rules.model_hash,
              "source": str(problems_dir), "problems": {}, "zero_shot": []}
