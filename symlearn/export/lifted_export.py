@@ -46,9 +46,9 @@ class LiftedConfig:
     # splits (docs/DOMAIN.md), and m(z)'s answers still give each rule its share and alternatives
     source: str = "observed"
     # a move structure becomes a rule once it was seen this often: each lifted cube rule grounds to every cube and
-    # pair of locations, so this sets Fast Downward's translator time (25: as many ground actions as the earlier
-    # export's 10 per description, with 0.07-0.10 more accuracy on the validation splits; docs/DOMAIN.md)
-    min_count: int = 25
+    # pair of locations, so this sets Fast Downward's translator time (50: fewer ground actions than the earlier
+    # export's 10 per description, and 0.04-0.10 more accuracy on the validation splits; docs/RESULTS.md)
+    min_count: int = 50
     # a move that carries riders needs only this many: riders are 1.5% of objects, and without these rules the
     # domain could not state what Table I is about (a stick carries what stands on it)
     rider_min_count: int = 3
