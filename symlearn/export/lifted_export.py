@@ -1,10 +1,12 @@
-"""`symlearn export-pddl`: the lifted domain of a run's m(z), distilled on observed scenes.
+"""`symlearn export-pddl`: the lifted domain of a run's codes, distilled from its training moves.
 
-m(z) is asked for its likeliest next codes on every training scene of the given data sets (each state as the
-robot saw it, with the action it took); each answer is read as a move of pieces (pddl_export.lifted_rules)
-and the moves are distilled into lifted rules. They are checked on the sets' held-out test splits: against
-m(z)'s own likeliest step (fidelity) and against what the robot observed next (accuracy, beside m(z)'s own),
-whole scenes compared on what the domain states (kept learned bits, location, place, level).
+Every training scene of the given data sets (each state as the robot saw it, in the run's located codes, with the
+action it took) is read as a move of pieces (pddl_export.lifted_rules), with its outcome: what the robot observed
+next (LiftedConfig.source "observed", the default) or m(z)'s likeliest answer ("network"); the moves are
+distilled into lifted rules, whose shares and alternatives are m(z)'s answers. They are checked on the sets'
+held-out test splits: against m(z)'s own likeliest step (fidelity) and against what the robot observed next
+(accuracy, beside m(z)'s own), whole scenes compared on what the domain states (kept learned bits, location,
+place, level).
 
 Needs an m(z) on 9 location bits (`train-transition --location-bits 9`): location, place and level are the
 relations of the domain. Writes RUN/pddl/lifted.json (the rules, the layout, the type reader, the checks)
