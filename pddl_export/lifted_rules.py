@@ -45,7 +45,7 @@ MAX_LIFTED_BYTES = 64 << 20  # a lifted rules file is kilobytes; refuse anything
 STRUCTURE = ("cls", "o.stick", "o.place", "o.level", "u.level", "v.level", "riders.sides", "riders.place",
              "riders.level", "beneath", "landing", "u.at", "v.at")
 REFINEMENTS = (("to",), ("o.kind",), ("v.kind",), ("u.kind",), ("riders.kind",))
-MIN_GAIN = 0.02  # a split must explain this share of its node's moves more (distil_lifted)
+MIN_GAIN = 0.05  # a split must explain this share of its node's moves more (distil_lifted, LiftedConfig)
 ALTERNATIVE_MIN_SHARE = 0.1  # an outcome this often m(z)'s answer among a rule's moves becomes an alternative
 MAX_ALTERNATIVES = 2  # per rule, the most frequent ones (the cost form writes 1 + this many actions per rule)
 WHERE = ("to", "from", "stay", "shift")  # where a piece ends, relative to the action; an int is a location
@@ -348,6 +348,7 @@ def distil_lifted(layout: CodeLayout, stick_of: dict, moves: Sequence[tuple[dict
     for sig, out in moves:
         groups[key_of(sig, 0)].append((sig, out))
     rules: list[Rule] = []
+    tallies: dict = {}  # a rule's key -> the outcomes of its moves (a merged rule's are its leaves' together)
     unwritable = 0
 
     def needed(key: tuple, out: Outcome) -> int:
@@ -359,6 +360,7 @@ def distil_lifted(layout: CodeLayout, stick_of: dict, moves: Sequence[tuple[dict
         if not writable(outcome):
             unwritable += 1
             return
+        tallies[key] = tally
         rules.append(_with_alternatives(Rule(len(key) - len(STRUCTURE), key, outcome, sum(tally.values())), tally))
 
     def grow(key: tuple, node: list, used: tuple[str, ...]) -> None:
@@ -390,54 +392,49 @@ def distil_lifted(layout: CodeLayout, stick_of: dict, moves: Sequence[tuple[dict
             else:
                 leaf(child, Counter(out for _, out in part), best)
         if split == "to":
-            rules[first:] = _merge_destinations(key, rules[first:], best)
+            rules[first:] = _merge_destinations(key, rules[first:], best, tallies)
 
     for key, node in groups.items():
         out = Counter(o for _, o in node).most_common(1)[0][0]
         if len(node) >= needed(key, out):
             grow(key, node, ())
-    covered = {r.key: r.outcome for r in rules}
     lookup = LiftedRules(layout, stick_of, tuple(rules))
     hits = [lookup.rule_for(sig) for sig, _ in moves]
     agree = sum(h is not None and h.outcome == out for h, (_, out) in zip(hits, moves))
     n_covered = sum(h is not None for h in hits)
-    stats = {"moves": len(moves), "structures": len(groups), "rules": len(covered),
+    stats = {"moves": len(moves), "structures": len(groups), "rules": len(rules),
              "structures_without_move": unwritable, "covered_moves": n_covered,
              "agreement": round(agree / n_covered, 4) if n_covered else 0.0}
     return LiftedRules(layout, stick_of, tuple(sorted(rules, key=lambda r: (repr(r.key), r.depth))),
                        model_hash, stats)
 
 
-def _destinations(key: tuple) -> tuple[int, ...]:
+def release_locations(cls) -> tuple[int, ...]:
     """Where a move of a lifted class can release: any location for a cube, the near row for a near-row stick."""
-    return tuple(range(N_LOCATIONS)) if dict(key)["cls"] == "cube" else NEAR_ROW
+    return tuple(range(N_LOCATIONS)) if cls == "cube" else NEAR_ROW
 
 
-def _merge_destinations(key: tuple, children: list[Rule], best: Outcome) -> list[Rule]:
+def _merge_destinations(key: tuple, children: list[Rule], best: Outcome, tallies: dict) -> list[Rule]:
     """The rules under a node split on where the move releases, with the leaves of one outcome merged into one rule
     whose "to" names all their locations (a schema with `?to` and `(differ ?to l)` for the others, not one per
-    location). Locations no move released at join the node's own answer, as the unsplit node would have had it."""
+    location), its share and alternatives those of its leaves' moves together. Locations no move released at join
+    the node's own answer, as the unsplit node would have had it."""
     depth = len(key) - len(STRUCTURE) + 1
     leaves = [r for r in children if len(r.key) == len(key) + 1]
     seen = {r.key[-1][1] for r in children}
     by_outcome: dict = defaultdict(list)
     for r in leaves:
         by_outcome[r.outcome].append(r)
-    unseen = tuple(d for d in _destinations(key) if d not in seen)
+    unseen = tuple(d for d in release_locations(dict(key)["cls"]) if d not in seen)
     if unseen and best not in by_outcome and writable(best):
         by_outcome[best] = []
     merged = []
     for outcome, group in by_outcome.items():
         where = tuple(sorted({r.key[-1][1] for r in group} | (set(unseen) if outcome == best else set())))
-        support = sum(r.support for r in group)
-        share = sum(r.share * r.support for r in group) / support if support else 1.0
-        alts: Counter = Counter()
-        for r in group:
-            for o, p in r.alternatives:
-                alts[o] += p * r.support
-        alternatives = tuple((o, round(w / support, 4)) for o, w in alts.most_common(MAX_ALTERNATIVES)
-                             if w / support >= ALTERNATIVE_MIN_SHARE) if support else ()
-        merged.append(Rule(depth, key + (("to", where),), outcome, support, round(share, 4), alternatives))
+        tally = sum((tallies[r.key] for r in group), Counter())
+        rule = Rule(depth, key + (("to", where),), outcome, sum(tally.values()))
+        tallies[rule.key] = tally
+        merged.append(_with_alternatives(rule, tally))
     return merged + [r for r in children if len(r.key) > len(key) + 1]
 
 

@@ -22,8 +22,8 @@ from pathlib import Path
 import numpy as np
 
 from pddl_export.files import atomic_write_text, sha256_file
-from pddl_export.lifted_rules import LiftedRules, build_codebook, distil_lifted, observed_moves, stick_reader, \
-    with_network_answers
+from pddl_export.lifted_rules import MIN_GAIN, LiftedRules, build_codebook, distil_lifted, observed_moves, \
+    stick_reader, with_network_answers
 from pddl_export.lifted_scene import FIELD_BITS, CodeLayout, kept_bits
 from pddl_export.lifted_writer import domain_pddl, schemas
 from pddl_export.rules_io import PDDL_DIR
@@ -56,7 +56,7 @@ class LiftedConfig:
     rider_min_count: int = 3
     # a far-row stick's move names its two locations and grounds to a few actions: it needs only this many
     pair_min_count: int = 6
-    min_gain: float = 0.05  # a refinement must explain this share of a node's moves more (distil_lifted)
+    min_gain: float = MIN_GAIN  # a refinement must explain this share of a node's moves more (distil_lifted)
     min_info: float = 0.25  # a learned bit with this much mutual information (bits) with the location tracks it
 
     def __post_init__(self) -> None:
