@@ -30,7 +30,7 @@ import math
 from dataclasses import dataclass
 from typing import Iterable, Sequence
 
-from pddl_export.lifted_rules import LiftedRules, Rule
+from pddl_export.lifted_rules import LiftedRules, Rule, release_locations
 from pddl_export.lifted_scene import FAR_ROW, NEAR_ROW, N_LOCATIONS, neighbours, read_scene, top_of
 from pddl_export.symbolic import SymbolicGoal
 
@@ -97,31 +97,40 @@ def _bit_effects(rules: LiftedRules, term: str, new_kind: int, old_kind: int | N
     return out
 
 
-def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0, cost: int | None = None) -> Schema:
-    """The action schema of one rule (see the module docstring for the vocabulary): of its own outcome, or of its
-    alternative-th alternative; with a cost, the action increases total-cost by it."""
-    f = rule.fields()
+def _move_head(f: dict) -> tuple:
+    """Where a rule's move picks and releases, and the schema's parameters and preconditions on o and the two
+    locations: (pick, release, frm, to, params, pre), a location None and its term `?from` / `?to` where the
+    schema is lifted over it. A lifted rule refined on where it releases fixes `?to` (one location) or excludes the
+    locations it does not name (`(differ ?to l)`)."""
     cls = f["cls"]
     concrete = isinstance(cls, tuple)
-    pick, release = (cls if concrete else (None, f.get("to")))  # a lifted rule refined on where it releases
+    pick, release = cls if concrete else (None, f.get("to"))
     others: tuple = ()  # where a rule naming several release locations may not release
     if isinstance(release, tuple):
-        allowed = set(range(N_LOCATIONS)) if cls == "cube" else set(NEAR_ROW)
-        release, others = (release[0], ()) if len(release) == 1 else (None, tuple(sorted(allowed - set(release))))
+        release, others = (release[0], ()) if len(release) == 1 else \
+            (None, tuple(x for x in release_locations(cls) if x not in release))
     frm = loc_name(pick) if concrete else "?from"
     to = "?to" if release is None else loc_name(release)
-    ho, hu, hv = level_name(f["o.level"]), level_name(f["u.level"]), level_name(f["v.level"])
     params: list[tuple[str, str]] = [("?o", "stick" if f["o.stick"] else "cube")]
+    pre: list[str] = [f"(at ?o {frm})", f"(level ?o {level_name(f['o.level'])})",
+                      f"(rests ?o {level_name(f['u.level'])})", f"(place ?o {place_name(f['o.place'])})"]
     if not concrete:
         params += [("?from", "location")] + ([("?to", "location")] if release is None else [])
-    pre: list[str] = [f"(at ?o {frm})", f"(level ?o {ho})", f"(rests ?o {hu})",
-                      f"(place ?o {place_name(f['o.place'])})"]
-    eff: list[str] = []
-    if not concrete:
         pre.append(f"(differ ?from {to})")
         if cls == "near":
             pre += ["(near ?from)"] + (["(near ?to)"] if release is None else [])
         pre += [f"(differ ?to {loc_name(x)})" for x in others]
+    return pick, release, frm, to, params, pre
+
+
+def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0, cost: int | None = None) -> Schema:
+    """The action schema of one rule (see the module docstring for the vocabulary): of its own outcome, or of its
+    alternative-th alternative; with a cost, the action increases total-cost by it."""
+    f = rule.fields()
+    concrete = isinstance(f["cls"], tuple)
+    pick, release, frm, to, params, pre = _move_head(f)
+    ho, hu, hv = level_name(f["o.level"]), level_name(f["u.level"]), level_name(f["v.level"])
+    eff: list[str] = []
     if f.get("o.kind") is not None:
         pre += _bit_literals(rules, "?o", f["o.kind"])
     outcome = rule.outcomes()[alternative][0]
