@@ -2,9 +2,12 @@
 
 One domain for any number of objects: typed blocks (`cube`, `stick`), the six table locations, eight levels and the
 places as constants, and relations read from the location bits: `(at ?b ?l)` (nearest location), `(level ?b ?h)`
-(its top, in 5 cm layers), `(place ?b ?p)` (on its location, or which way and how far off), `(height ?l ?h)` (the
-top at a location: where a released object lands), `(rests ?b ?h)` (what is left at its location when it is
-lifted) and `(beneath ?l ?h)` (what is left under a far-row stick's end). The learned bits a rule tests are unary
+(its top, in 5 cm layers), `(place ?b ?p)` (on its location, or which way and how far off), `(height ?l ?h ?s)`
+(the top at a location: where a released object lands, and what it is: the `table`, a `block-top` standing there,
+or a far-row `stick-end` lying over it from a neighbour), `(rests ?b ?h ?s)` (what is left at its location when it
+is lifted) and `(beneath ?l ?h)` (what is left under a far-row stick's end). The surfaces keep a move onto a
+stick's end and one onto a tower of the same height apart (the rules' `v.at`, `u.at`: without them both actions
+would apply to either). The learned bits a rule tests are unary
 predicates in both polarities (`bit-I`, `no-bit-I`; docs/DOMAIN.md says what they mean in a real run), and
 `(differ ?a ?b)`, `(near ?l)` are static facts of every problem. Each rule of `pddl_export.lifted_rules` is one
 action schema in plain STRIPS with typing: no negative preconditions, no equality, no conditional effects, no
@@ -36,6 +39,12 @@ from pddl_export.symbolic import SymbolicGoal
 
 LEVELS = 8
 OUTCOME_COST_UNIT = 10  # the cost of a step m(z) always answered so; -ln share adds in the same unit
+SURFACES = ("table", "block-top", "stick-end")  # what the top at a location is, and what a block rests on
+
+
+def surface(level: int, stands: bool) -> str:
+    """The surface at a level: the table (level 0), a block standing at the location, or a far-row stick's end."""
+    return SURFACES[0] if level == 0 else SURFACES[1] if stands else SURFACES[2]
 
 
 def outcome_cost(share: float) -> int:
@@ -113,7 +122,8 @@ def _move_head(f: dict) -> tuple:
     to = "?to" if release is None else loc_name(release)
     params: list[tuple[str, str]] = [("?o", "stick" if f["o.stick"] else "cube")]
     pre: list[str] = [f"(at ?o {frm})", f"(level ?o {level_name(f['o.level'])})",
-                      f"(rests ?o {level_name(f['u.level'])})", f"(place ?o {place_name(f['o.place'])})"]
+                      f"(rests ?o {level_name(f['u.level'])} {surface(f['u.level'], f['u.at'])})",
+                      f"(place ?o {place_name(f['o.place'])})"]
     if not concrete:
         params += [("?from", "location")] + ([("?to", "location")] if release is None else [])
         pre.append(f"(differ ?from {to})")
@@ -138,17 +148,24 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
     lands_on = o_out[1] == 0  # o ends on the release location (else off it: a far stick then covers no neighbour)
     new_o = level_name(o_out[2])
 
-    # before: the heights of the locations o (or a rider) covers; `under`: what is left there once o is lifted
+    # before: the heights of the locations o (or a rider) covers; `under`: what is left there once o is lifted;
+    # tops / lifted: the same for what the top there is (a surface, or a parameter where the rule's key does not
+    # say: a far-row stick landing over a neighbour of some height)
     before, under = {frm: ho}, {frm: hu}
-    riders = _stick_ends(rules, f, pick, ho, before, under, params, pre, eff) if concrete else []
+    s_u = surface(f["u.level"], f["u.at"])
+    tops: dict[str, str] = {frm: "block-top"}
+    lifted = {frm: s_u}
+    riders = _stick_ends(rules, f, pick, ho, before, under, params, pre, eff, tops, lifted) if concrete else []
     for loc, h in before.items():
-        pre.append(f"(height {loc} {h})")
+        pre.append(f"(height {loc} {h} {tops[loc]})")
     # what the release location and (for a far-row stick) its neighbours hold once o is lifted
     if to in before:
         if under[to] != hv:
             raise ValueError(f"rule {index}: the release location's level {hv} is not what lies under the stick")
+        s_v = lifted[to]
     else:
-        pre.append(f"(height {to} {hv})")
+        s_v = tops[to] = surface(f["v.level"], f["v.at"])
+        pre.append(f"(height {to} {hv} {s_v})")
     landing = dict(zip((loc_name(n) for n in neighbours(release)), map(level_name, f["landing"]))) \
         if concrete and lands_on else {}
     for loc, h in landing.items():
@@ -156,9 +173,13 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
             if under[loc] != h:
                 raise ValueError(f"rule {index}: a neighbour's level {h} is not what lies under the stick")
         else:
-            pre.append(f"(height {loc} {h})")
+            tops[loc] = "table" if h == level_name(0) else f"?s-{loc}"
+            if tops[loc] != "table":
+                params.append((tops[loc], "surface"))
+            pre.append(f"(height {loc} {h} {tops[loc]})")
     after = {to: new_o}
-    eff += [f"(not (at ?o {frm}))", f"(at ?o {to})", f"(not (rests ?o {hu}))", f"(rests ?o {hv})"]
+    eff += [f"(not (at ?o {frm}))", f"(at ?o {to})"] + _replace("rests", "?o", f"{hu} {s_u}", f"{hv} {s_v}")
+    ends = set(landing)  # the locations o's own ends will top (unless a rider ends on one)
     for loc, h in landing.items():
         after[loc] = new_o
         eff.append(f"(beneath {loc} {h})")
@@ -168,7 +189,7 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
     known = set(before) | set(landing) | {to}  # the locations whose heights the rule knows
     for i, n, term, hr in riders:
         eff += _rider_effects(rules, f, i, n, term, hr, r_out[i], (pick, release), lands_on, (ho, new_o), known,
-                              after, index)
+                              after, index, ends)
     # the learned bits of what o leaves on top at its pick location, and of what it lands on
     for term, loc, level, kind, role in (("?u", frm, hu, u_kind, "u"), ("?v", to, hv, v_kind, "v")):
         if kind is None:
@@ -183,7 +204,9 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
         new = after.get(loc, under.get(loc, old))
         if old is None or new is None:
             raise ValueError(f"rule {index}: the height at {loc} is not known before and after the move")
-        eff += _replace("height", loc, old, new)
+        old_s = tops[loc]
+        new_s = ("stick-end" if loc in ends else "block-top") if loc in after else lifted.get(loc, old_s)
+        eff += _replace("height", loc, f"{old} {old_s}", f"{new} {new_s}")
     # beneath facts a landing re-adds where it also lifted them cancel out; keep the effects consistent
     eff = _net_effects(eff)
     if cost is not None:
@@ -207,10 +230,11 @@ def place_name(p: int) -> str:
 
 
 def _stick_ends(rules: LiftedRules, f: dict, pick: int, ho: str, before: dict, under: dict, params: list, pre: list,
-                eff: list) -> list[tuple]:
+                eff: list, tops: dict, lifted: dict) -> list[tuple]:
     """A far-row stick's ends over its pick's neighbours: each end's rider (a parameter, with its description) or
-    the stick itself on top there, and the level beneath it. Fills before/under/params/pre/eff; returns the
-    riders as (index, location, term, level)."""
+    the stick itself on top there, and the level beneath it. Fills before/under/params/pre/eff and the tops there
+    before and once the stick is lifted (what lies beneath an end is taken to be a block standing there, or the
+    table); returns the riders as (index, location, term, level)."""
     riders = []
     sides = f["riders.sides"]
     for n, hb in zip(neighbours(pick), f["beneath"]):
@@ -219,15 +243,18 @@ def _stick_ends(rules: LiftedRules, f: dict, pick: int, ho: str, before: dict, u
             i = sides.index(side)
             term, hr = f"?r{i}", level_name(f["riders.level"][i])
             params.append((term, "block"))
-            pre += [f"(at {term} {loc_name(n)})", f"(level {term} {hr})", f"(rests {term} {ho})",
+            pre += [f"(at {term} {loc_name(n)})", f"(level {term} {hr})", f"(rests {term} {ho} stick-end)",
                     f"(place {term} {place_name(f['riders.place'][i])})"]
             if f.get("riders.kind") is not None:
                 pre += _bit_literals(rules, term, f["riders.kind"][i])
             riders.append((i, n, term, hr))
             before[loc_name(n)] = hr
+            tops[loc_name(n)] = "block-top"
         else:
             before[loc_name(n)] = ho
+            tops[loc_name(n)] = "stick-end"
         under[loc_name(n)] = level_name(hb)
+        lifted[loc_name(n)] = surface(hb, True)
         pre.append(f"(beneath {loc_name(n)} {level_name(hb)})")
         eff.append(f"(not (beneath {loc_name(n)} {level_name(hb)}))")
     return riders
@@ -239,18 +266,21 @@ def _replace(predicate: str, term: str, old: str, new: str) -> list[str]:
 
 
 def _rider_effects(rules: LiftedRules, f: dict, i: int, n: int, term: str, hr: str, change, move: tuple[int, int],
-                   lands_on: bool, stick_levels: tuple[str, str], known: set, after: dict, index: int) -> list[str]:
+                   lands_on: bool, stick_levels: tuple[str, str], known: set, after: dict, index: int,
+                   ends: set) -> list[str]:
     """Effects on rider i of a far-row stick (at neighbour n, level hr): it rides along to the shifted neighbour,
     or falls (it stays at its place's location, or the one m(z) says, on the table). Sets `after`'s height where a
-    rider ends at a location whose height the rule knows."""
+    rider ends at a location whose height the rule knows, and takes that location out of `ends` (the stick's end
+    there is not its top)."""
     pick, release = move
     ho, new_o = stick_levels
     shifted = n + release - pick
     new_r = level_name(change[2])
     if change[0] == "shift" and lands_on and shifted in neighbours(release):  # rides along
         after[loc_name(shifted)] = new_r
+        ends.discard(loc_name(shifted))
         eff = [f"(not (at {term} {loc_name(n)}))", f"(at {term} {loc_name(shifted)})"]
-        eff += _replace("rests", term, ho, new_o)
+        eff += _replace("rests", term, f"{ho} stick-end", f"{new_o} stick-end")
     else:
         where = change[0]
         new_loc = {"stay": n, "shift": shifted}.get(where, where if isinstance(where, int) else n)
@@ -258,7 +288,8 @@ def _rider_effects(rules: LiftedRules, f: dict, i: int, n: int, term: str, hr: s
             raise ValueError(f"rule {index}: a rider ends at no location ({new_loc})")
         if loc_name(new_loc) in known:
             after[loc_name(new_loc)] = new_r  # elsewhere the rule does not know the height it lands beside
-        eff = [f"(not (rests {term} {ho}))", f"(rests {term} {level_name(0)})"]
+            ends.discard(loc_name(new_loc))
+        eff = [f"(not (rests {term} {ho} stick-end))", f"(rests {term} {level_name(0)} table)"]
         eff += _replace("at", term, loc_name(n), loc_name(new_loc))
     eff += _replace("place", term, place_name(f["riders.place"][i]), place_name(change[1]))
     eff += _replace("level", term, hr, new_r)
@@ -388,10 +419,12 @@ def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
             f"(define (domain {domain_name(rules)})\n"
             f"  (:requirements {requirements})\n"
             # one line per parent type: pddlgym's parser reads a parent's name up to the end of its line
-            "  (:types\n    block location layer position - object\n    cube stick - block)\n"
-            f"  (:constants {locs} - location {lvls} - layer {' '.join(PLACES)} - position)\n"
-            "  (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer) (rests ?b - block ?h - layer)\n"
-            "               (height ?l - location ?h - layer) (beneath ?l - location ?h - layer) (place ?b - block ?p - position)\n"
+            "  (:types\n    block location layer position surface - object\n    cube stick - block)\n"
+            f"  (:constants {locs} - location {lvls} - layer {' '.join(PLACES)} - position\n"
+            f"    {' '.join(SURFACES)} - surface)\n"
+            "  (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer)\n"
+            "               (rests ?b - block ?h - layer ?s - surface) (height ?l - location ?h - layer ?s - surface)\n"
+            "               (beneath ?l - location ?h - layer) (place ?b - block ?p - position)\n"
             "               (near ?l - location) (differ ?a - location ?b - location)"
             + (f"\n               {bits}" if bits else "") + ")\n"
             + functions + body + ")\n")
@@ -399,6 +432,11 @@ def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
 
 def object_name(i: int) -> str:
     return f"o{i}"
+
+
+def _surface_of(pieces, t: int | None, loc: int) -> str:
+    """What piece t (None: nothing) is as the top at location loc."""
+    return surface(0 if t is None else pieces[t].level, t is not None and pieces[t].loc == loc)
 
 
 def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicGoal, name: str,
@@ -419,11 +457,13 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
         init.append(f"(level {o} {level_name(p.level)})")
         init += _bit_literals(rules, o, p.kind)
         init.append(f"(place {o} {place_name(p.place)})")
-        if p.loc < N_LOCATIONS:  # the level under it at its own location
+        if p.loc < N_LOCATIONS:  # the level under it at its own location, and whether that stands there
             below = top_of(pieces, p.loc, frozenset(j for j, q in enumerate(pieces) if q.level >= p.level))
-            init.append(f"(rests {o} {level_name(0 if below is None else pieces[below].level)})")
+            init.append(f"(rests {o} {level_name(0 if below is None else pieces[below].level)} "
+                        f"{_surface_of(pieces, below, p.loc)})")
     for loc, t in enumerate(graph.tops):
-        init.append(f"(height {loc_name(loc)} {level_name(0 if t is None else pieces[t].level)})")
+        init.append(f"(height {loc_name(loc)} {level_name(0 if t is None else pieces[t].level)} "
+                    f"{_surface_of(pieces, t, loc)})")
         for i, p in enumerate(pieces):  # a far-row stick's end over loc: the level under it
             if p.stick and p.on_location and p.loc != loc and loc in p.covers():
                 below = top_of(pieces, loc, frozenset(j for j, q in enumerate(pieces) if q.level >= p.level))

@@ -16,7 +16,7 @@ import pytest
 from pddl_export.lifted_rules import REFINEMENTS, LiftedRules, distil_lifted, key_of, load_lifted, observed_moves, \
     participants, stick_reader
 from pddl_export.lifted_scene import CodeLayout, Piece, kept_bits, read_scene
-from pddl_export.lifted_writer import domain_pddl, object_name, plan_actions, problem_pddl
+from pddl_export.lifted_writer import SURFACES, domain_pddl, object_name, plan_actions, problem_pddl, schemas
 from pddl_export.symbolic import SymbolicGoal
 from symlearn.problems.stacking import act, drop_all
 from symlearn.world import ObjectType
@@ -167,7 +167,8 @@ def test_rules_that_write_the_same_action_write_it_once(world_rules):
 
 
 def test_pddl_successors_are_the_rules(pair_rules):
-    """Every applicable ground action of the PDDL leads where the rules lead, for every action of sampled states."""
+    """Every action of sampled states has one applicable ground action in the PDDL where the rules have a rule for it,
+    and none elsewhere, and it leads where the rules lead."""
     from unified_planning.io import PDDLReader
     from unified_planning.shortcuts import SequentialSimulator, get_environment
     get_environment().credits_stream = None
@@ -187,6 +188,8 @@ def test_pddl_successors_are_the_rules(pair_rules):
         for a in range(36):
             want, rule = pair_rules.step_pieces(pieces, a)
             assert (rule is not None) == (a in by_action), f"action {a} from {start}"
+            # the leaves partition the moves, and so do the schemas: one ground action per (pick, release)
+            assert len(by_action.get(a, [])) <= 1, f"action {a} from {start}: {len(by_action[a])} ground actions"
             for nxt in by_action.get(a, []):
                 checked += 1
                 for i, p in enumerate(want):
@@ -195,6 +198,63 @@ def test_pddl_successors_are_the_rules(pair_rules):
                     lvl = [h for h in range(8) if nxt.get_value(problem.fluent("level")(o, problem.object(f"h{h}"))).bool_constant_value()]
                     assert at == [p.loc] and lvl == [p.level], f"object {i} after action {a} from {start}"
     assert checked >= 3
+
+
+def _applicable(schema_list, problem_text: str) -> dict[str, list[tuple]]:
+    """Each schema's ground actions whose preconditions hold in the problem's initial state (a small grounder for
+    the test: bindings by type, pruned as soon as a precondition's terms are bound)."""
+    objects = problem_text.split("(:objects", 1)[1].split(")", 1)[0].split()
+    typed = {"block": [], "cube": [], "stick": [], "location": [f"l{i}" for i in range(6)], "surface": list(SURFACES)}
+    for name, _, kind in zip(objects[::3], objects[1::3], objects[2::3]):
+        typed[kind].append(name)
+        typed["block"].append(name)
+    lines = problem_text.split("(:init", 1)[1].split("(:goal", 1)[0].splitlines()
+    init = {line.strip()[:line.strip().index(")") + 1] for line in lines if line.strip().startswith("(")}
+    found: dict[str, list[tuple]] = {}
+    for s in schema_list:
+        names = [p for p, _ in s.params]
+        def holds(atom: str, binding: dict) -> bool | None:
+            words = atom.strip("()").split()
+            if any(w.startswith("?") and w not in binding for w in words):
+                return None
+            return "(" + " ".join(binding.get(w, w) for w in words) + ")" in init
+        def extend(binding: dict, k: int):
+            if any(holds(a, binding) is False for a in s.pre):
+                return
+            if k == len(names):
+                found.setdefault(s.name, []).append(tuple(binding[n] for n in names))
+                return
+            for value in typed[s.params[k][1]]:
+                extend({**binding, names[k]: value}, k + 1)
+        extend({}, 0)
+    return found
+
+
+def test_one_ground_action_per_pick_and_release_where_stick_ends_and_towers_share_a_height(world_rules):
+    """A cube released onto a far-row stick's end and one released onto a block standing at the location are
+    different moves (the structure's `v.at`), as is a cube lifted off a stick's end and one lifted off a block
+    (`u.at`); the PDDL states what the top at a location is and what a block rests on (`height`, `rests`), so in
+    every state at most one ground action stands for each robot action, the one of the rule that matches."""
+    assert any(not r.fields()["v.at"] and r.fields()["v.level"] > 0 for r in world_rules.rules)
+    assert any(not r.fields()["u.at"] and r.fields()["u.level"] > 0 for r in world_rules.rules)
+    written = schemas(world_rules)
+    onto_end = checked = 0
+    for start, _, _, _ in world_moves(120, seed=5, objects=(3, 4)):
+        text = problem_pddl(world_rules, start, SymbolicGoal(tuple(start)), "p")
+        pieces = world_rules.pieces(start)
+        graph = read_scene(pieces)
+        by_action: dict[int, list[str]] = {}
+        for name, bindings in _applicable(written, text).items():
+            for b in bindings:
+                by_action.setdefault(plan_actions(world_rules, [f"({name} {' '.join(b)})"])[0], []).append(name)
+        for a in range(36):
+            _, rule = world_rules.step_pieces(pieces, a)
+            assert len(by_action.get(a, [])) == (rule is not None), f"action {a} from {start}: {by_action.get(a)}"
+            if rule is not None:
+                checked += 1
+                v = graph.tops[a % 6]
+                onto_end += v is not None and pieces[v].loc != a % 6
+    assert checked > 300 and onto_end > 5
 
 
 @pytest.mark.parametrize("planner", ["fd-lmcut", "fd-lama-first", "pyperplan"])
