@@ -249,7 +249,10 @@ def test_closed_loop_records_every_executed_step(sim, encoder, problems):
                                                    for i in range(len(ex.executed))]
 
 
-def test_closed_loop_stops_when_replanning_fails(sim, encoder, problems):
+@pytest.mark.parametrize("keep", [True, False])
+def test_a_failed_replan_keeps_the_plan_running_or_stops(sim, encoder, problems, keep):
+    """The first step departs from its prediction and the replan finds nothing: by default the plan's other two
+    steps still run (as open loop would); with keep_plan_on_failed_replan off, execution stops there."""
     pr = problems[0]
     goal = goal_codes(sim, encoder, pr)
     start = scene_codes(sim, encoder, pr.initial)
@@ -257,8 +260,10 @@ def test_closed_loop_stops_when_replanning_fails(sim, encoder, problems):
     fail = PlanResult(planner="t", status=PlanStatus.UNSOLVABLE, plan=(), predicted_states=(), expansions=3,
                       planning_time_s=0.0)
     plan = _plan([a, a, a], [start, _wrong(start), start, start])
-    ex = execute_plan(sim, pr, plan, encoder, goal, ExecutionConfig(closed_loop=True), replan=lambda c: fail)
-    assert ex.replan_failed and ex.replans == 1 and len(ex.executed) == 1
+    cfg = ExecutionConfig(closed_loop=True, keep_plan_on_failed_replan=keep)
+    ex = execute_plan(sim, pr, plan, encoder, goal, cfg, replan=lambda c: fail)
+    assert ex.replan_failed and ex.replans == 1 and len(ex.executed) == (3 if keep else 1)
+    assert all(tuple(s) == tuple(start) for s in ex.observed_states[1:])  # an empty pick leaves the scene as it was
 
 
 def test_closed_loop_needs_a_replan_function(sim, encoder, problems):
