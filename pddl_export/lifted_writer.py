@@ -2,14 +2,15 @@
 
 One domain for any number of objects: typed blocks (`cube`, `stick`), the six table locations, eight levels and the
 places as constants, and relations read from the location bits: `(at ?b ?l)` (nearest location), `(level ?b ?h)`
-(its top, in 5 cm layers), `(place ?b ?p)` (on its location, or which way and how far off), `(height ?l ?h ?s)`
-(the top at a location: where a released object lands, and what it is: the `table`, a `block-top` standing there,
-or a far-row `stick-end` lying over it from a neighbour), `(rests ?b ?h ?s)` (what is left at its location when it
-is lifted) and `(beneath ?l ?h)` (what is left under a far-row stick's end). The surfaces keep a move onto a
-stick's end and one onto a tower of the same height apart (the rules' `v.at`, `u.at`: without them both actions
-would apply to either). The learned bits a rule tests are unary
+(its top, in 5 cm layers), `(place ?b ?p)` (on its location, or which way and how far off), `(height ?l ?t)`
+(the top at a location: where a released object lands) and `(rests ?b ?t)` (what is left at its location when it
+is lifted), where the top `?t` is a layer (`h0`: the table; `h3`: a block standing there, its top at level 3) or
+the end of a far-row stick lying over the location from a neighbour (`h1-end`); and `(beneath ?l ?h)` (what is
+left under a stick's end). The ends keep a move onto a stick's end and one onto a tower of the same height apart
+(the rules' `v.at`, `u.at`: without them both actions would apply to either). The learned bits a rule tests are unary
 predicates in both polarities (`bit-I`, `no-bit-I`; docs/DOMAIN.md says what they mean in a real run), and
-`(differ ?a ?b)`, `(near ?l)` are static facts of every problem. Each rule of `pddl_export.lifted_rules` is one
+`(differ ?a ?b)`, `(is ?a ?b)` (the same location), `(near ?l)` and `(same-level ?t ?h)` are static facts of every
+problem. Each rule of `pddl_export.lifted_rules` is one
 action schema in plain STRIPS with typing: no negative preconditions, no equality, no conditional effects, no
 quantifiers, no axioms, so that Fast Downward (LM-cut included), pyperplan and pyval take it. `at`, `level`,
 `rests` and `height` hold one value per block or location, which Fast Downward's translator finds.
@@ -45,6 +46,20 @@ SURFACES = ("table", "block-top", "stick-end")  # what the top at a location is,
 def surface(level: int, stands: bool) -> str:
     """The surface at a level: the table (level 0), a block standing at the location, or a far-row stick's end."""
     return SURFACES[0] if level == 0 else SURFACES[1] if stands else SURFACES[2]
+
+
+def top_name(layer: str, what: str) -> str:
+    """The layer constant of a top: `h3` (the table at h0, or a block standing there), `h3-end` (a stick's end);
+    a parameter (`?t-...`) stands for itself. One value per location or block, so that Fast Downward's invariant
+    synthesis (one counted argument per predicate) finds `height` and `rests` as multi-valued variables."""
+    if what.startswith("?"):
+        return what
+    return f"{layer}-end" if what == SURFACES[2] else layer
+
+
+def layer_names() -> list[str]:
+    """Every layer constant: the levels h0-h7 and the stick ends h1-end-h7-end."""
+    return [level_name(h) for h in range(LEVELS)] + [f"{level_name(h)}-end" for h in range(1, LEVELS)]
 
 
 def outcome_cost(share: float) -> int:
@@ -119,14 +134,19 @@ def _move_head(f: dict) -> tuple:
         release, others = (release[0], ()) if len(release) == 1 else \
             (None, tuple(x for x in release_locations(cls) if x not in release))
     frm = loc_name(pick) if concrete else "?from"
-    to = "?to" if release is None else loc_name(release)
+    # a lifted rule refined to one release location keeps ?to as a parameter, fixed by the static `(is ?to l2)`:
+    # Fast Downward's invariant synthesis then sees ?from and ?to differ (it does not see a parameter differ from a
+    # constant), and finds each location's height as one variable
+    to = loc_name(release) if concrete else "?to"
     params: list[tuple[str, str]] = [("?o", "stick" if f["o.stick"] else "cube")]
     pre: list[str] = [f"(at ?o {frm})", f"(level ?o {level_name(f['o.level'])})",
-                      f"(rests ?o {level_name(f['u.level'])} {surface(f['u.level'], f['u.at'])})",
+                      f"(rests ?o {top_name(level_name(f['u.level']), surface(f['u.level'], f['u.at']))})",
                       f"(place ?o {place_name(f['o.place'])})"]
     if not concrete:
-        params += [("?from", "location")] + ([("?to", "location")] if release is None else [])
+        params += [("?from", "location"), ("?to", "location")]
         pre.append(f"(differ ?from {to})")
+        if release is not None:
+            pre.append(f"(is ?to {loc_name(release)})")
         if cls == "near":
             pre += ["(near ?from)"] + (["(near ?to)"] if release is None else [])
         pre += [f"(differ ?to {loc_name(x)})" for x in others]
@@ -157,7 +177,7 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
     lifted = {frm: s_u}
     riders = _stick_ends(rules, f, pick, ho, before, under, params, pre, eff, tops, lifted) if concrete else []
     for loc, h in before.items():
-        pre.append(f"(height {loc} {h} {tops[loc]})")
+        pre.append(f"(height {loc} {top_name(h, tops[loc])})")
     # what the release location and (for a far-row stick) its neighbours hold once o is lifted
     if to in before:
         if under[to] != hv:
@@ -165,7 +185,7 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
         s_v = lifted[to]
     else:
         s_v = tops[to] = surface(f["v.level"], f["v.at"])
-        pre.append(f"(height {to} {hv} {s_v})")
+        pre.append(f"(height {to} {top_name(hv, s_v)})")
     landing = dict(zip((loc_name(n) for n in neighbours(release)), map(level_name, f["landing"]))) \
         if concrete and lands_on else {}
     for loc, h in landing.items():
@@ -173,12 +193,13 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
             if under[loc] != h:
                 raise ValueError(f"rule {index}: a neighbour's level {h} is not what lies under the stick")
         else:
-            tops[loc] = "table" if h == level_name(0) else f"?s-{loc}"
+            tops[loc] = "table" if h == level_name(0) else f"?t-{loc}"  # a block or a stick's end at level h
             if tops[loc] != "table":
-                params.append((tops[loc], "surface"))
-            pre.append(f"(height {loc} {h} {tops[loc]})")
+                params.append((tops[loc], "layer"))
+                pre.append(f"(same-level {tops[loc]} {h})")
+            pre.append(f"(height {loc} {top_name(h, tops[loc])})")
     after = {to: new_o}
-    eff += [f"(not (at ?o {frm}))", f"(at ?o {to})"] + _replace("rests", "?o", f"{hu} {s_u}", f"{hv} {s_v}")
+    eff += [f"(not (at ?o {frm}))", f"(at ?o {to})"] + _replace("rests", "?o", top_name(hu, s_u), top_name(hv, s_v))
     ends = set(landing)  # the locations o's own ends will top (unless a rider ends on one)
     for loc, h in landing.items():
         after[loc] = new_o
@@ -206,14 +227,14 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
             raise ValueError(f"rule {index}: the height at {loc} is not known before and after the move")
         old_s = tops[loc]
         new_s = ("stick-end" if loc in ends else "block-top") if loc in after else lifted.get(loc, old_s)
-        eff += _replace("height", loc, f"{old} {old_s}", f"{new} {new_s}")
+        eff += _replace("height", loc, top_name(old, old_s), top_name(new, new_s))
     # beneath facts a landing re-adds where it also lifted them cancel out; keep the effects consistent
     eff = _net_effects(eff)
     if cost is not None:
         cost = int(cost)
         eff.append(f"(increase (total-cost) {cost})")
 
-    where = f"-{frm}-{to}" if concrete else (f"-to-{to}" if release is not None else "")
+    where = f"-{frm}-{to}" if concrete else (f"-to-{loc_name(release)}" if release is not None else "")
     name = (f"pick-release-{'stick' if f['o.stick'] else 'cube'}{where}-{index}"
             + (f"-alt{alternative}" if alternative else ""))
     text = _schema_text(name, params, pre, eff, _comment(rule, f, alternative))
@@ -243,7 +264,7 @@ def _stick_ends(rules: LiftedRules, f: dict, pick: int, ho: str, before: dict, u
             i = sides.index(side)
             term, hr = f"?r{i}", level_name(f["riders.level"][i])
             params.append((term, "block"))
-            pre += [f"(at {term} {loc_name(n)})", f"(level {term} {hr})", f"(rests {term} {ho} stick-end)",
+            pre += [f"(at {term} {loc_name(n)})", f"(level {term} {hr})", f"(rests {term} {ho}-end)",
                     f"(place {term} {place_name(f['riders.place'][i])})"]
             if f.get("riders.kind") is not None:
                 pre += _bit_literals(rules, term, f["riders.kind"][i])
@@ -280,7 +301,7 @@ def _rider_effects(rules: LiftedRules, f: dict, i: int, n: int, term: str, hr: s
         after[loc_name(shifted)] = new_r
         ends.discard(loc_name(shifted))
         eff = [f"(not (at {term} {loc_name(n)}))", f"(at {term} {loc_name(shifted)})"]
-        eff += _replace("rests", term, f"{ho} stick-end", f"{new_o} stick-end")
+        eff += _replace("rests", term, f"{ho}-end", f"{new_o}-end")
     else:
         where = change[0]
         new_loc = {"stay": n, "shift": shifted}.get(where, where if isinstance(where, int) else n)
@@ -289,7 +310,7 @@ def _rider_effects(rules: LiftedRules, f: dict, i: int, n: int, term: str, hr: s
         if loc_name(new_loc) in known:
             after[loc_name(new_loc)] = new_r  # elsewhere the rule does not know the height it lands beside
             ends.discard(loc_name(new_loc))
-        eff = [f"(not (rests {term} {ho} stick-end))", f"(rests {term} {level_name(0)} table)"]
+        eff = [f"(not (rests {term} {ho}-end))", f"(rests {term} {level_name(0)})"]
         eff += _replace("at", term, loc_name(n), loc_name(new_loc))
     eff += _replace("place", term, place_name(f["riders.place"][i]), place_name(change[1]))
     eff += _replace("level", term, hr, new_r)
@@ -410,7 +431,7 @@ def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
     """The lifted domain's text; with costs, its all-outcomes cost form (the module docstring)."""
     bits = " ".join(f"(bit-{b} ?b - block) (no-bit-{b} ?b - block)" for b in rules.layout.kept)
     locs = " ".join(loc_name(i) for i in range(N_LOCATIONS))
-    lvls = " ".join(level_name(h) for h in range(LEVELS))
+    lvls = " ".join(layer_names())
     body = "".join(s.text for s in schemas(rules, costs))
     requirements = ":strips :typing :action-costs" if costs else ":strips :typing"
     functions = "  (:functions (total-cost) - number)\n" if costs else ""
@@ -419,13 +440,12 @@ def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
             f"(define (domain {domain_name(rules)})\n"
             f"  (:requirements {requirements})\n"
             # one line per parent type: pddlgym's parser reads a parent's name up to the end of its line
-            "  (:types\n    block location layer position surface - object\n    cube stick - block)\n"
-            f"  (:constants {locs} - location {lvls} - layer {' '.join(PLACES)} - position\n"
-            f"    {' '.join(SURFACES)} - surface)\n"
+            "  (:types\n    block location layer position - object\n    cube stick - block)\n"
+            f"  (:constants {locs} - location {' '.join(PLACES)} - position\n    {lvls} - layer)\n"
             "  (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer)\n"
-            "               (rests ?b - block ?h - layer ?s - surface) (height ?l - location ?h - layer ?s - surface)\n"
+            "               (rests ?b - block ?t - layer) (height ?l - location ?t - layer) (same-level ?t - layer ?h - layer)\n"
             "               (beneath ?l - location ?h - layer) (place ?b - block ?p - position)\n"
-            "               (near ?l - location) (differ ?a - location ?b - location)"
+            "               (near ?l - location) (differ ?a - location ?b - location) (is ?a - location ?b - location)"
             + (f"\n               {bits}" if bits else "") + ")\n"
             + functions + body + ")\n")
 
@@ -449,7 +469,9 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
     graph = read_scene(pieces)
     objs = " ".join(f"{object_name(i)} - {'stick' if p.stick else 'cube'}" for i, p in enumerate(pieces))
     init = [f"(near {loc_name(x)})" for x in NEAR_ROW]
+    init += [f"(same-level {t} {t.removesuffix('-end')})" for t in layer_names() if t != level_name(0)]
     init += [f"(differ {loc_name(a)} {loc_name(b)})" for a in range(N_LOCATIONS) for b in range(N_LOCATIONS) if a != b]
+    init += [f"(is {loc_name(a)} {loc_name(a)})" for a in range(N_LOCATIONS)]
     for i, p in enumerate(pieces):
         o = object_name(i)
         if p.loc < N_LOCATIONS:
@@ -459,11 +481,9 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
         init.append(f"(place {o} {place_name(p.place)})")
         if p.loc < N_LOCATIONS:  # the level under it at its own location, and whether that stands there
             below = top_of(pieces, p.loc, frozenset(j for j, q in enumerate(pieces) if q.level >= p.level))
-            init.append(f"(rests {o} {level_name(0 if below is None else pieces[below].level)} "
-                        f"{_surface_of(pieces, below, p.loc)})")
+            init.append(f"(rests {o} {top_name(level_name(0 if below is None else pieces[below].level), _surface_of(pieces, below, p.loc))})")
     for loc, t in enumerate(graph.tops):
-        init.append(f"(height {loc_name(loc)} {level_name(0 if t is None else pieces[t].level)} "
-                    f"{_surface_of(pieces, t, loc)})")
+        init.append(f"(height {loc_name(loc)} {top_name(level_name(0 if t is None else pieces[t].level), _surface_of(pieces, t, loc))})")
         for i, p in enumerate(pieces):  # a far-row stick's end over loc: the level under it
             if p.stick and p.on_location and p.loc != loc and loc in p.covers():
                 below = top_of(pieces, loc, frozenset(j for j, q in enumerate(pieces) if q.level >= p.level))

@@ -16,7 +16,7 @@ import pytest
 from pddl_export.lifted_rules import REFINEMENTS, LiftedRules, distil_lifted, key_of, load_lifted, observed_moves, \
     participants, stick_reader
 from pddl_export.lifted_scene import CodeLayout, Piece, kept_bits, read_scene
-from pddl_export.lifted_writer import SURFACES, domain_pddl, object_name, plan_actions, problem_pddl, schemas
+from pddl_export.lifted_writer import domain_pddl, layer_names, object_name, plan_actions, problem_pddl, schemas
 from pddl_export.symbolic import SymbolicGoal
 from symlearn.problems.stacking import act, drop_all
 from symlearn.world import ObjectType
@@ -204,7 +204,7 @@ def _applicable(schema_list, problem_text: str) -> dict[str, list[tuple]]:
     """Each schema's ground actions whose preconditions hold in the problem's initial state (a small grounder for
     the test: bindings by type, pruned as soon as a precondition's terms are bound)."""
     objects = problem_text.split("(:objects", 1)[1].split(")", 1)[0].split()
-    typed = {"block": [], "cube": [], "stick": [], "location": [f"l{i}" for i in range(6)], "surface": list(SURFACES)}
+    typed = {"block": [], "cube": [], "stick": [], "location": [f"l{i}" for i in range(6)], "layer": layer_names()}
     for name, _, kind in zip(objects[::3], objects[1::3], objects[2::3]):
         typed[kind].append(name)
         typed["block"].append(name)
@@ -233,7 +233,7 @@ def _applicable(schema_list, problem_text: str) -> dict[str, list[tuple]]:
 def test_one_ground_action_per_pick_and_release_where_stick_ends_and_towers_share_a_height(world_rules):
     """A cube released onto a far-row stick's end and one released onto a block standing at the location are
     different moves (the structure's `v.at`), as is a cube lifted off a stick's end and one lifted off a block
-    (`u.at`); the PDDL states what the top at a location is and what a block rests on (`height`, `rests`), so in
+    (`u.at`); the PDDL states what the top at a location is and what a block rests on (`h3` or `h3-end`), so in
     every state at most one ground action stands for each robot action, the one of the rule that matches."""
     assert any(not r.fields()["v.at"] and r.fields()["v.level"] > 0 for r in world_rules.rules)
     assert any(not r.fields()["u.at"] and r.fields()["u.level"] > 0 for r in world_rules.rules)
