@@ -193,7 +193,7 @@ def run_group(args: Sequence[str], stdin_text: str, timeout_s: float, *, cwd: Pa
         unregister_group(proc.pid)
 
 
-class DeadlineExceeded(Exception):
+class DeadlineExceeded(BaseException):
     """Raised inside `within` when its time is up."""
 
 
