@@ -109,24 +109,24 @@ def test_two_process_ddp_ends_with_identical_weights(data, tmp_path):
     assert m["world_size"] == 2 and m["ranks_identical"] is True
 
 
-def test_two_nodes_by_rendezvous_train_one_run(data, tmp_path):
-    """docs/SCALING.md's two-node command, both "nodes" on this machine: one torchrun launcher per node,
-    joined by a c10d rendezvous, one process each, writing one shared run."""
+def _two_node_launch(data, tmp_path: Path, attempt: int) -> tuple[bool, list[str], Path]:
+    """One try of docs/SCALING.md's two-node command on this machine: (every launcher that ended by itself
+    succeeded and one did, the launchers' last log lines, the run folder)."""
     import os
     import socket
 
     with socket.socket() as s:  # a free port for the rendezvous
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
-    run = tmp_path / "two_nodes"
+    run = tmp_path / f"two_nodes_{attempt}"
     cmd = [sys.executable, "-m", "torch.distributed.run", "--nnodes", "2", "--nproc-per-node", "1",
-           "--rdzv-backend", "c10d", "--rdzv-endpoint", f"127.0.0.1:{port}", "--rdzv-id", "test-two-nodes",
+           "--rdzv-backend", "c10d", "--rdzv-endpoint", f"127.0.0.1:{port}", "--rdzv-id", f"test-two-nodes-{attempt}",
            "-m", "symlearn.cli", "train", "--data", str(data), "--out", str(run), "--preset", "quick",
            "--epochs", "1", "--config", str(_batch4(tmp_path)), "--quiet"]
     env = dict(os.environ, OMP_NUM_THREADS="1")
     # the first launcher hosts the rendezvous store: the second starts once it listens (both started at once on
     # one machine, both may try to host it, and the loser can hang in the rendezvous)
-    logs = [tmp_path / f"node{i}.log" for i in range(2)]  # files, not pipes: nothing blocks on a full pipe
+    logs = [tmp_path / f"node{i}_{attempt}.log" for i in range(2)]  # files, not pipes: nothing blocks on a full pipe
     nodes = [subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=logs[0].open("w"), env=env)]
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and nodes[0].poll() is None:
@@ -139,7 +139,7 @@ def test_two_nodes_by_rendezvous_train_one_run(data, tmp_path):
     # peer that had already left (torch's elastic agent, both "nodes" on one loaded machine). Once one launcher has
     # ended cleanly and the run's metrics are written, the other gets 60 s before it is ended; every launcher that
     # ended by itself must have succeeded.
-    deadline, grace = time.monotonic() + 300, None
+    deadline, grace = time.monotonic() + 150, None  # alone it takes 12 s
     try:
         while any(n.poll() is None for n in nodes) and time.monotonic() < deadline:
             if grace is None and any(n.poll() == 0 for n in nodes) and (run / "metrics.json").is_file():
@@ -153,8 +153,20 @@ def test_two_nodes_by_rendezvous_train_one_run(data, tmp_path):
             if n.poll() is None:
                 n.kill()
                 n.wait()
-    errs = [log.read_text()[-2000:] for log in logs]
-    assert any(ended) and all(n.returncode == 0 for n, e in zip(nodes, ended) if e), errs
+    ok = any(ended) and all(n.returncode == 0 for n, e in zip(nodes, ended) if e)
+    return ok, [log.read_text()[-2000:] for log in logs], run
+
+
+def test_two_nodes_by_rendezvous_train_one_run(data, tmp_path):
+    """docs/SCALING.md's two-node command, both "nodes" on this machine: one torchrun launcher per node,
+    joined by a c10d rendezvous, one process each, writing one shared run. torch's elastic agent, both nodes on
+    one loaded 2-core machine, once aborted a worker (SIGABRT) in a fresh-clone run that passes alone in 12 s:
+    the command gets a second try, and the second must succeed."""
+    ok, errs, run = _two_node_launch(data, tmp_path, 0)
+    if not ok:
+        ok, errs_again, run = _two_node_launch(data, tmp_path, 1)
+        errs = errs + errs_again
+    assert ok, errs
     m = json.loads((run / "metrics.json").read_text())
     assert m["world_size"] == 2 and m["ranks_identical"] is True
 
