@@ -138,21 +138,14 @@ def _run_guarded(args: tuple, wait_s: float) -> tuple[Any, int | None]:
 
 def _cached_domain(name: str, domain_text: str, timeout_s: float, t0: float) -> Any:
     """The parsed domain (cached across calls), parsed within the call's time limit: the domain or a failed PlanResult."""
-    def late() -> PlanResult:
+    try:
+        return within(lambda: parsed_domain(domain_text), timeout_s - (time.perf_counter() - t0))
+    except DeadlineExceeded:
         return failed(name, PlanStatus.TIMEOUT, t0, f"time limit of {timeout_s:g} s reached while parsing the domain",
                       total_time_s=time.perf_counter() - t0, planner_time_s=0.0)
-    try:
-        domain = within(lambda: parsed_domain(domain_text), timeout_s - (time.perf_counter() - t0))
-    except DeadlineExceeded:
-        return late()
     except Exception as e:  # noqa: BLE001
         return failed(name, PlanStatus.ERROR, t0, f"PDDL parse failed: {type(e).__name__}: {e}",
                       total_time_s=time.perf_counter() - t0)
-    if time.perf_counter() - t0 >= timeout_s:
-        # the alarm fell where Python only reports an exception (in a finalizer the parser's garbage ran) and the
-        # parse went on to its end: it still took the call's time
-        return late()
-    return domain
 
 
 def solve_pddl(

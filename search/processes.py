@@ -198,7 +198,10 @@ class DeadlineExceeded(BaseException):
 
 
 def within(fn: Callable[[], Any], seconds: float) -> Any:
-    """fn() interrupted by DeadlineExceeded after `seconds` (SIGALRM: main thread only; elsewhere unbounded)."""
+    """fn() interrupted by DeadlineExceeded after `seconds` (SIGALRM: main thread only; elsewhere unbounded).
+
+    An fn that returns after its time is a DeadlineExceeded too: the alarm can fall where Python only reports an
+    exception (a finalizer that fn's garbage runs; seen in unified-planning's parser) and fn goes on to its end."""
     if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
         return fn()
     if seconds <= 0:
@@ -211,12 +214,15 @@ def within(fn: Callable[[], Any], seconds: float) -> Any:
     old_timer = signal.setitimer(signal.ITIMER_REAL, seconds)
     t0 = time.monotonic()
     try:
-        return fn()
+        result = fn()
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
         if old_timer[0] > 0:  # someone else's alarm: re-arm it with what is left of it
             signal.setitimer(signal.ITIMER_REAL, max(old_timer[0] - (time.monotonic() - t0), 1e-3), old_timer[1])
+    if time.monotonic() - t0 >= seconds:
+        raise DeadlineExceeded()
+    return result
 
 
 atexit.register(cleanup)

@@ -22,7 +22,7 @@ from pathlib import Path
 import pytest
 
 from conftest import cli
-from search.processes import PlannerInterrupted, planner_guard, run_group
+from search.processes import DeadlineExceeded, PlannerInterrupted, planner_guard, run_group, within
 from search.result import PlanStatus, failed
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -546,3 +546,19 @@ def test_pyperplan_grounding_counts_against_its_limit(tiny_run, planning_task, m
     res = fn(transition, start, goal, 0.5)
     assert res.status is PlanStatus.TIMEOUT, res.message
     assert time.perf_counter() - t0 < 30.0  # far below the 60 s grounding: it was cut off
+
+
+def test_within_calls_a_late_return_a_deadline_even_when_the_alarm_is_lost():
+    """The alarm can fall where Python only reports the exception (a finalizer) and fn runs on to its end: a
+    result that comes back after the time is still a DeadlineExceeded; one in time is returned."""
+    def swallows_the_alarm() -> int:
+        t = time.monotonic()
+        while time.monotonic() - t < 0.1:
+            try:
+                time.sleep(0.01)
+            except DeadlineExceeded:
+                pass
+        return 1
+    with pytest.raises(DeadlineExceeded):
+        within(swallows_the_alarm, 0.02)
+    assert within(lambda: 2, 5.0) == 2
