@@ -252,14 +252,12 @@ def _step(sim, encoder, seg: Segment, prog: Progress, goal: SymbolicGoal, config
         kept = recover(seg, codes, models, goal, prog, config.max_fallbacks)
         if kept is not None:
             return kept
-    if prog.replans >= config.max_replans:
-        seg.t += 1  # no replans left: go on with the plan as it is
-        return seg
-    new = replanned(replan, codes, prog)
-    if new is None and config.keep_plan_on_failed_replan:
-        seg.t += 1  # no plan from here: go on with the plan as it is
-        return seg
-    return new
+    if prog.replans < config.max_replans:
+        new = replanned(replan, codes, prog)
+        if new is not None or not config.keep_plan_on_failed_replan:
+            return new
+    seg.t += 1  # no replans left, or no plan from here: go on with the plan as it is
+    return seg
 
 
 @dataclass(frozen=True)
