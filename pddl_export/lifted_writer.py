@@ -188,16 +188,7 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
         pre.append(f"(height {to} {top_name(hv, s_v)})")
     landing = dict(zip((loc_name(n) for n in neighbours(release)), map(level_name, f["landing"]))) \
         if concrete and lands_on else {}
-    for loc, h in landing.items():
-        if loc in before:
-            if under[loc] != h:
-                raise ValueError(f"rule {index}: a neighbour's level {h} is not what lies under the stick")
-        else:
-            tops[loc] = "table" if h == level_name(0) else f"?t-{loc}"  # a block or a stick's end at level h
-            if tops[loc] != "table":
-                params.append((tops[loc], "layer"))
-                pre.append(f"(same-level {tops[loc]} {h})")
-            pre.append(f"(height {loc} {top_name(h, tops[loc])})")
+    _landing_tops(landing, before, under, tops, params, pre, index)
     after = {to: new_o}
     eff += [f"(not (at ?o {frm}))", f"(at ?o {to})"] + _replace("rests", "?o", top_name(hu, s_u), top_name(hv, s_v))
     ends = set(landing)  # the locations o's own ends will top (unless a rider ends on one)
@@ -220,14 +211,7 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
         if f.get(f"{role}.kind") is not None:
             pre += _bit_literals(rules, term, f[f"{role}.kind"])
         eff += _bit_effects(rules, term, kind, f.get(f"{role}.kind"))
-    for loc in list(before) + [x for x in after if x not in before]:
-        old = before.get(loc, hv if loc == to else landing.get(loc))
-        new = after.get(loc, under.get(loc, old))
-        if old is None or new is None:
-            raise ValueError(f"rule {index}: the height at {loc} is not known before and after the move")
-        old_s = tops[loc]
-        new_s = ("stick-end" if loc in ends else "block-top") if loc in after else lifted.get(loc, old_s)
-        eff += _replace("height", loc, top_name(old, old_s), top_name(new, new_s))
+    eff += _height_effects(before, after, under, landing, tops, lifted, ends, (to, hv), index)
     # beneath facts a landing re-adds where it also lifted them cancel out; keep the effects consistent
     eff = _net_effects(eff)
     if cost is not None:
@@ -239,6 +223,39 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
             + (f"-alt{alternative}" if alternative else ""))
     text = _schema_text(name, params, pre, eff, _comment(rule, f, alternative))
     return Schema(name, pick, release, text, tuple(params), tuple(dict.fromkeys(pre)), tuple(eff), alternative, cost)
+
+
+def _landing_tops(landing: dict, before: dict, under: dict, tops: dict, params: list, pre: list, index: int) -> None:
+    """Preconditions on the locations a far-row stick's ends will cover, and their tops in `tops`: what lies under
+    the stick where it covered them already, else the table at h0, or a layer parameter tied to the level
+    (`(same-level ?t-l4 h2)`: a block standing there or a stick's end, which the rule's key does not say)."""
+    for loc, h in landing.items():
+        if loc in before:
+            if under[loc] != h:
+                raise ValueError(f"rule {index}: a neighbour's level {h} is not what lies under the stick")
+            continue
+        tops[loc] = "table" if h == level_name(0) else f"?t-{loc}"
+        if tops[loc] != "table":
+            params.append((tops[loc], "layer"))
+            pre.append(f"(same-level {tops[loc]} {h})")
+        pre.append(f"(height {loc} {top_name(h, tops[loc])})")
+
+
+def _height_effects(before: dict, after: dict, under: dict, landing: dict, tops: dict, lifted: dict, ends: set,
+                    release: tuple[str, str], index: int) -> list[str]:
+    """The `height` effects of a move: every location it lifts from or lands on goes from its top before (level
+    and what it is) to its top after: what now lands there (o, or o's own end, or a rider), else what lifting left."""
+    to, hv = release
+    eff: list[str] = []
+    for loc in list(before) + [x for x in after if x not in before]:
+        old = before.get(loc, hv if loc == to else landing.get(loc))
+        new = after.get(loc, under.get(loc, old))
+        if old is None or new is None:
+            raise ValueError(f"rule {index}: the height at {loc} is not known before and after the move")
+        old_s = tops[loc]
+        new_s = ("stick-end" if loc in ends else "block-top") if loc in after else lifted.get(loc, old_s)
+        eff += _replace("height", loc, top_name(old, old_s), top_name(new, new_s))
+    return eff
 
 
 PLACES = ("on-spot", "minus-y-near", "minus-y-mid", "minus-y-far", "plus-y-near", "plus-y-mid", "plus-y-far", "off-x")
