@@ -10,15 +10,21 @@ left under a stick's end). The ends keep a move onto a stick's end and one onto 
 (the rules' `v.at`, `u.at`: without them both actions would apply to either). The learned bits a rule tests are unary
 predicates in both polarities (`bit-I`, `no-bit-I`; docs/DOMAIN.md says what they mean in a real run), and
 `(differ ?a ?b)`, `(is ?a ?b)` (the same location), `(near ?l)` and `(same-level ?t ?h)` are static facts of every
-problem. Each rule of `pddl_export.lifted_rules` is one
-action schema in plain STRIPS with typing: no negative preconditions, no equality, no conditional effects, no
-quantifiers, no axioms, so that Fast Downward (LM-cut included), pyperplan and pyval take it. `at`, `level`,
-`rests` and `height` hold one value per block or location, which Fast Downward's translator finds.
+problem. Each rule of `pddl_export.lifted_rules` is one robot action in plain STRIPS with typing: no negative preconditions, no equality, no conditional effects, no
+quantifiers, no axioms, so that Fast Downward (LM-cut included), pyperplan and pyval take it. `at` (or `holding`),
+`level`, `rests` and `height` hold one value per block or location, which Fast Downward's translator finds.
+
+A cube's move is stated in two halves, as a person would write it: `pick-cube ?o ?from ?h ?t` lifts the cube off
+the top of its location (which drops to what it rested on; `(liftable ?h ?t)` lists the pairs some rule puts
+down) and one `release-cube-N ?o ?to` per rule puts it down at the release location. Whole, each rule would ground
+once per cube and pair of locations, and the translator's time follows its operators (schemas explains).
+`(hand-empty)` holds between robot actions; every other move (a stick's) is one action that needs it.
+plan_decoder reads a plan back as robot actions.
 
 The cost form (`costs=True`: domain_pddl, problem_pddl) is the all-outcomes determinisation of the rules: one
 action per outcome of a rule (its own and its alternatives, `-altJ`), each costing OUTCOME_COST_UNIT * (1 - ln
-share) rounded (`:action-costs`, `(:metric minimize (total-cost))`), so that a cost-aware search (A* with LM-cut)
-takes the plan whose steps m(z) answered most often, as `rules-outcomes` does on the rules over whole codes.
+share) rounded (`:action-costs`, `(:metric minimize (total-cost))`; pick-cube costs nothing, the release carries
+its rule's cost), so that a cost-aware search (A* with LM-cut) takes the plan whose steps m(z) answered most often, as `rules-outcomes` does on the rules over whole codes.
 
 A cube's rule and a stick's moved within the near row are lifted over both locations (`?from`, `?to`); a stick
 moved in or out of the far row covers its row neighbours with its ends, and which of those overlap depends on
@@ -95,6 +101,7 @@ class Schema:
     eff: tuple = ()
     alternative: int = 0  # which of its rule's outcomes (0: the rule's own)
     cost: int | None = None  # the cost form's action cost (its last effect increases total-cost by it)
+    step: str = "move"  # "move": one robot action; "pick" / "release": its two halves (a cube's move, split)
 
 
 def _bit_literals(rules: LiftedRules, term: str, kind: int, present: bool = True) -> list[str]:
@@ -379,8 +386,56 @@ def _schema_text(name: str, params, pre, eff, comment: str) -> str:
             f"    :precondition (and {_wrapped(pre, pad)})\n    :effect (and {_wrapped(eff, pad)}))\n")
 
 
-def schemas(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
-    """The domain's action schemas, one per rule; in the cost form one per outcome of each rule, with its cost.
+PICK_CUBE = "pick-cube"
+PICK_CUBE_TEXT = """  ; a cube is lifted off the top of its location, which drops to what it rested on; its level and what it
+  ; rested on stay with it until a release-cube action puts it down (the pairs some release takes: liftable)
+  (:action pick-cube
+    :parameters (?o - cube ?from - location ?h - layer ?t - layer)
+    :precondition (and (hand-empty) (liftable ?h ?t) (at ?o ?from) (level ?o ?h) (rests ?o ?t) (height ?from ?h))
+    :effect (and (not (hand-empty)) (holding ?o) (not (at ?o ?from)) (not (height ?from ?h)) (height ?from ?t)))
+"""
+
+
+def _pick_side(s: Schema) -> tuple[str, str] | None:
+    """A cube's move whose pick side is the plain one (a lifted `?from`, the cube the top there, nothing else
+    read or changed at ?from): its (level, rests) pair; else None (the move stays one action)."""
+    if s.pick is not None or dict(s.params).get("?o") != "cube" or "?from" not in dict(s.params):
+        return None
+    level = next((p.split()[2][:-1] for p in s.pre if p.startswith("(level ?o ")), None)
+    rests = next((p.split()[2][:-1] for p in s.pre if p.startswith("(rests ?o ")), None)
+    if level is None or rests is None:
+        return None
+    pre = {p for p in s.pre if "?from" in p}
+    eff = {e for e in s.eff if "?from" in e}
+    if pre != {"(at ?o ?from)", f"(height ?from {level})", "(differ ?from ?to)"} or \
+            eff != {"(not (at ?o ?from))", f"(not (height ?from {level}))", f"(height ?from {rests})"}:
+        return None
+    return level, rests
+
+
+def _halves(s: Schema) -> Schema:
+    """A move as the domain states it: a cube's plain move becomes its release half (pick-cube is its pick half),
+    any other move one action that needs the hand empty."""
+    comment = s.text.split("\n", 1)[0].strip()
+    if _pick_side(s) is None:
+        pre = ("(hand-empty)",) + s.pre
+        return dataclasses.replace(s, pre=pre, text=_schema_text(s.name, s.params, pre, s.eff, comment))
+    params = tuple((p, t) for p, t in s.params if p != "?from")
+    pre = ("(holding ?o)",) + tuple(p for p in s.pre if "?from" not in p)
+    eff = ("(not (holding ?o))", "(hand-empty)") + tuple(e for e in s.eff if "?from" not in e)
+    name = s.name.replace("pick-release-cube", "release-cube", 1)
+    return dataclasses.replace(s, name=name, params=params, pre=pre, eff=eff, step="release",
+                               text=_schema_text(name, params, pre, eff, comment))
+
+
+def liftable(found: Iterable[Schema]) -> list[tuple[str, str]]:
+    """The (level, rests) pairs of a cube that some release-cube action puts down: pick-cube lifts only these."""
+    return sorted({pair for s in found if (pair := _pick_side(s)) is not None})
+
+
+def moves(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
+    """One schema per rule, each a whole robot action (pick and release); in the cost form one per outcome of each
+    rule, with its cost. `schemas` states them as the domain does.
 
     (A form with one schema per kind of move and a conditional effect per rule would ground to far fewer
     actions, but Fast Downward's translator then works out, for every fact one clause adds and another
@@ -398,6 +453,29 @@ def schemas(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
                     raise
                 # an alternative whose heights cannot be stated from the rule's key: no action for it
     return _distinct(out)
+
+
+def schemas(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
+    """The domain's action schemas: pick-cube, the release half of every cube's plain move, and every other move
+    whole.
+
+    A cube's move, grounded whole, is one action per cube and pair of locations (30 pairs) for each rule: with 4
+    cubes, about 1,900 operators that Fast Downward's translator instantiates before it searches. Split, the
+    release half is one per cube and release location (6), and one pick-cube per cube, location and (level,
+    rests) pair: a third of the operators, the same robot actions. A release at the location the cube was
+    picked from puts it back on what it rested on; `plan_decoder` drops such a pair from the robot's plan.
+    """
+    found = moves(rules, costs)
+    halves = tuple(_halves(s) for s in found)
+    if not any(s.step == "release" for s in halves):
+        return halves
+    pick = Schema(PICK_CUBE, None, None, PICK_CUBE_TEXT,
+                  (("?o", "cube"), ("?from", "location"), ("?h", "layer"), ("?t", "layer")),
+                  ("(hand-empty)", "(liftable ?h ?t)", "(at ?o ?from)", "(level ?o ?h)", "(rests ?o ?t)",
+                   "(height ?from ?h)"),
+                  ("(not (hand-empty))", "(holding ?o)", "(not (at ?o ?from))", "(not (height ?from ?h))",
+                   "(height ?from ?t)"), step="pick")
+    return (pick,) + halves
 
 
 def _distinct(found: Iterable[Schema]) -> tuple[Schema, ...]:
@@ -420,28 +498,55 @@ def _distinct(found: Iterable[Schema]) -> tuple[Schema, ...]:
     return tuple(out)
 
 
-def step_decoder(rules: LiftedRules, costs: bool = False):
-    """Plan step ('(pick-release-cube-3-alt1 o1 l0 l4 ...)') -> (robot action id, pick * 6 + release; the outcome
-    of its rule the step stands for, 0 for the rule's own)."""
+def plan_decoder(rules: LiftedRules, costs: bool = False):
+    """Plan steps -> one (robot action id, pick * 6 + release; the outcome of its rule the step stands for, 0 for the
+    rule's own) per robot action: a whole move ('(pick-release-stick-l1-l4-30 o2)') is one, a pick-cube and the
+    release-cube that puts the cube down ('(pick-cube o1 l0 h2 h0)', '(release-cube-3-alt1 o1 l4)') are one
+    together. A cube put back where it was picked is no robot action (the rules say it changes nothing there) and
+    is left out. Raises ValueError on a step of no action of the domain, a release of a cube not held, a move
+    while a cube is held, or a plan that ends holding one."""
     by_name = {s.name: s for s in schemas(rules, costs)}
 
-    def decode(step: str) -> tuple[int, int]:
-        words = step.strip().strip("()").split()
-        if not words or words[0].lower() not in by_name:
-            raise ValueError(f"plan step {step!r} names no action of the lifted domain")
-        s = by_name[words[0].lower()]
-        if s.pick is not None:
-            return s.pick * N_LOCATIONS + s.release, s.alternative
-        frm = int(words[2].lower()[1:])
-        to = s.release if s.release is not None else int(words[3].lower()[1:])  # a schema refined on ?to fixes it
-        return frm * N_LOCATIONS + to, s.alternative
+    def location(word: str) -> int:
+        if len(word) != 2 or word[0] != "l" or not word[1].isdigit() or int(word[1]) >= N_LOCATIONS:
+            raise ValueError(f"{word!r} is not a location")
+        return int(word[1])
+
+    def decode(steps: Sequence[str]) -> list[tuple[int, int]]:
+        out: list[tuple[int, int]] = []
+        held: tuple[str, int] | None = None  # the cube in the hand and where it was picked
+        for step in steps:
+            words = step.strip().strip("()").lower().split()
+            if not words or words[0] not in by_name:
+                raise ValueError(f"plan step {step!r} names no action of the lifted domain")
+            s = by_name[words[0]]
+            if len(words) != len(s.params) + 1:
+                raise ValueError(f"plan step {step!r} gives {len(words) - 1} arguments, {s.name} takes {len(s.params)}")
+            if s.step == "release" and held is None:
+                raise ValueError(f"plan step {step!r} releases a cube that is not held")
+            if s.step != "release" and held is not None:
+                raise ValueError(f"plan step {step!r} comes while {held[0]} is held")
+            if s.step == "pick":
+                held = (words[1], location(words[2]))
+                continue
+            if s.step == "release":
+                if words[1] != held[0]:
+                    raise ValueError(f"plan step {step!r} releases {words[1]}, but {held[0]} is held")
+                frm, to = held[1], s.release if s.release is not None else location(words[2])
+                held = None
+                if frm != to:
+                    out.append((frm * N_LOCATIONS + to, s.alternative))
+                continue
+            if s.pick is not None:
+                out.append((s.pick * N_LOCATIONS + s.release, s.alternative))
+                continue
+            frm = location(words[2])
+            to = s.release if s.release is not None else location(words[3])  # a schema refined on ?to fixes it
+            out.append((frm * N_LOCATIONS + to, s.alternative))
+        if held is not None:
+            raise ValueError(f"the plan ends with {held[0]} held")
+        return out
     return decode
-
-
-def action_decoder(rules: LiftedRules, costs: bool = False):
-    """Plan step ('(pick-release-cube-3 o1 l0 l4 ...)') -> robot action id (pick * 6 + release)."""
-    decode = step_decoder(rules, costs)
-    return lambda step: decode(step)[0]
 
 
 def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
@@ -462,7 +567,8 @@ def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
             "  (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer)\n"
             "               (rests ?b - block ?t - layer) (height ?l - location ?t - layer) (same-level ?t - layer ?h - layer)\n"
             "               (beneath ?l - location ?h - layer) (place ?b - block ?p - position)\n"
-            "               (near ?l - location) (differ ?a - location ?b - location) (is ?a - location ?b - location)"
+            "               (near ?l - location) (differ ?a - location ?b - location) (is ?a - location ?b - location)\n"
+            "               (hand-empty) (holding ?b - block) (liftable ?h - layer ?t - layer)"
             + (f"\n               {bits}" if bits else "") + ")\n"
             + functions + body + ")\n")
 
@@ -477,9 +583,10 @@ def _surface_of(pieces, t: int | None, loc: int) -> str:
 
 
 def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicGoal, name: str,
-                 costs: bool = False) -> str:
+                 costs: bool = False, pairs: Sequence[tuple[str, str]] | None = None) -> str:
     """A problem of the lifted domain (of its cost form, with costs): the start scene read from its codes, the goal's
-    located fields."""
+    located fields and an empty hand. `pairs`: the domain's liftable pairs where the caller has them (else worked
+    out from the rules)."""
     if len(goal.codes) != len(start_codes):
         raise ValueError(f"the goal has {len(goal.codes)} objects, the start {len(start_codes)}")
     pieces = rules.pieces(start_codes)
@@ -489,6 +596,8 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
     init += [f"(same-level {t} {t.removesuffix('-end')})" for t in layer_names() if t != level_name(0)]
     init += [f"(differ {loc_name(a)} {loc_name(b)})" for a in range(N_LOCATIONS) for b in range(N_LOCATIONS) if a != b]
     init += [f"(is {loc_name(a)} {loc_name(a)})" for a in range(N_LOCATIONS)]
+    pairs = liftable(moves(rules, costs)) if pairs is None else pairs
+    init += ["(hand-empty)"] + [f"(liftable {h} {t})" for h, t in pairs]
     for i, p in enumerate(pieces):
         o = object_name(i)
         if p.loc < N_LOCATIONS:
@@ -505,7 +614,7 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
             if p.stick and p.on_location and p.loc != loc and loc in p.covers():
                 below = top_of(pieces, loc, frozenset(j for j, q in enumerate(pieces) if q.level >= p.level))
                 init.append(f"(beneath {loc_name(loc)} {level_name(0 if below is None else pieces[below].level)})")
-    goals = []
+    goals = ["(hand-empty)"]
     for i, code in enumerate(goal.codes):
         if code is None:
             continue
@@ -525,6 +634,6 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
 
 
 def plan_actions(rules: LiftedRules, steps: Sequence[str]) -> list[int]:
-    """Plan steps ('(pick-release-cube-3 o1 l0 l4 ...)') -> robot action ids (pick * 6 + release)."""
-    decode = action_decoder(rules)
-    return [decode(step) for step in steps]
+    """Plan steps ('(pick-cube o1 l0 h2 h0)', '(release-cube-3 o1 l4)', ...) -> robot action ids (pick * 6 +
+    release), as plan_decoder reads them."""
+    return [a for a, _ in plan_decoder(rules)(steps)]

@@ -79,8 +79,9 @@ class PlanResult:
     # further plans of a top-k planner, best first, each (plan, predicted_states); the main plan not among them
     alternatives: tuple[tuple[tuple[int, ...], tuple[tuple[int, ...], ...]], ...] = field(default=(), hash=False)
     # the ground plan as a PDDL planner wrote it, e.g. "(pick-release b1 l0 l3)", one str per step; () for planners
-    # that plan on action ids. A stock planner on a domain whose steps are not mapped to action ids returns a
-    # SOLVED result with steps and an empty plan (search.stock_planners)
+    # that plan on action ids. An action may take more than one step (a lifted domain's pick-cube and release-cube),
+    # so a plan has at most as many actions as steps. A stock planner on a domain whose steps are not mapped to
+    # action ids returns a SOLVED result with steps and an empty plan (search.stock_planners)
     steps: tuple[str, ...] = field(default=(), hash=False)
 
     def __post_init__(self) -> None:
@@ -138,8 +139,8 @@ class PlanResult:
                 raise ValueError("steps are only allowed with status solved")
             if any(not isinstance(x, str) or not x or "\n" in x for x in steps):
                 raise ValueError("steps must be non-empty one-line str")
-            if plan and len(plan) != len(steps):
-                raise ValueError(f"steps must match the plan's actions one to one: {len(plan)}, got {len(steps)}")
+            if len(plan) > len(steps):
+                raise ValueError(f"steps must cover the plan's actions: {len(plan)} actions, {len(steps)} steps")
         set_("steps", steps)
 
     @property

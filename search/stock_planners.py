@@ -4,8 +4,8 @@ Fast Downward runs through its own driver, `fast-downward.py` from the up-fast-d
 with its own translator (`python -m fast_downward.translate`) and search binary; pyperplan runs
 through its command line (`python -m pyperplan`). Nothing of the project's encoding is involved:
 any (domain.pddl, problem.pddl) pair goes in, the ground plan the planner wrote comes out
-(PlanResult.steps, e.g. "(pick-release b1 l0 l3)"), and, with `action_id` (a map from a ground
-step to the robot's action id, such as a lifted domain's), the plan as action ids.
+(PlanResult.steps, e.g. "(pick-release b1 l0 l3)"), and, with `action_ids` (a map from the ground
+steps to the robot's action ids, such as a lifted domain's plan_decoder), the plan as action ids.
 
 Each call runs one process (an argument list, with sys.executable) in its own process group,
 in a symlearn-stock-* folder that holds the planner's files (output.sas, sas_plan, the copies
@@ -38,7 +38,7 @@ import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Sequence
 
 from search.processes import external_signal, planner_guard, run_group, temp_dir
 from search.result import PlanResult, PlanStatus, failed
@@ -236,7 +236,7 @@ def _command(spec: StockPlanner, domain: Path, problem: Path, tmp: Path, memory_
 
 
 def _finish(planner: str, spec: StockPlanner, code: int | None, out: str, err: str, plan_name: str, tmp: Path,
-            action_id: Callable[[str], int] | None, t0: float, extra: dict) -> PlanResult:
+            action_ids: Callable[[Sequence[str]], Sequence[int]] | None, t0: float, extra: dict) -> PlanResult:
     """The PlanResult of a finished run, from its exit code, log and plan file."""
     fd = spec.tool == "fast-downward"
     expansions = _fd_log(out, extra) if fd else _pp_log(out, extra)
@@ -261,9 +261,9 @@ def _finish(planner: str, spec: StockPlanner, code: int | None, out: str, err: s
         extra["plan_cost"] = cost
     extra["optimal"] = spec.optimal
     ids: tuple[int, ...] = ()
-    if action_id is not None:
+    if action_ids is not None:
         try:
-            ids = tuple(action_id(s) for s in steps)
+            ids = tuple(action_ids(steps))
         except (ValueError, KeyError) as e:
             return failed(planner, PlanStatus.ERROR, t0, f"{planner} returned a step that maps to no action: {e}",
                           **extra)
@@ -271,12 +271,12 @@ def _finish(planner: str, spec: StockPlanner, code: int | None, out: str, err: s
         return PlanResult(planner=planner, status=PlanStatus.SOLVED, plan=ids, predicted_states=(),
                           expansions=expansions, planning_time_s=time.perf_counter() - t0, extra=extra,
                           steps=tuple(steps))
-    except (TypeError, ValueError) as e:  # e.g. action_id gave an id outside 0..35
+    except (TypeError, ValueError) as e:  # e.g. action_ids gave an id outside 0..35
         return failed(planner, PlanStatus.ERROR, t0, f"{planner}'s plan does not map to action ids: {e}", **extra)
 
 
 def _solve_in(tmp: Path, domain: Path, problem: Path, planner: str, timeout_s: float, t0: float,
-              action_id: Callable[[str], int] | None, memory_mb: int) -> PlanResult:
+              action_ids: Callable[[Sequence[str]], Sequence[int]] | None, memory_mb: int) -> PlanResult:
     """Run the planner on the two files with tmp as its working folder (inside planner_guard and temp_dir)."""
     spec = STOCK_PLANNERS[planner]
     if spec.tool == "pyperplan" and problem.parent != tmp:  # it writes PROBLEM.soln beside the problem:
@@ -304,7 +304,7 @@ def _solve_in(tmp: Path, domain: Path, problem: Path, planner: str, timeout_s: f
         return failed(planner, PlanStatus.ERROR, t0, f"{planner} was killed by {signal.Signals(killed).name} (not by "
                       "its time limit)", killed_by_signal=killed, **extra)
     plan_name = "sas_plan" if spec.tool == "fast-downward" else problem.name + ".soln"
-    return _finish(planner, spec, code, out, err, plan_name, tmp, action_id, t0, extra)
+    return _finish(planner, spec, code, out, err, plan_name, tmp, action_ids, t0, extra)
 
 
 def _check(planner: str, timeout_s: float, t0: float) -> PlanResult | None:
@@ -319,10 +319,10 @@ def _check(planner: str, timeout_s: float, t0: float) -> PlanResult | None:
 
 
 def solve_files(domain: Path | str, problem: Path | str, planner: str, timeout_s: float, *,
-                action_id: Callable[[str], int] | None = None, memory_mb: int = MEMORY_LIMIT_MB) -> PlanResult:
+                action_ids: Callable[[Sequence[str]], Sequence[int]] | None = None, memory_mb: int = MEMORY_LIMIT_MB) -> PlanResult:
     """Plan on a domain and a problem file with a stock planner (STOCK_PLANNERS); failures come back as a status.
 
-    SOLVED carries the ground steps (PlanResult.steps) and, with action_id (ground step -> action id,
+    SOLVED carries the ground steps (PlanResult.steps) and, with action_ids (ground steps -> action ids,
     ValueError or KeyError for a step it does not know), the plan as action ids; without it the plan
     is empty. UNSOLVABLE, TIMEOUT (the whole call past timeout_s) and ERROR (a missing or oversized
     file, an unknown planner, a planner that refuses the task: its own one-line reason) have no plan.
@@ -337,11 +337,11 @@ def solve_files(domain: Path | str, problem: Path | str, planner: str, timeout_s
     if bad:
         return failed(planner, PlanStatus.ERROR, t0, bad)
     with planner_guard(), temp_dir("symlearn-stock-") as tmp:
-        return _solve_in(tmp, domain, problem, planner, timeout_s, t0, action_id, memory_mb)
+        return _solve_in(tmp, domain, problem, planner, timeout_s, t0, action_ids, memory_mb)
 
 
 def solve_texts(domain_text: str, problem_text: str, planner: str, timeout_s: float, *,
-                action_id: Callable[[str], int] | None = None, memory_mb: int = MEMORY_LIMIT_MB) -> PlanResult:
+                action_ids: Callable[[Sequence[str]], Sequence[int]] | None = None, memory_mb: int = MEMORY_LIMIT_MB) -> PlanResult:
     """solve_files on PDDL texts: they are written as domain.pddl and problem.pddl into the run's own folder."""
     t0 = time.perf_counter()
     refused = _check(planner, timeout_s, t0)
@@ -354,7 +354,7 @@ def solve_texts(domain_text: str, problem_text: str, planner: str, timeout_s: fl
     with planner_guard(), temp_dir("symlearn-stock-") as tmp:
         (tmp / "domain.pddl").write_text(domain_text)
         (tmp / "problem.pddl").write_text(problem_text)
-        return _solve_in(tmp, tmp / "domain.pddl", tmp / "problem.pddl", planner, timeout_s, t0, action_id,
+        return _solve_in(tmp, tmp / "domain.pddl", tmp / "problem.pddl", planner, timeout_s, t0, action_ids,
                          memory_mb)
 
 

@@ -16,7 +16,8 @@ import pytest
 from pddl_export.lifted_rules import REFINEMENTS, LiftedRules, distil_lifted, key_of, load_lifted, observed_moves, \
     participants, stick_reader
 from pddl_export.lifted_scene import CodeLayout, Piece, kept_bits, read_scene
-from pddl_export.lifted_writer import domain_pddl, layer_names, object_name, plan_actions, problem_pddl, schemas
+from pddl_export.lifted_writer import PICK_CUBE, domain_pddl, layer_names, object_name, plan_actions, problem_pddl, \
+    schemas
 from pddl_export.symbolic import SymbolicGoal
 from symlearn.problems.stacking import act, drop_all
 from symlearn.world import ObjectType
@@ -153,8 +154,8 @@ def test_the_domain_is_small_plain_strips(world_rules):
 
 def test_rules_that_write_the_same_action_write_it_once(world_rules):
     """Rules whose keys differ only in what the PDDL leaves unsaid give one schema, which names the others."""
-    from pddl_export.lifted_writer import rule_schema, schemas
-    written = schemas(world_rules)
+    from pddl_export.lifted_writer import moves, rule_schema
+    written = moves(world_rules)
     bodies = [(s.params, s.pre, s.eff) for s in written]
     assert len(set(bodies)) == len(bodies)
     every = [rule_schema(world_rules, r, i) for i, r in enumerate(world_rules.rules)]
@@ -164,6 +165,27 @@ def test_rules_that_write_the_same_action_write_it_once(world_rules):
     named = [n for s in written if "stands for " in s.text.split("\n", 1)[0]
              for n in s.text.split("\n", 1)[0].split("stands for ", 1)[1].split(", ")]
     assert sorted(named) == sorted(dropped)
+
+
+def _step(action, params) -> str:
+    return f"({action.name} {' '.join(str(p) for p in params)})"
+
+
+def _robot_moves(sim, state, rules: LiftedRules) -> list[tuple[int, object]]:
+    """(robot action, next state) of every whole move applicable in a unified-planning state and of every
+    pick-cube followed by a release-cube (a cube put back where it was picked is no robot action)."""
+    out = []
+    for action, params in sim.get_applicable_actions(state):
+        nxt = sim.apply(state, action, params)
+        if action.name != PICK_CUBE:
+            out.append((plan_actions(rules, [_step(action, params)])[0], nxt))
+            continue
+        assert not any(a.name == PICK_CUBE for a, _ in sim.get_applicable_actions(nxt)), "two cubes in the hand"
+        for release, args in sim.get_applicable_actions(nxt):
+            ids = plan_actions(rules, [_step(action, params), _step(release, args)])
+            if ids:
+                out.append((ids[0], sim.apply(nxt, release, args)))
+    return out
 
 
 def test_pddl_successors_are_the_rules(pair_rules):
@@ -182,9 +204,8 @@ def test_pddl_successors_are_the_rules(pair_rules):
         with SequentialSimulator(problem) as sim:
             state = sim.get_initial_state()
             by_action = {}
-            for action, params in sim.get_applicable_actions(state):
-                step = f"({action.name} {' '.join(str(p) for p in params)})"
-                by_action.setdefault(plan_actions(pair_rules, [step])[0], []).append(sim.apply(state, action, params))
+            for a, nxt in _robot_moves(sim, state, pair_rules):
+                by_action.setdefault(a, []).append(nxt)
         for a in range(36):
             want, rule = pair_rules.step_pieces(pieces, a)
             assert (rule is not None) == (a in by_action), f"action {a} from {start}"
@@ -200,34 +221,87 @@ def test_pddl_successors_are_the_rules(pair_rules):
     assert checked >= 3
 
 
-def _applicable(schema_list, problem_text: str) -> dict[str, list[tuple]]:
-    """Each schema's ground actions whose preconditions hold in the problem's initial state (a small grounder for
-    the test: bindings by type, pruned as soon as a precondition's terms are bound)."""
+def _facts(problem_text: str) -> tuple[set[str], dict[str, list[str]]]:
+    """A problem's initial facts and its objects of each type (with the domain's constants)."""
     objects = problem_text.split("(:objects", 1)[1].split(")", 1)[0].split()
     typed = {"block": [], "cube": [], "stick": [], "location": [f"l{i}" for i in range(6)], "layer": layer_names()}
     for name, _, kind in zip(objects[::3], objects[1::3], objects[2::3]):
         typed[kind].append(name)
         typed["block"].append(name)
     lines = problem_text.split("(:init", 1)[1].split("(:goal", 1)[0].splitlines()
-    init = {line.strip()[:line.strip().index(")") + 1] for line in lines if line.strip().startswith("(")}
-    found: dict[str, list[tuple]] = {}
+    return {line.strip()[:line.strip().index(")") + 1] for line in lines if line.strip().startswith("(")}, typed
+
+
+def _ground(atom: str, binding: dict) -> str:
+    return "(" + " ".join(binding.get(w, w) for w in atom.strip("()").split()) + ")"
+
+
+def _applicable(schema_list, init: set[str], typed: dict) -> list[tuple]:
+    """(schema, binding) of each ground action whose preconditions hold in a state (a small grounder for the test:
+    bindings by type, pruned as soon as a precondition's terms are bound)."""
+    found: list[tuple] = []
     for s in schema_list:
         names = [p for p, _ in s.params]
         def holds(atom: str, binding: dict) -> bool | None:
-            words = atom.strip("()").split()
-            if any(w.startswith("?") and w not in binding for w in words):
+            if any(w.startswith("?") and w not in binding for w in atom.strip("()").split()):
                 return None
-            return "(" + " ".join(binding.get(w, w) for w in words) + ")" in init
+            return _ground(atom, binding) in init
         def extend(binding: dict, k: int):
             if any(holds(a, binding) is False for a in s.pre):
                 return
             if k == len(names):
-                found.setdefault(s.name, []).append(tuple(binding[n] for n in names))
+                found.append((s, binding))
                 return
             for value in typed[s.params[k][1]]:
                 extend({**binding, names[k]: value}, k + 1)
         extend({}, 0)
     return found
+
+
+def _robot_actions(schema_list, problem_text: str, rules: LiftedRules) -> dict[int, list[str]]:
+    """Robot action -> the names of the ground actions (a whole move, or a pick-cube and a release-cube) that
+    stand for it in the problem's initial state."""
+    init, typed = _facts(problem_text)
+    out: dict[int, list[str]] = {}
+    step = lambda s, b: f"({s.name} {' '.join(b[p] for p, _ in s.params)})"  # noqa: E731
+    for s, b in _applicable(schema_list, init, typed):
+        if s.name != PICK_CUBE:
+            out.setdefault(plan_actions(rules, [step(s, b)])[0], []).append(s.name)
+            continue
+        held = (init - {_ground(e[5:-1], b) for e in s.eff if e.startswith("(not ")}) | \
+            {_ground(e, b) for e in s.eff if not e.startswith("(not ")}
+        for r, rb in _applicable(schema_list, held, typed):
+            for a in plan_actions(rules, [step(s, b), step(r, rb)]):
+                out.setdefault(a, []).append(r.name)
+    return out
+
+
+def test_a_plan_reads_back_as_robot_actions_a_pick_and_its_release_as_one(world_rules):
+    """plan_decoder: a pick-cube and the release-cube after it are one robot action (pick * 6 + release), a stick's
+    move is one on its own, a cube put back where it was picked is none; a plan that releases what is not held,
+    moves while holding, or ends holding is refused in one line."""
+    from pddl_export.lifted_writer import plan_decoder
+    written = schemas(world_rules)
+    release = next(s for s in written if s.step == "release" and s.release is None)
+    stick = next(s for s in written if s.step == "move" and s.pick is not None)
+    assert sum(s.step == "pick" for s in written) == 1 and all(s.name != PICK_CUBE for s in written if s.step != "pick")
+    decode = plan_decoder(world_rules)
+    pick = "(pick-cube o1 l4 h2 h0)"
+    stick_step = f"({stick.name} {' '.join('o0' for _ in stick.params)})"
+    assert decode([pick, f"({release.name} o1 l0)", stick_step]) == [(4 * 6 + 0, 0),
+                                                                       (stick.pick * 6 + stick.release, 0)]
+    assert decode([pick, f"({release.name.upper()} O1 L4)"]) == []  # put back: no robot action
+    assert plan_actions(world_rules, [pick, f"({release.name} o1 l2)"]) == [4 * 6 + 2]
+    for steps, message in (([f"({release.name} o1 l0)"], "releases a cube that is not held"),
+                           ([pick, pick], "comes while o1 is held"),
+                           ([pick, stick_step], "comes while o1 is held"),
+                           ([pick], "the plan ends with o1 held"),
+                           ([pick, f"({release.name} o2 l0)"], "releases o2, but o1 is held"),
+                           (["(pick-cube o1 l9 h2 h0)"], "'l9' is not a location"),
+                           (["(pick-cube o1 l4)"], "gives 2 arguments, pick-cube takes 4"),
+                           (["(fly o1)"], "names no action of the lifted domain")):
+        with pytest.raises(ValueError, match=message.replace("(", r"\(")):
+            decode(steps)
 
 
 def test_one_ground_action_per_pick_and_release_where_stick_ends_and_towers_share_a_height(world_rules):
@@ -243,10 +317,7 @@ def test_one_ground_action_per_pick_and_release_where_stick_ends_and_towers_shar
         text = problem_pddl(world_rules, start, SymbolicGoal(tuple(start)), "p")
         pieces = world_rules.pieces(start)
         graph = read_scene(pieces)
-        by_action: dict[int, list[str]] = {}
-        for name, bindings in _applicable(written, text).items():
-            for b in bindings:
-                by_action.setdefault(plan_actions(world_rules, [f"({name} {' '.join(b)})"])[0], []).append(name)
+        by_action = _robot_actions(written, text, world_rules)
         for a in range(36):
             _, rule = world_rules.step_pieces(pieces, a)
             assert len(by_action.get(a, [])) == (rule is not None), f"action {a} from {start}: {by_action.get(a)}"
@@ -274,7 +345,7 @@ def test_stock_planners_plan_a_tower_the_rules_build(world_rules, tmp_path, plan
     (tmp_path / "domain.pddl").write_text(domain_pddl(world_rules))
     (tmp_path / "p01.pddl").write_text(problem_pddl(world_rules, start, SymbolicGoal(tuple(goal)), "p01"))
     res = solve_files(tmp_path / "domain.pddl", tmp_path / "p01.pddl", planner, timeout_s=120,
-                      action_id=lambda step: plan_actions(world_rules, [step])[0])
+                      action_ids=lambda steps: plan_actions(world_rules, steps))
     assert res.found, res.message
     if planner == "fd-lmcut":
         assert len(res.plan) == 2  # optimal: both cubes onto location 0
@@ -311,13 +382,22 @@ def test_pddlgym_loads_the_domain_and_steps_to_the_goal_as_the_rules_do(world_ru
     (tmp_path / "problems" / "p01.pddl").write_text(problem_pddl(world_rules, start, goal, "p01"))
     env = _pddlgym_env(tmp_path / "domain.pddl", tmp_path / "problems")
     obs, _ = env.reset()
-    offered = env.action_space.all_ground_literals(obs)
     step = lambda lit: f"({lit.predicate.name} {' '.join(v.name for v in lit.variables)})"  # noqa: E731
+    offered = set()  # the robot actions of pddlgym's ground actions: a whole move, or a pick and a release
+    for lit in env.action_space.all_ground_literals(obs):
+        if lit.predicate.name != PICK_CUBE:
+            offered.add(plan_actions(world_rules, [step(lit)])[0])
+            continue
+        held, *_ = env.step(lit)
+        offered |= {a for rel in env.action_space.all_ground_literals(held)
+                    for a in plan_actions(world_rules, [step(lit), step(rel)])}
+        env.set_state(obs)
     allowed = {a for a in range(36) if world_rules.step_pieces(world_rules.pieces(start), a)[1] is not None}
-    assert {plan_actions(world_rules, [step(lit)])[0] for lit in offered} == allowed
+    assert offered == allowed
     res = solve_files(tmp_path / "domain.pddl", tmp_path / "problems" / "p01.pddl", "fd-lama-first",
-                      timeout_s=120, action_id=lambda s: plan_actions(world_rules, [s])[0])
-    assert res.found and len(res.steps) == 2, res.message
+                      timeout_s=120, action_ids=lambda steps: plan_actions(world_rules, steps))
+    assert res.found and sorted(res.plan) == [1 * 6 + 5, 4 * 6 + 3], res.message
+    assert len(res.steps) == 3  # the cube picked and released, the stick moved whole
     done = False
     for text in res.steps:
         by_text = {step(lit).lower(): lit for lit in env.action_space.all_ground_literals(obs)}
@@ -400,7 +480,7 @@ def test_moves_the_world_model_never_makes_still_write_a_domain_fast_downward_re
     off = Rule(0, tuple((n, cube[n]) for n in STRUCTURE), (("to", 2, 2, 3), None, None), 3)
     rules = dataclasses.replace(world_rules, rules=(falls, off), stick_of={(1, 1): True, (2, 3): False})
     text = domain_pddl(rules)
-    assert "None" not in text and text.count("(:action") == 2
+    assert "None" not in text and text.count("(:action") == 3  # the stick's move; pick-cube, the cube's release
     start = [(1 << 9) | (1 << 6) | 1, (2 << 9) | (0 << 6) | 3, (2 << 9) | (2 << 6) | 3]  # a stick at 1, two riders
     goal = SymbolicGoal(((1 << 9) | (4 << 6) | 1, None, None))  # the stick at 4
     res = solve_texts(text, problem_pddl(rules, start, goal, "p"), "fd-blind", 60)
@@ -433,7 +513,7 @@ def test_a_rule_keeps_its_outcome_share_and_the_cost_form_plans_on_its_alternati
 
     import pyval
 
-    from pddl_export.lifted_writer import outcome_cost, step_decoder
+    from pddl_export.lifted_writer import outcome_cost, plan_decoder
     from search.stock_planners import solve_texts
     from symlearn.planning.lifted_planner import LiftedPlanner
     before, actions, after, mask, stick = _arrays(world_moves(300, seed=0))
@@ -463,19 +543,19 @@ def test_a_rule_keeps_its_outcome_share_and_the_cost_form_plans_on_its_alternati
         rules.step_codes(start, action, alternative=2)
 
     deterministic, costed = domain_pddl(rules), domain_pddl(rules, costs=True)
-    assert deterministic.count("(:action") == 1 and "total-cost" not in deterministic
-    assert costed.count("(:action") == 2 and ":action-costs" in costed
+    assert deterministic.count("(:action") == 2 and "total-cost" not in deterministic  # pick-cube, one release
+    assert costed.count("(:action") == 3 and ":action-costs" in costed
     assert (outcome_cost(0.7), outcome_cost(0.3), outcome_cost(1.0)) == (14, 22, 10)
     assert "(increase (total-cost) 14)" in costed and "(increase (total-cost) 22)" in costed
     with pytest.raises(ValueError, match="must lie in"):
         outcome_cost(0.0)
-    decode = step_decoder(rules, costs=True)
+    decode = plan_decoder(rules, costs=True)
     for target, alternative in ((own, 0), (alt, 1)):
         goal = SymbolicGoal(tuple(c if j in moved else None for j, c in enumerate(target)))
         problem = problem_pddl(rules, start, goal, "p", costs=True)
         assert "(:metric minimize (total-cost))" in problem
-        res = solve_texts(costed, problem, "fd-lmcut", 60, action_id=lambda s: decode(s)[0])
-        assert res.found and [decode(s) for s in res.steps] == [(action, alternative)], res.message
+        res = solve_texts(costed, problem, "fd-lmcut", 60, action_ids=lambda steps: [a for a, _ in decode(steps)])
+        assert res.found and decode(res.steps) == [(action, alternative)], res.message
         (tmp_path / "d.pddl").write_text(costed)
         (tmp_path / "p.pddl").write_text(problem)
         (tmp_path / "plan.txt").write_text("".join(f"{s}\n" for s in res.steps))
@@ -486,7 +566,7 @@ def test_a_rule_keeps_its_outcome_share_and_the_cost_form_plans_on_its_alternati
         assert planned.found and planned.predicted_states[-1] == tuple(
             g if g is not None else c for c, g in zip(target, goal.codes))
     only_own = dataclasses.replace(rule, alternatives=())
-    assert domain_pddl(dataclasses.replace(rules, rules=(only_own,)), costs=True).count("(:action") == 1
+    assert domain_pddl(dataclasses.replace(rules, rules=(only_own,)), costs=True).count("(:action") == 2
 
 
 def test_a_kind_that_follows_the_release_location_splits_the_rule_there_and_the_pddl_does_the_same():
@@ -512,18 +592,16 @@ def test_a_kind_that_follows_the_release_location_splits_the_rule_there_and_the_
     cube_to = [dict(r.key)["to"] for r in rules.rules if dict(r.key)["cls"] == "cube" and "to" in dict(r.key)]
     assert (2,) in cube_to and any(len(t) > 1 and 2 not in t for t in cube_to), cube_to
     domain = domain_pddl(rules)
-    assert "(differ ?to l2)" in domain and "pick-release-cube-to-l2-" in domain
+    assert "(differ ?to l2)" in domain and "(:action release-cube-to-l2-" in domain
     checked = 0
     for start in [m[0] for m in world_moves(6, seed=5, objects=(2, 2))]:
         problem = PDDLReader().parse_problem_string(domain, problem_pddl(rules, start, SymbolicGoal(tuple(start)), "p"))
         pieces = rules.pieces(start)
         with SequentialSimulator(problem) as sim:
             state = sim.get_initial_state()
-            for action, params in sim.get_applicable_actions(state):
-                a = plan_actions(rules, [f"({action.name} {' '.join(str(p) for p in params)})"])[0]
+            for a, nxt in _robot_moves(sim, state, rules):
                 want, rule = rules.step_pieces(pieces, a)
                 assert rule is not None, f"the PDDL offers action {a} from {start}, no rule does"
-                nxt = sim.apply(state, action, params)
                 for i, p in enumerate(want):
                     o = problem.object(object_name(i))
                     kind = 0

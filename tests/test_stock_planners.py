@@ -85,6 +85,11 @@ def action_id(step: str) -> int:
     return int(frm[1:]) * 6 + int(to[1:])
 
 
+def action_ids(steps) -> list[int]:
+    """The robot actions of a toy plan, one per step."""
+    return [action_id(s) for s in steps]
+
+
 @pytest.fixture(scope="module")
 def toy(tmp_path_factory) -> Path:
     """A folder with the toy's domains and problems."""
@@ -122,7 +127,7 @@ def test_the_toy_optimum_is_seven_moves():
 @pytest.mark.parametrize("planner", ["fd-lama-first", "fd-lmcut"])
 def test_stock_fast_downward_solves_the_toy_and_its_plan_validates(toy, validator, tmp_path, planner):
     before = sorted(p.name for p in toy.iterdir())
-    res = solve_files(toy / "domain.pddl", toy / "reverse.pddl", planner, timeout_s=30, action_id=action_id)
+    res = solve_files(toy / "domain.pddl", toy / "reverse.pddl", planner, timeout_s=30, action_ids=action_ids)
     assert res.status is PlanStatus.SOLVED, res.message
     assert validate(validator, toy / "domain.pddl", toy / "reverse.pddl", res.steps, tmp_path) == "VALID"
     assert res.plan == tuple(action_id(s) for s in res.steps) and all(s.startswith("(pick-release ") for s in res.steps)
@@ -225,7 +230,7 @@ def test_a_time_limit_reports_timeout_and_leaves_no_process_or_folder(tmp_path, 
 def test_pyperplan_solves_the_strips_toy(toy, validator, tmp_path):
     before = sorted(p.name for p in toy.iterdir())
     res = solve_files(toy / "pos-domain.pddl", toy / "reverse-pos.pddl", "pyperplan", timeout_s=60,
-                      action_id=action_id)
+                      action_ids=action_ids)
     assert res.status is PlanStatus.SOLVED, res.message
     assert validate(validator, toy / "pos-domain.pddl", toy / "reverse-pos.pddl", res.steps, tmp_path) == "VALID"
     assert len(res.plan) == len(res.steps) >= 7
@@ -270,10 +275,11 @@ def test_steps_that_map_to_no_action_are_an_error(toy):
     def strict(step: str) -> int:
         raise KeyError(step)
 
-    res = solve_files(toy / "domain.pddl", toy / "reverse.pddl", "fd-lmcut", timeout_s=30, action_id=strict)
+    res = solve_files(toy / "domain.pddl", toy / "reverse.pddl", "fd-lmcut", timeout_s=30,
+                      action_ids=lambda steps: [strict(s) for s in steps])
     assert res.status is PlanStatus.ERROR and "maps to no action" in res.message
     out_of_range = solve_files(toy / "domain.pddl", toy / "reverse.pddl", "fd-lmcut", timeout_s=30,
-                               action_id=lambda s: 99)
+                               action_ids=lambda steps: [99 for _ in steps])
     assert out_of_range.status is PlanStatus.ERROR and "0..35" in out_of_range.message
 
 
@@ -299,7 +305,7 @@ def test_plan_result_keeps_steps_through_json():
     assert PlanResult.from_json(r.to_json()) == r and r.to_json()["steps"] == ["(pick-release b1 l0 l2)"]
     assert "steps" not in PlanResult(planner="astar", status=PlanStatus.SOLVED, plan=(), predicted_states=(),
                                      expansions=None, planning_time_s=0.0).to_json()
-    with pytest.raises(ValueError, match="one to one"):
+    with pytest.raises(ValueError, match="must cover the plan's actions: 2 actions, 1 steps"):
         PlanResult(planner="x", status=PlanStatus.SOLVED, plan=(2, 3), predicted_states=(), expansions=None,
                    planning_time_s=0.0, steps=("(a)",))
     with pytest.raises(ValueError, match="only allowed with status solved"):

@@ -22,7 +22,7 @@ import numpy as np
 
 from pddl_export.files import atomic_write_text
 from pddl_export.lifted_rules import LiftedRules, LiftedTransition
-from pddl_export.lifted_writer import domain_pddl, problem_pddl, step_decoder
+from pddl_export.lifted_writer import domain_pddl, liftable, moves, plan_decoder, problem_pddl
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
 from search.result import PlanResult, PlanStatus, failed
 from search.stock_planners import solve_texts
@@ -41,8 +41,8 @@ class LiftedPlanner:
                  costs: bool = False) -> None:
         self.lifted, self.name, self.engine, self.costs = rules, name, engine, costs
         self.domain = domain_pddl(rules, costs)
-        self.decode = step_decoder(rules, costs)
-        self.action_id = lambda step: self.decode(step)[0]
+        self.decode = plan_decoder(rules, costs)
+        self.pairs = liftable(moves(rules, costs))
         self.write_dir = None if write_dir is None else Path(write_dir)
         self.calls = 0
 
@@ -68,15 +68,15 @@ class LiftedPlanner:
         t0 = time.perf_counter()
         init = [int(c) for c in start]
         try:
-            problem = problem_pddl(self.lifted, init, goal, "task", self.costs)
+            problem = problem_pddl(self.lifted, init, goal, "task", self.costs, self.pairs)
         except ValueError as e:
             return failed(self.name, PlanStatus.ERROR, t0, str(e))
         self._save(problem)
         write_s = time.perf_counter() - t0
         res = solve_texts(self.domain, problem, self.engine, max(timeout_s - write_s, 0.001),
-                          action_id=self.action_id)
+                          action_ids=lambda steps: [a for a, _ in self.decode(steps)])
         extra = dict(res.extra, pddl_write_time_s=round(write_s, 5))
-        alternatives = [self.decode(step)[1] for step in res.steps] if res.found else None
+        alternatives = [alt for _, alt in self.decode(res.steps)] if res.found else None
         predicted = self.predictions(init, list(res.plan), goal, alternatives) if res.found else ()
         return dataclasses.replace(res, planner=self.name, predicted_states=predicted,
                                    planning_time_s=write_s + res.planning_time_s, extra=extra)
