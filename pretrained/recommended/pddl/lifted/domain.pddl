@@ -11,225 +11,218 @@
                (rests ?b - block ?t - layer) (height ?l - location ?t - layer) (same-level ?t - layer ?h - layer)
                (beneath ?l - location ?h - layer) (place ?b - block ?p - position)
                (near ?l - location) (differ ?a - location ?b - location) (is ?a - location ?b - location)
+               (hand-empty) (holding ?b - block) (liftable ?h - layer ?t - layer)
                (bit-0 ?b - block) (no-bit-0 ?b - block) (bit-5 ?b - block) (no-bit-5 ?b - block))
+  ; a cube is lifted off the top of its location, which drops to what it rested on; its level and what it
+  ; rested on stay with it until a release-cube action puts it down (the pairs some release takes: liftable)
+  (:action pick-cube
+    :parameters (?o - cube ?from - location ?h - layer ?t - layer)
+    :precondition (and (hand-empty) (liftable ?h ?t) (at ?o ?from) (level ?o ?h) (rests ?o ?t) (height ?from ?h))
+    :effect (and (not (hand-empty)) (holding ?o) (not (at ?o ?from)) (not (height ?from ?h)) (height ?from ?t)))
   ; 3219 moves: a cube lands on its release location at level 2
-  (:action pick-release-cube-0
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?from ?to)
-      (differ ?to l2) (height ?from h2) (height ?to h0))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o)
-      (not (bit-5 ?o)) (not (height ?from h2)) (height ?from h0) (not (height ?to h0)) (height ?to h2)))
+  (:action release-cube-0
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?to l2)
+      (height ?to h0))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (bit-0 ?o) (not (no-bit-0 ?o))
+      (no-bit-5 ?o) (not (bit-5 ?o)) (not (height ?to h0)) (height ?to h2)))
   ; 895 moves: a cube lands on its release location at level 2
-  (:action pick-release-cube-to-l2-1
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?from ?to)
-      (is ?to l2) (height ?from h2) (height ?to h0))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
-      (not (no-bit-5 ?o)) (not (height ?from h2)) (height ?from h0) (not (height ?to h0)) (height ?to h2)))
+  (:action release-cube-to-l2-1
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (is ?to l2)
+      (height ?to h0))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (bit-0 ?o) (not (no-bit-0 ?o))
+      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?to h0)) (height ?to h2)))
   ; 135 moves: a cube lands on its release location at level 3
-  (:action pick-release-cube-2
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?from ?to)
-      (height ?from h2) (height ?to h1-end))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h1-end)
+  (:action release-cube-2
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (height ?to h1-end))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h1-end)
       (not (level ?o h2)) (level ?o h3) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h2)) (height ?from h0) (not (height ?to h1-end)) (height ?to h3)))
+      (not (height ?to h1-end)) (height ?to h3)))
   ; 640 moves: a cube lands on its release location at level 3
-  (:action pick-release-cube-3
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?from ?to)
-      (differ ?to l4) (height ?from h2) (height ?to h1))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h1)
+  (:action release-cube-3
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?to l4)
+      (height ?to h1))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h1)
       (not (level ?o h2)) (level ?o h3) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h2)) (height ?from h0) (not (height ?to h1)) (height ?to h3)))
+      (not (height ?to h1)) (height ?to h3)))
   ; 170 moves: a cube lands on its release location at level 3
-  (:action pick-release-cube-to-l4-4
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?from ?to)
-      (is ?to l4) (height ?from h2) (height ?to h1))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h1)
+  (:action release-cube-to-l4-4
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (is ?to l4)
+      (height ?to h1))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h1)
       (not (level ?o h2)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h2)) (height ?from h0) (not (height ?to h1)) (height ?to h3)))
+      (not (height ?to h1)) (height ?to h3)))
   ; 635 moves: a cube lands on its release location at level 4
-  (:action pick-release-cube-5
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?from ?to)
-      (differ ?to l3) (height ?from h2) (height ?to h2))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h2)
+  (:action release-cube-5
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?to l3)
+      (height ?to h2))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h2)) (level ?o h4) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h2)) (height ?from h0) (not (height ?to h2)) (height ?to h4)))
+      (not (height ?to h2)) (height ?to h4)))
   ; 196 moves: a cube lands on its release location at level 4
-  (:action pick-release-cube-to-l3-6
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?from ?to)
-      (is ?to l3) (height ?from h2) (height ?to h2))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h2)
+  (:action release-cube-to-l3-6
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (is ?to l3)
+      (height ?to h2))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h2)) (level ?o h4) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h2)) (height ?from h0) (not (height ?to h2)) (height ?to h4)))
+      (not (height ?to h2)) (height ?to h4)))
   ; 51 moves: a cube ends off its release location at level 1
-  (:action pick-release-cube-7
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?from ?to)
-      (height ?from h2) (height ?to h3-end))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h3-end)
+  (:action release-cube-7
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (height ?to h3-end))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h3-end)
       (not (place ?o on-spot)) (place ?o plus-y-near) (not (level ?o h2)) (level ?o h1) (bit-0 ?o)
-      (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?from h2)) (height ?from h0)
-      (not (height ?to h3-end)) (height ?to h1)))
+      (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?to h3-end)) (height ?to h1)))
   ; 333 moves: a cube lands on its release location at level 5
-  (:action pick-release-cube-8
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?from ?to)
-      (height ?from h2) (height ?to h3))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h3)
+  (:action release-cube-8
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (height ?to h3))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h3)
       (not (level ?o h2)) (level ?o h5) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h2)) (height ?from h0) (not (height ?to h3)) (height ?to h5)))
+      (not (height ?to h3)) (height ?to h5)))
   ; 103 moves: a cube lands on its release location at level 6
-  (:action pick-release-cube-9
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?from ?to)
-      (height ?from h2) (height ?to h4))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h4)
+  (:action release-cube-9
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (height ?to h4))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h4)
       (not (level ?o h2)) (level ?o h6) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h2)) (height ?from h0) (not (height ?to h4)) (height ?to h6)))
+      (not (height ?to h4)) (height ?to h6)))
   ; 110 moves: a cube lands on its release location at level 2
-  (:action pick-release-cube-10
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h2) (rests ?o h1) (place ?o on-spot) (differ ?from ?to)
-      (height ?from h2) (height ?to h0))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h1)) (rests ?o h0) (bit-0 ?o)
-      (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o)) (not (height ?from h2)) (height ?from h1)
-      (not (height ?to h0)) (height ?to h2)))
+  (:action release-cube-10
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h2) (rests ?o h1) (place ?o on-spot) (height ?to h0))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h1)) (rests ?o h0)
+      (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o)) (not (height ?to h0)) (height ?to h2)))
   ; 53 moves: a cube lands on its release location at level 2
-  (:action pick-release-cube-11
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h3) (rests ?o h1-end) (place ?o on-spot) (differ ?from ?to)
-      (height ?from h3) (height ?to h0))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h1-end)) (rests ?o h0)
+  (:action release-cube-11
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h3) (rests ?o h1-end) (place ?o on-spot) (height ?to h0))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h1-end)) (rests ?o h0)
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h3)) (height ?from h1-end) (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2)))
   ; 396 moves: a cube lands on its release location at level 2
-  (:action pick-release-cube-12
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h3) (rests ?o h1) (place ?o on-spot) (differ ?from ?to)
-      (differ ?to l2) (height ?from h3) (height ?to h0))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h1)) (rests ?o h0)
+  (:action release-cube-12
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h3) (rests ?o h1) (place ?o on-spot) (differ ?to l2)
+      (height ?to h0))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h1)) (rests ?o h0)
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h3)) (height ?from h1) (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2)))
   ; 90 moves: a cube lands on its release location at level 2
-  (:action pick-release-cube-to-l2-13
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h3) (rests ?o h1) (place ?o on-spot) (differ ?from ?to)
-      (is ?to l2) (height ?from h3) (height ?to h0))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h1)) (rests ?o h0)
+  (:action release-cube-to-l2-13
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h3) (rests ?o h1) (place ?o on-spot) (is ?to l2)
+      (height ?to h0))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h1)) (rests ?o h0)
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height ?from h3)) (height ?from h1) (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2)))
   ; 106 moves: a cube lands on its release location at level 4
-  (:action pick-release-cube-14
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h3) (rests ?o h1) (place ?o on-spot) (differ ?from ?to)
-      (height ?from h3) (height ?to h2))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h1)) (rests ?o h2)
+  (:action release-cube-14
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h3) (rests ?o h1) (place ?o on-spot) (height ?to h2))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h1)) (rests ?o h2)
       (not (level ?o h3)) (level ?o h4) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h3)) (height ?from h1) (not (height ?to h2)) (height ?to h4)))
+      (not (height ?to h2)) (height ?to h4)))
   ; 640 moves: a cube lands on its release location at level 2
-  (:action pick-release-cube-15
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h4) (rests ?o h2) (place ?o on-spot) (differ ?from ?to)
-      (differ ?to l2) (height ?from h4) (height ?to h0))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h2)) (rests ?o h0)
+  (:action release-cube-15
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h4) (rests ?o h2) (place ?o on-spot) (differ ?to l2)
+      (height ?to h0))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h2)) (rests ?o h0)
       (not (level ?o h4)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h4)) (height ?from h2) (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2)))
   ; 146 moves: a cube lands on its release location at level 2
-  (:action pick-release-cube-to-l2-16
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h4) (rests ?o h2) (place ?o on-spot) (differ ?from ?to)
-      (is ?to l2) (height ?from h4) (height ?to h0))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h2)) (rests ?o h0)
+  (:action release-cube-to-l2-16
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h4) (rests ?o h2) (place ?o on-spot) (is ?to l2)
+      (height ?to h0))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h2)) (rests ?o h0)
       (not (level ?o h4)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height ?from h4)) (height ?from h2) (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2)))
   ; 144 moves: a cube lands on its release location at level 3
-  (:action pick-release-cube-17
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h4) (rests ?o h2) (place ?o on-spot) (differ ?from ?to)
-      (height ?from h4) (height ?to h1))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h2)) (rests ?o h1)
+  (:action release-cube-17
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h4) (rests ?o h2) (place ?o on-spot) (height ?to h1))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h2)) (rests ?o h1)
       (not (level ?o h4)) (level ?o h3) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h4)) (height ?from h2) (not (height ?to h1)) (height ?to h3)))
+      (not (height ?to h1)) (height ?to h3)))
   ; 94 moves: a cube lands on its release location at level 4
-  (:action pick-release-cube-18
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h4) (rests ?o h2) (place ?o on-spot) (differ ?from ?to)
-      (height ?from h4) (height ?to h2))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o)
-      (not (bit-5 ?o)) (not (height ?from h4)) (height ?from h2) (not (height ?to h2)) (height ?to h4)))
+  (:action release-cube-18
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h4) (rests ?o h2) (place ?o on-spot) (height ?to h2))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (no-bit-0 ?o) (not (bit-0 ?o))
+      (no-bit-5 ?o) (not (bit-5 ?o)) (not (height ?to h2)) (height ?to h4)))
   ; 230 moves: a cube lands on its release location at level 2
-  (:action pick-release-cube-19
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h5) (rests ?o h3) (place ?o on-spot) (differ ?from ?to)
-      (height ?from h5) (height ?to h0))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h3)) (rests ?o h0)
+  (:action release-cube-19
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h5) (rests ?o h3) (place ?o on-spot) (height ?to h0))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h3)) (rests ?o h0)
       (not (level ?o h5)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h5)) (height ?from h3) (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2)))
   ; 89 moves: a cube lands on its release location at level 1
-  (:action pick-release-cube-20
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h5) (rests ?o h4) (place ?o on-spot) (differ ?from ?to)
-      (height ?from h5) (height ?to h0))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h4)) (rests ?o h0)
+  (:action release-cube-20
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h5) (rests ?o h4) (place ?o on-spot) (height ?to h0))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h4)) (rests ?o h0)
       (not (level ?o h5)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height ?from h5)) (height ?from h4) (not (height ?to h0)) (height ?to h1)))
+      (not (height ?to h0)) (height ?to h1)))
   ; 74 moves: a cube lands on its release location at level 2
-  (:action pick-release-cube-21
-    :parameters (?o - cube ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h6) (rests ?o h4) (place ?o on-spot) (differ ?from ?to)
-      (height ?from h6) (height ?to h0))
-    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h4)) (rests ?o h0)
+  (:action release-cube-21
+    :parameters (?o - cube ?to - location)
+    :precondition (and (holding ?o) (level ?o h6) (rests ?o h4) (place ?o on-spot) (height ?to h0))
+    :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h4)) (rests ?o h0)
       (not (level ?o h6)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h6)) (height ?from h4) (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2)))
   ; 318 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-22
     :parameters (?o - stick ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h1) (rests ?o h0) (place ?o on-spot) (differ ?from ?to)
-      (near ?from) (near ?to) (height ?from h1) (height ?to h0))
+    :precondition (and (hand-empty) (at ?o ?from) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (differ ?from ?to) (near ?from) (near ?to) (height ?from h1) (height ?to h0))
     :effect (and (not (at ?o ?from)) (at ?o ?to) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (height ?from h1)) (height ?from h0) (not (height ?to h0)) (height ?to h1)))
   ; 251 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-23
     :parameters (?o - stick ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h1) (rests ?o h0) (place ?o on-spot) (differ ?from ?to)
-      (near ?from) (near ?to) (height ?from h1) (height ?to h2))
+    :precondition (and (hand-empty) (at ?o ?from) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (differ ?from ?to) (near ?from) (near ?to) (height ?from h1) (height ?to h2))
     :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height ?from h1)) (height ?from h0) (not (height ?to h2)) (height ?to h3)))
   ; 61 moves: a stick lands on its release location at level 5
   (:action pick-release-stick-24
     :parameters (?o - stick ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h1) (rests ?o h0) (place ?o on-spot) (differ ?from ?to)
-      (near ?from) (near ?to) (height ?from h1) (height ?to h4))
+    :precondition (and (hand-empty) (at ?o ?from) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (differ ?from ?to) (near ?from) (near ?to) (height ?from h1) (height ?to h4))
     :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h4)
       (not (level ?o h1)) (level ?o h5) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height ?from h1)) (height ?from h0) (not (height ?to h4)) (height ?to h5)))
   ; 117 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-25
     :parameters (?o - stick ?from - location ?to - location)
-    :precondition (and (at ?o ?from) (level ?o h3) (rests ?o h2) (place ?o on-spot) (differ ?from ?to)
-      (near ?from) (near ?to) (height ?from h3) (height ?to h0))
+    :precondition (and (hand-empty) (at ?o ?from) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (differ ?from ?to) (near ?from) (near ?to) (height ?from h3) (height ?to h0))
     :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h2)) (rests ?o h0)
       (not (level ?o h3)) (level ?o h1) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height ?from h3)) (height ?from h2) (not (height ?to h0)) (height ?to h1)))
   ; 18 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l1-26
     :parameters (?o - stick)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l0 h1) (height l1 h1-end) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l2 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l1) (beneath l0 h0) (beneath l2 h0)
       (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h1-end)
       (not (height l1 h1-end)) (height l1 h1) (not (height l2 h0)) (height l2 h1-end)))
   ; 6 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l0-l1-27
     :parameters (?o - stick ?t-l2 - layer)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l0 h1) (height l1 h1-end) (same-level ?t-l2 h2) (height l2 ?t-l2))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (same-level ?t-l2 h2) (height l2 ?t-l2))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l1) (beneath l0 h0) (beneath l2 h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l0 h1)) (height l0 h3-end) (not (height l1 h1-end)) (height l1 h3) (not (height l2 ?t-l2))
@@ -237,15 +230,16 @@
   ; 31 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l2-28
     :parameters (?o - stick)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l0 h1) (height l1 h1-end) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l2 h0))
     :effect (and (not (at ?o l0)) (at ?o l2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0) (not (height l2 h0)) (height l2 h1)))
   ; 5 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l2-29
     :parameters (?o - stick ?r0 - block)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1) (level ?r0 h3)
-      (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l0 h1) (height l1 h3) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
+      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l0 h1) (height l1 h3)
+      (height l2 h0))
     :effect (and (not (at ?o l0)) (at ?o l2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (place ?r0 on-spot))
       (place ?r0 plus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
@@ -253,24 +247,25 @@
   ; 7 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l2-30
     :parameters (?o - stick)
-    :precondition (and (at ?o l0) (level ?o h3) (rests ?o h2) (place ?o on-spot) (beneath l1 h0)
-      (height l0 h3) (height l1 h3-end) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (beneath l1 h0) (height l0 h3) (height l1 h3-end) (height l2 h0))
     :effect (and (not (at ?o l0)) (at ?o l2) (not (rests ?o h2)) (rests ?o h0) (not (level ?o h3))
       (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h3))
       (height l0 h2) (not (height l1 h3-end)) (height l1 h1-end) (not (height l2 h0)) (height l2 h1)))
   ; 11 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l3-31
     :parameters (?o - stick)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l0 h1) (height l1 h1-end) (height l3 h0))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l3 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l3) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end))
       (height l1 h0) (not (height l3 h0)) (height l3 h1)))
   ; 3 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l3-32
     :parameters (?o - stick ?r0 - block)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1) (level ?r0 h3)
-      (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l0 h1) (height l1 h3) (height l3 h0))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
+      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l0 h1) (height l1 h3)
+      (height l3 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l3) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (at ?r0 l1)) (at ?r0 l4)
       (not (place ?r0 on-spot)) (place ?r0 minus-y-mid) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0)
@@ -279,8 +274,8 @@
   ; 8 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l0-l3-33
     :parameters (?o - stick)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l0 h1) (height l1 h1-end) (height l3 h2))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l3 h2))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l3) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l3 h2))
@@ -288,24 +283,25 @@
   ; 8 moves: a stick ends off its release location at level 1
   (:action pick-release-stick-l0-l3-34
     :parameters (?o - stick)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o minus-y-far) (height l0 h1)
-      (height l3 h0))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o minus-y-far)
+      (height l0 h1) (height l3 h0))
     :effect (and (not (at ?o l0)) (at ?o l3) (not (place ?o minus-y-far)) (place ?o minus-y-mid)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0)
       (not (height l3 h0)) (height l3 h1)))
   ; 14 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l4-35
     :parameters (?o - stick)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l0 h1) (height l1 h1-end) (height l4 h0))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l4 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l4) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end))
       (height l1 h0) (not (height l4 h0)) (height l4 h1)))
   ; 4 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l4-36
     :parameters (?o - stick ?r0 - block)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1) (level ?r0 h3)
-      (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l0 h1) (height l1 h3) (height l4 h0))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
+      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l0 h1) (height l1 h3)
+      (height l4 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l4) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (at ?r0 l1)) (at ?r0 l5)
       (not (place ?r0 on-spot)) (place ?r0 minus-y-mid) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0)
@@ -314,8 +310,8 @@
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l0-l4-37
     :parameters (?o - stick)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l0 h1) (height l1 h1-end) (height l4 h2))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l4 h2))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l4) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l4 h2))
@@ -323,16 +319,17 @@
   ; 14 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l5-38
     :parameters (?o - stick)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l0 h1) (height l1 h1-end) (height l5 h0))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l5 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l5) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end))
       (height l1 h0) (not (height l5 h0)) (height l5 h1)))
   ; 3 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l5-39
     :parameters (?o - stick ?r0 - block)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1) (level ?r0 h3)
-      (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l0 h1) (height l1 h3) (height l5 h0))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
+      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l0 h1) (height l1 h3)
+      (height l5 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l5) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (place ?r0 on-spot))
       (place ?r0 plus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
@@ -340,8 +337,8 @@
   ; 6 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l0-l5-40
     :parameters (?o - stick)
-    :precondition (and (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l0 h1) (height l1 h1-end) (height l5 h2))
+    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l5 h2))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l5) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l5 h2))
@@ -349,16 +346,16 @@
   ; 21 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l0-41
     :parameters (?o - stick)
-    :precondition (and (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l0 h0)
-      (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end))
+    :precondition (and (hand-empty) (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end))
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l0)
       (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l1 h1))
       (height l1 h1-end) (not (height l0 h1-end)) (height l0 h1) (not (height l2 h1-end)) (height l2 h0)))
   ; 6 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l0-42
     :parameters (?o - stick)
-    :precondition (and (at ?o l1) (level ?o h3) (rests ?o h0) (place ?o on-spot) (beneath l0 h0)
-      (beneath l2 h2) (height l1 h3) (height l0 h3-end) (height l2 h3-end))
+    :precondition (and (hand-empty) (at ?o l1) (level ?o h3) (rests ?o h0) (place ?o on-spot)
+      (beneath l0 h0) (beneath l2 h2) (height l1 h3) (height l0 h3-end) (height l2 h3-end))
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h2)) (not (at ?o l1)) (at ?o l0)
       (beneath l1 h0) (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (height l1 h3)) (height l1 h1-end) (not (height l0 h3-end)) (height l0 h1)
@@ -366,17 +363,17 @@
   ; 25 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l2-43
     :parameters (?o - stick)
-    :precondition (and (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l0 h0)
-      (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end))
+    :precondition (and (hand-empty) (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end))
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l2)
       (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l1 h1))
       (height l1 h1-end) (not (height l0 h1-end)) (height l0 h0) (not (height l2 h1-end)) (height l2 h1)))
   ; 5 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l2-44
     :parameters (?o - stick ?r0 - block)
-    :precondition (and (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l0 h0)
-      (at ?r0 l2) (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l2 h0) (height l1 h1)
-      (height l0 h1-end) (height l2 h3))
+    :precondition (and (hand-empty) (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l0 h0) (at ?r0 l2) (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l2 h0)
+      (height l1 h1) (height l0 h1-end) (height l2 h3))
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l2)
       (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end))
       (rests ?r0 h0) (not (place ?r0 on-spot)) (place ?r0 plus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0))
@@ -385,8 +382,8 @@
   ; 11 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l3-45
     :parameters (?o - stick)
-    :precondition (and (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l0 h0)
-      (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l3 h0))
+    :precondition (and (hand-empty) (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l3 h0))
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l1 h1)) (height l1 h0)
       (not (height l0 h1-end)) (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l3 h0))
@@ -394,8 +391,8 @@
   ; 8 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l1-l3-46
     :parameters (?o - stick)
-    :precondition (and (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l0 h0)
-      (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l3 h2))
+    :precondition (and (hand-empty) (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l3 h2))
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l3)
       (not (rests ?o h0)) (rests ?o h2) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o))
       (no-bit-5 ?o) (not (bit-5 ?o)) (not (height l1 h1)) (height l1 h0) (not (height l0 h1-end))
@@ -403,8 +400,8 @@
   ; 10 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l4-47
     :parameters (?o - stick)
-    :precondition (and (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l0 h0)
-      (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l4 h0))
+    :precondition (and (hand-empty) (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l4 h0))
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l4)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l1 h1)) (height l1 h0)
       (not (height l0 h1-end)) (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l4 h0))
@@ -412,8 +409,8 @@
   ; 10 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l5-48
     :parameters (?o - stick)
-    :precondition (and (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l0 h0)
-      (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l5 h0))
+    :precondition (and (hand-empty) (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l5 h0))
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l5)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l1 h1)) (height l1 h0)
       (not (height l0 h1-end)) (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l5 h0))
@@ -421,8 +418,8 @@
   ; 9 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l1-l5-49
     :parameters (?o - stick)
-    :precondition (and (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l0 h0)
-      (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l5 h2))
+    :precondition (and (hand-empty) (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l5 h2))
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l5)
       (not (rests ?o h0)) (rests ?o h2) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o))
       (no-bit-5 ?o) (not (bit-5 ?o)) (not (height l1 h1)) (height l1 h0) (not (height l0 h1-end))
@@ -430,8 +427,8 @@
   ; 7 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l5-50
     :parameters (?o - stick)
-    :precondition (and (at ?o l1) (level ?o h3) (rests ?o h0) (place ?o on-spot) (beneath l0 h0)
-      (beneath l2 h2) (height l1 h3) (height l0 h3-end) (height l2 h3-end) (height l5 h0))
+    :precondition (and (hand-empty) (at ?o l1) (level ?o h3) (rests ?o h0) (place ?o on-spot)
+      (beneath l0 h0) (beneath l2 h2) (height l1 h3) (height l0 h3-end) (height l2 h3-end) (height l5 h0))
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h2)) (not (at ?o l1)) (at ?o l5)
       (not (level ?o h3)) (level ?o h1) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l1 h3)) (height l1 h0) (not (height l0 h3-end)) (height l0 h0) (not (height l2 h3-end))
@@ -439,15 +436,16 @@
   ; 23 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l0-51
     :parameters (?o - stick)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l2 h1) (height l1 h1-end) (height l0 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l0 h0))
     :effect (and (not (at ?o l2)) (at ?o l0) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l0 h0)) (height l0 h1)))
   ; 3 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l0-52
     :parameters (?o - stick ?r0 - block)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1) (level ?r0 h3)
-      (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3) (height l0 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
+      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3)
+      (height l0 h0))
     :effect (and (not (at ?o l2)) (at ?o l0) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (place ?r0 on-spot))
       (place ?r0 minus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
@@ -455,24 +453,25 @@
   ; 6 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l0-53
     :parameters (?o - stick)
-    :precondition (and (at ?o l2) (level ?o h3) (rests ?o h2) (place ?o on-spot) (beneath l1 h0)
-      (height l2 h3) (height l1 h3-end) (height l0 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (beneath l1 h0) (height l2 h3) (height l1 h3-end) (height l0 h0))
     :effect (and (not (at ?o l2)) (at ?o l0) (not (rests ?o h2)) (rests ?o h0) (not (level ?o h3))
       (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h3))
       (height l2 h2) (not (height l1 h3-end)) (height l1 h1-end) (not (height l0 h0)) (height l0 h1)))
   ; 22 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l1-54
     :parameters (?o - stick)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l2 h1) (height l1 h1-end) (height l0 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l0 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l1) (beneath l0 h0) (beneath l2 h0)
       (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h1-end)
       (not (height l1 h1-end)) (height l1 h1) (not (height l0 h0)) (height l0 h1-end)))
   ; 6 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l1-55
     :parameters (?o - stick ?r0 - block)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1) (level ?r0 h3)
-      (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3) (height l0 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
+      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3)
+      (height l0 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l1) (beneath l0 h0) (beneath l2 h0)
       (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (at ?r0 l1)) (at ?r0 l0) (bit-0 ?r0)
       (not (no-bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0)) (not (height l2 h1)) (height l2 h1-end)
@@ -480,16 +479,17 @@
   ; 13 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l3-56
     :parameters (?o - stick)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l2 h1) (height l1 h1-end) (height l3 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l3 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l3) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end))
       (height l1 h0) (not (height l3 h0)) (height l3 h1)))
   ; 4 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l3-57
     :parameters (?o - stick ?r0 - block)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1) (level ?r0 h3)
-      (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3) (height l3 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
+      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3)
+      (height l3 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l3) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (place ?r0 on-spot))
       (place ?r0 minus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
@@ -497,8 +497,8 @@
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l2-l3-58
     :parameters (?o - stick)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l2 h1) (height l1 h1-end) (height l3 h2))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l3 h2))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l3) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l3 h2))
@@ -506,8 +506,9 @@
   ; 3 moves: a stick lands on its release location at level 4
   (:action pick-release-stick-l2-l3-59
     :parameters (?o - stick ?r0 - block)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1) (level ?r0 h3)
-      (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3) (height l3 h2))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
+      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3)
+      (height l3 h2))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l3) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h1)) (level ?o h4) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (place ?r0 on-spot)) (place ?r0 minus-y-far)
@@ -517,24 +518,25 @@
   ; 8 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l3-60
     :parameters (?o - stick)
-    :precondition (and (at ?o l2) (level ?o h3) (rests ?o h0) (place ?o on-spot) (beneath l1 h2)
-      (height l2 h3) (height l1 h3-end) (height l3 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h3) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h2) (height l2 h3) (height l1 h3-end) (height l3 h0))
     :effect (and (not (beneath l1 h2)) (not (at ?o l2)) (at ?o l3) (not (level ?o h3)) (level ?o h1)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h3)) (height l2 h0)
       (not (height l1 h3-end)) (height l1 h2) (not (height l3 h0)) (height l3 h1)))
   ; 13 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l4-61
     :parameters (?o - stick)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l2 h1) (height l1 h1-end) (height l4 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l4 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l4) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end))
       (height l1 h0) (not (height l4 h0)) (height l4 h1)))
   ; 7 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l4-62
     :parameters (?o - stick ?r0 - block)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1) (level ?r0 h3)
-      (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3) (height l4 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
+      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3)
+      (height l4 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l4) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (at ?r0 l1)) (at ?r0 l3)
       (not (place ?r0 on-spot)) (place ?r0 plus-y-mid) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0)
@@ -543,8 +545,8 @@
   ; 14 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l2-l4-63
     :parameters (?o - stick)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l2 h1) (height l1 h1-end) (height l4 h2))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l4 h2))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l4) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l4 h2))
@@ -552,23 +554,24 @@
   ; 14 moves: a stick ends off its release location at level 1
   (:action pick-release-stick-l2-l4-64
     :parameters (?o - stick)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o plus-y-mid) (height l2 h1)
-      (height l4 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o plus-y-mid)
+      (height l2 h1) (height l4 h0))
     :effect (and (not (at ?o l2)) (at ?o l4) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l4 h0)) (height l4 h1)))
   ; 25 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l5-65
     :parameters (?o - stick)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (beneath l1 h0)
-      (height l2 h1) (height l1 h1-end) (height l5 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l5 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l5) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end))
       (height l1 h0) (not (height l5 h0)) (height l5 h1)))
   ; 5 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l5-66
     :parameters (?o - stick ?r0 - block)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1) (level ?r0 h3)
-      (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3) (height l5 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
+      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3)
+      (height l5 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l5) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (at ?r0 l1)) (at ?r0 l4)
       (not (place ?r0 on-spot)) (place ?r0 plus-y-mid) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0)
@@ -577,39 +580,39 @@
   ; 6 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l5-67
     :parameters (?o - stick)
-    :precondition (and (at ?o l2) (level ?o h3) (rests ?o h0) (place ?o on-spot) (beneath l1 h2)
-      (height l2 h3) (height l1 h3-end) (height l5 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h3) (rests ?o h0) (place ?o on-spot)
+      (beneath l1 h2) (height l2 h3) (height l1 h3-end) (height l5 h0))
     :effect (and (not (beneath l1 h2)) (not (at ?o l2)) (at ?o l5) (not (level ?o h3)) (level ?o h1)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h3)) (height l2 h0)
       (not (height l1 h3-end)) (height l1 h2) (not (height l5 h0)) (height l5 h1)))
   ; 6 moves: a stick ends off its release location at level 1
   (:action pick-release-stick-l2-l5-68
     :parameters (?o - stick)
-    :precondition (and (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o plus-y-mid) (height l2 h1)
-      (height l5 h0))
+    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o plus-y-mid)
+      (height l2 h1) (height l5 h0))
     :effect (and (not (at ?o l2)) (at ?o l5) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l5 h0)) (height l5 h1)))
   ; 80 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l3-l0-69
     :parameters (?o - stick)
-    :precondition (and (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l3 h1)
-      (height l0 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l3 h1) (height l0 h0) (height l1 h0))
     :effect (and (not (at ?o l3)) (at ?o l0) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0) (not (height l0 h0)) (height l0 h1)
       (not (height l1 h0)) (height l1 h1-end)))
   ; 13 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l0-70
     :parameters (?o - stick ?t-l1 - layer)
-    :precondition (and (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l3 h1)
-      (height l0 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l3 h1) (height l0 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
     :effect (and (not (at ?o l3)) (at ?o l0) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0)
       (not (height l0 h0)) (height l0 h3) (not (height l1 ?t-l1)) (height l1 h3-end)))
   ; 17 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l0-71
     :parameters (?o - stick)
-    :precondition (and (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l3 h1)
-      (height l0 h2) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l3 h1) (height l0 h2) (height l1 h0))
     :effect (and (not (at ?o l3)) (at ?o l0) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l3 h1)) (height l3 h0) (not (height l0 h2)) (height l0 h3) (not (height l1 h0))
@@ -617,8 +620,8 @@
   ; 21 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l3-l0-72
     :parameters (?o - stick)
-    :precondition (and (at ?o l3) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l3 h3)
-      (height l0 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l3 h3) (height l0 h0) (height l1 h0))
     :effect (and (not (at ?o l3)) (at ?o l0) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l3 h3)) (height l3 h2) (not (height l0 h0)) (height l0 h1) (not (height l1 h0))
@@ -626,16 +629,16 @@
   ; 9 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l0-73
     :parameters (?o - stick)
-    :precondition (and (at ?o l3) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l3 h3)
-      (height l0 h2) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l3 h3) (height l0 h2) (height l1 h0))
     :effect (and (not (at ?o l3)) (at ?o l0) (beneath l1 h0) (no-bit-0 ?o) (not (bit-0 ?o))
       (no-bit-5 ?o) (not (bit-5 ?o)) (not (height l3 h3)) (height l3 h2) (not (height l0 h2)) (height l0 h3)
       (not (height l1 h0)) (height l1 h3-end)))
   ; 51 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l3-l1-74
     :parameters (?o - stick)
-    :precondition (and (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l3 h1)
-      (height l1 h0) (height l0 h0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l3 h1) (height l1 h0) (height l0 h0) (height l2 h0))
     :effect (and (not (at ?o l3)) (at ?o l1) (beneath l0 h0) (beneath l2 h0) (bit-0 ?o)
       (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0)
       (not (height l1 h0)) (height l1 h1) (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0))
@@ -643,8 +646,8 @@
   ; 15 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l1-75
     :parameters (?o - stick ?t-l2 - layer)
-    :precondition (and (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l3 h1)
-      (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l3 h1) (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
     :effect (and (not (at ?o l3)) (at ?o l1) (beneath l0 h0) (beneath l2 h2) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1))
       (height l3 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
@@ -652,8 +655,8 @@
   ; 11 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l1-76
     :parameters (?o - stick ?t-l0 - layer)
-    :precondition (and (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l3 h1)
-      (height l1 h0) (same-level ?t-l0 h2) (height l0 ?t-l0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l3 h1) (height l1 h0) (same-level ?t-l0 h2) (height l0 ?t-l0) (height l2 h0))
     :effect (and (not (at ?o l3)) (at ?o l1) (beneath l0 h2) (beneath l2 h0) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1))
       (height l3 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?t-l0)) (height l0 h3-end)
@@ -661,8 +664,8 @@
   ; 13 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l1-77
     :parameters (?o - stick)
-    :precondition (and (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l3 h1)
-      (height l1 h2) (height l0 h0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l3 h1) (height l1 h2) (height l0 h0) (height l2 h0))
     :effect (and (not (at ?o l3)) (at ?o l1) (not (rests ?o h0)) (rests ?o h2) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o)
       (not (bit-5 ?o)) (not (height l3 h1)) (height l3 h0) (not (height l1 h2)) (height l1 h3)
@@ -670,8 +673,8 @@
   ; 12 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l3-l1-78
     :parameters (?o - stick)
-    :precondition (and (at ?o l3) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l3 h3)
-      (height l1 h0) (height l0 h0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l3 h3) (height l1 h0) (height l0 h0) (height l2 h0))
     :effect (and (not (at ?o l3)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (height l3 h3)) (height l3 h2) (not (height l1 h0)) (height l1 h1)
@@ -679,24 +682,24 @@
   ; 69 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l3-l2-79
     :parameters (?o - stick)
-    :precondition (and (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l3 h1)
-      (height l2 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l3 h1) (height l2 h0) (height l1 h0))
     :effect (and (not (at ?o l3)) (at ?o l2) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0) (not (height l2 h0)) (height l2 h1)
       (not (height l1 h0)) (height l1 h1-end)))
   ; 15 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l2-80
     :parameters (?o - stick ?t-l1 - layer)
-    :precondition (and (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l3 h1)
-      (height l2 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l3 h1) (height l2 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
     :effect (and (not (at ?o l3)) (at ?o l2) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0)
       (not (height l2 h0)) (height l2 h3) (not (height l1 ?t-l1)) (height l1 h3-end)))
   ; 12 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l2-81
     :parameters (?o - stick)
-    :precondition (and (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l3 h1)
-      (height l2 h2) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l3 h1) (height l2 h2) (height l1 h0))
     :effect (and (not (at ?o l3)) (at ?o l2) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l3 h1)) (height l3 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 h0))
@@ -704,8 +707,8 @@
   ; 7 moves: a stick lands on its release location at level 5
   (:action pick-release-stick-l3-l2-82
     :parameters (?o - stick ?v - block)
-    :precondition (and (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l3 h1)
-      (height l2 h4) (height l1 h0) (at ?v l2) (level ?v h4))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l3 h1) (height l2 h4) (height l1 h0) (at ?v l2) (level ?v h4))
     :effect (and (not (at ?o l3)) (at ?o l2) (not (rests ?o h0)) (rests ?o h4) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h5) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (bit-0 ?v) (not (no-bit-0 ?v)) (bit-5 ?v) (not (no-bit-5 ?v)) (not (height l3 h1)) (height l3 h0)
@@ -713,8 +716,8 @@
   ; 17 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l3-l2-83
     :parameters (?o - stick)
-    :precondition (and (at ?o l3) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l3 h3)
-      (height l2 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l3) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l3 h3) (height l2 h0) (height l1 h0))
     :effect (and (not (at ?o l3)) (at ?o l2) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l3 h3)) (height l3 h2) (not (height l2 h0)) (height l2 h1) (not (height l1 h0))
@@ -722,24 +725,24 @@
   ; 65 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l0-84
     :parameters (?o - stick)
-    :precondition (and (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l4 h1)
-      (height l0 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l4 h1) (height l0 h0) (height l1 h0))
     :effect (and (not (at ?o l4)) (at ?o l0) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0) (not (height l0 h0)) (height l0 h1)
       (not (height l1 h0)) (height l1 h1-end)))
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l0-85
     :parameters (?o - stick ?t-l1 - layer)
-    :precondition (and (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l4 h1)
-      (height l0 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l4 h1) (height l0 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
     :effect (and (not (at ?o l4)) (at ?o l0) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0)
       (not (height l0 h0)) (height l0 h3) (not (height l1 ?t-l1)) (height l1 h3-end)))
   ; 18 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l0-86
     :parameters (?o - stick)
-    :precondition (and (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l4 h1)
-      (height l0 h2) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l4 h1) (height l0 h2) (height l1 h0))
     :effect (and (not (at ?o l4)) (at ?o l0) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l4 h1)) (height l4 h0) (not (height l0 h2)) (height l0 h3) (not (height l1 h0))
@@ -747,8 +750,8 @@
   ; 21 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l0-87
     :parameters (?o - stick)
-    :precondition (and (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l4 h3)
-      (height l0 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l4 h3) (height l0 h0) (height l1 h0))
     :effect (and (not (at ?o l4)) (at ?o l0) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l4 h3)) (height l4 h2) (not (height l0 h0)) (height l0 h1) (not (height l1 h0))
@@ -756,16 +759,16 @@
   ; 7 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l0-88
     :parameters (?o - stick)
-    :precondition (and (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l4 h3)
-      (height l0 h2) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l4 h3) (height l0 h2) (height l1 h0))
     :effect (and (not (at ?o l4)) (at ?o l0) (beneath l1 h0) (no-bit-0 ?o) (not (bit-0 ?o))
       (no-bit-5 ?o) (not (bit-5 ?o)) (not (height l4 h3)) (height l4 h2) (not (height l0 h2)) (height l0 h3)
       (not (height l1 h0)) (height l1 h3-end)))
   ; 56 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l1-89
     :parameters (?o - stick)
-    :precondition (and (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l4 h1)
-      (height l1 h0) (height l0 h0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l4 h1) (height l1 h0) (height l0 h0) (height l2 h0))
     :effect (and (not (at ?o l4)) (at ?o l1) (beneath l0 h0) (beneath l2 h0) (bit-0 ?o)
       (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0)
       (not (height l1 h0)) (height l1 h1) (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0))
@@ -773,8 +776,8 @@
   ; 17 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-90
     :parameters (?o - stick ?t-l2 - layer)
-    :precondition (and (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l4 h1)
-      (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l4 h1) (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
     :effect (and (not (at ?o l4)) (at ?o l1) (beneath l0 h0) (beneath l2 h2) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1))
       (height l4 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
@@ -782,8 +785,8 @@
   ; 8 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-91
     :parameters (?o - stick ?t-l0 - layer)
-    :precondition (and (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l4 h1)
-      (height l1 h0) (same-level ?t-l0 h2) (height l0 ?t-l0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l4 h1) (height l1 h0) (same-level ?t-l0 h2) (height l0 ?t-l0) (height l2 h0))
     :effect (and (not (at ?o l4)) (at ?o l1) (beneath l0 h2) (beneath l2 h0) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1))
       (height l4 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?t-l0)) (height l0 h3-end)
@@ -791,8 +794,8 @@
   ; 9 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-92
     :parameters (?o - stick)
-    :precondition (and (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l4 h1)
-      (height l1 h2) (height l0 h0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l4 h1) (height l1 h2) (height l0 h0) (height l2 h0))
     :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h0)) (rests ?o h2) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o)
       (not (bit-5 ?o)) (not (height l4 h1)) (height l4 h0) (not (height l1 h2)) (height l1 h3)
@@ -800,8 +803,8 @@
   ; 8 moves: a stick lands on its release location at level 2
   (:action pick-release-stick-l4-l1-93
     :parameters (?o - stick)
-    :precondition (and (at ?o l4) (level ?o h3) (rests ?o h1) (place ?o on-spot) (height l4 h3)
-      (height l1 h0) (height l0 h0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h1) (place ?o on-spot)
+      (height l4 h3) (height l1 h0) (height l0 h0) (height l2 h0))
     :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h1)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o)
       (not (bit-5 ?o)) (not (height l4 h3)) (height l4 h1) (not (height l1 h0)) (height l1 h2)
@@ -809,8 +812,8 @@
   ; 14 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l1-94
     :parameters (?o - stick)
-    :precondition (and (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l4 h3)
-      (height l1 h0) (height l0 h0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l4 h3) (height l1 h0) (height l0 h0) (height l2 h0))
     :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (height l4 h3)) (height l4 h2) (not (height l1 h0)) (height l1 h1)
@@ -818,8 +821,8 @@
   ; 8 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-95
     :parameters (?o - stick ?t-l2 - layer)
-    :precondition (and (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l4 h3)
-      (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l4 h3) (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
     :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h2) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h3))
       (height l4 h2) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
@@ -827,8 +830,8 @@
   ; 7 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-96
     :parameters (?o - stick ?t-l0 - layer)
-    :precondition (and (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l4 h3)
-      (height l1 h0) (same-level ?t-l0 h2) (height l0 ?t-l0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l4 h3) (height l1 h0) (same-level ?t-l0 h2) (height l0 ?t-l0) (height l2 h0))
     :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h2)
       (beneath l2 h0) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h3))
       (height l4 h2) (not (height l1 h0)) (height l1 h3) (not (height l0 ?t-l0)) (height l0 h3-end)
@@ -836,24 +839,24 @@
   ; 53 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l2-97
     :parameters (?o - stick)
-    :precondition (and (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l4 h1)
-      (height l2 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l4 h1) (height l2 h0) (height l1 h0))
     :effect (and (not (at ?o l4)) (at ?o l2) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0) (not (height l2 h0)) (height l2 h1)
       (not (height l1 h0)) (height l1 h1-end)))
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l2-98
     :parameters (?o - stick ?t-l1 - layer)
-    :precondition (and (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l4 h1)
-      (height l2 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l4 h1) (height l2 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
     :effect (and (not (at ?o l4)) (at ?o l2) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0)
       (not (height l2 h0)) (height l2 h3) (not (height l1 ?t-l1)) (height l1 h3-end)))
   ; 19 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l2-99
     :parameters (?o - stick)
-    :precondition (and (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l4 h1)
-      (height l2 h2) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l4 h1) (height l2 h2) (height l1 h0))
     :effect (and (not (at ?o l4)) (at ?o l2) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l4 h1)) (height l4 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 h0))
@@ -861,8 +864,8 @@
   ; 10 moves: a stick lands on its release location at level 2
   (:action pick-release-stick-l4-l2-100
     :parameters (?o - stick)
-    :precondition (and (at ?o l4) (level ?o h3) (rests ?o h1) (place ?o on-spot) (height l4 h3)
-      (height l2 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h1) (place ?o on-spot)
+      (height l4 h3) (height l2 h0) (height l1 h0))
     :effect (and (not (at ?o l4)) (at ?o l2) (not (rests ?o h1)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l4 h3)) (height l4 h1) (not (height l2 h0)) (height l2 h2) (not (height l1 h0))
@@ -870,8 +873,8 @@
   ; 19 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l2-101
     :parameters (?o - stick)
-    :precondition (and (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l4 h3)
-      (height l2 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l4 h3) (height l2 h0) (height l1 h0))
     :effect (and (not (at ?o l4)) (at ?o l2) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l4 h3)) (height l4 h2) (not (height l2 h0)) (height l2 h1) (not (height l1 h0))
@@ -879,24 +882,24 @@
   ; 58 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l5-l0-102
     :parameters (?o - stick)
-    :precondition (and (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l5 h1)
-      (height l0 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l5 h1) (height l0 h0) (height l1 h0))
     :effect (and (not (at ?o l5)) (at ?o l0) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0) (not (height l0 h0)) (height l0 h1)
       (not (height l1 h0)) (height l1 h1-end)))
   ; 12 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l0-103
     :parameters (?o - stick ?t-l1 - layer)
-    :precondition (and (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l5 h1)
-      (height l0 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l5 h1) (height l0 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
     :effect (and (not (at ?o l5)) (at ?o l0) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0)
       (not (height l0 h0)) (height l0 h3) (not (height l1 ?t-l1)) (height l1 h3-end)))
   ; 17 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l0-104
     :parameters (?o - stick)
-    :precondition (and (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l5 h1)
-      (height l0 h2) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l5 h1) (height l0 h2) (height l1 h0))
     :effect (and (not (at ?o l5)) (at ?o l0) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l5 h1)) (height l5 h0) (not (height l0 h2)) (height l0 h3) (not (height l1 h0))
@@ -904,8 +907,8 @@
   ; 6 moves: a stick lands on its release location at level 2
   (:action pick-release-stick-l5-l0-105
     :parameters (?o - stick)
-    :precondition (and (at ?o l5) (level ?o h3) (rests ?o h1) (place ?o on-spot) (height l5 h3)
-      (height l0 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h3) (rests ?o h1) (place ?o on-spot)
+      (height l5 h3) (height l0 h0) (height l1 h0))
     :effect (and (not (at ?o l5)) (at ?o l0) (not (rests ?o h1)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l5 h3)) (height l5 h1) (not (height l0 h0)) (height l0 h2) (not (height l1 h0))
@@ -913,8 +916,8 @@
   ; 25 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l5-l0-106
     :parameters (?o - stick)
-    :precondition (and (at ?o l5) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l5 h3)
-      (height l0 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l5 h3) (height l0 h0) (height l1 h0))
     :effect (and (not (at ?o l5)) (at ?o l0) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l5 h3)) (height l5 h2) (not (height l0 h0)) (height l0 h1) (not (height l1 h0))
@@ -922,8 +925,8 @@
   ; 51 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l5-l1-107
     :parameters (?o - stick)
-    :precondition (and (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l5 h1)
-      (height l1 h0) (height l0 h0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l5 h1) (height l1 h0) (height l0 h0) (height l2 h0))
     :effect (and (not (at ?o l5)) (at ?o l1) (beneath l0 h0) (beneath l2 h0) (bit-0 ?o)
       (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0)
       (not (height l1 h0)) (height l1 h1) (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0))
@@ -931,8 +934,8 @@
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l1-108
     :parameters (?o - stick ?t-l2 - layer)
-    :precondition (and (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l5 h1)
-      (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l5 h1) (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
     :effect (and (not (at ?o l5)) (at ?o l1) (beneath l0 h0) (beneath l2 h2) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1))
       (height l5 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
@@ -940,8 +943,8 @@
   ; 9 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l1-109
     :parameters (?o - stick ?t-l0 - layer)
-    :precondition (and (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l5 h1)
-      (height l1 h0) (same-level ?t-l0 h2) (height l0 ?t-l0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l5 h1) (height l1 h0) (same-level ?t-l0 h2) (height l0 ?t-l0) (height l2 h0))
     :effect (and (not (at ?o l5)) (at ?o l1) (beneath l0 h2) (beneath l2 h0) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1))
       (height l5 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?t-l0)) (height l0 h3-end)
@@ -949,8 +952,8 @@
   ; 17 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l1-110
     :parameters (?o - stick)
-    :precondition (and (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l5 h1)
-      (height l1 h2) (height l0 h0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l5 h1) (height l1 h2) (height l0 h0) (height l2 h0))
     :effect (and (not (at ?o l5)) (at ?o l1) (not (rests ?o h0)) (rests ?o h2) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o)
       (not (bit-5 ?o)) (not (height l5 h1)) (height l5 h0) (not (height l1 h2)) (height l1 h3)
@@ -958,8 +961,8 @@
   ; 10 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l5-l1-111
     :parameters (?o - stick)
-    :precondition (and (at ?o l5) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l5 h3)
-      (height l1 h0) (height l0 h0) (height l2 h0))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l5 h3) (height l1 h0) (height l0 h0) (height l2 h0))
     :effect (and (not (at ?o l5)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (height l5 h3)) (height l5 h2) (not (height l1 h0)) (height l1 h1)
@@ -967,8 +970,8 @@
   ; 6 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l1-112
     :parameters (?o - stick ?t-l2 - layer)
-    :precondition (and (at ?o l5) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l5 h3)
-      (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l5 h3) (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
     :effect (and (not (at ?o l5)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h2) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h3))
       (height l5 h2) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
@@ -976,24 +979,24 @@
   ; 63 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l5-l2-113
     :parameters (?o - stick)
-    :precondition (and (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l5 h1)
-      (height l2 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l5 h1) (height l2 h0) (height l1 h0))
     :effect (and (not (at ?o l5)) (at ?o l2) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0) (not (height l2 h0)) (height l2 h1)
       (not (height l1 h0)) (height l1 h1-end)))
   ; 11 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l2-114
     :parameters (?o - stick ?t-l1 - layer)
-    :precondition (and (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l5 h1)
-      (height l2 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l5 h1) (height l2 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
     :effect (and (not (at ?o l5)) (at ?o l2) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0)
       (not (height l2 h0)) (height l2 h3) (not (height l1 ?t-l1)) (height l1 h3-end)))
   ; 14 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l2-115
     :parameters (?o - stick)
-    :precondition (and (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l5 h1)
-      (height l2 h2) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l5 h1) (height l2 h2) (height l1 h0))
     :effect (and (not (at ?o l5)) (at ?o l2) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l5 h1)) (height l5 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 h0))
@@ -1001,8 +1004,8 @@
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l2-116
     :parameters (?o - stick ?t-l1 - layer)
-    :precondition (and (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot) (height l5 h1)
-      (height l2 h2) (same-level ?t-l1 h2) (height l1 ?t-l1))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
+      (height l5 h1) (height l2 h2) (same-level ?t-l1 h2) (height l1 ?t-l1))
     :effect (and (not (at ?o l5)) (at ?o l2) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l5 h1)) (height l5 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 ?t-l1))
@@ -1010,8 +1013,8 @@
   ; 11 moves: a stick lands on its release location at level 2
   (:action pick-release-stick-l5-l2-117
     :parameters (?o - stick)
-    :precondition (and (at ?o l5) (level ?o h3) (rests ?o h1) (place ?o on-spot) (height l5 h3)
-      (height l2 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h3) (rests ?o h1) (place ?o on-spot)
+      (height l5 h3) (height l2 h0) (height l1 h0))
     :effect (and (not (at ?o l5)) (at ?o l2) (not (rests ?o h1)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l5 h3)) (height l5 h1) (not (height l2 h0)) (height l2 h2) (not (height l1 h0))
@@ -1019,8 +1022,8 @@
   ; 19 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l5-l2-118
     :parameters (?o - stick)
-    :precondition (and (at ?o l5) (level ?o h3) (rests ?o h2) (place ?o on-spot) (height l5 h3)
-      (height l2 h0) (height l1 h0))
+    :precondition (and (hand-empty) (at ?o l5) (level ?o h3) (rests ?o h2) (place ?o on-spot)
+      (height l5 h3) (height l2 h0) (height l1 h0))
     :effect (and (not (at ?o l5)) (at ?o l2) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l5 h3)) (height l5 h2) (not (height l2 h0)) (height l2 h1) (not (height l1 h0))
