@@ -7,6 +7,7 @@ level. Rules distilled from its moves must reproduce held-out moves exactly, and
 """
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from collections import Counter
 
@@ -115,6 +116,16 @@ def test_a_far_stick_covers_its_neighbours_and_carries_its_rider():
     assert participants(graph, 2, 4) == "a stick's end"
     assert participants(graph, 3, 4) == "nothing to pick"
     assert layout.piece(located_code(drop_all([(ObjectType.CUBE, 3)]), [ObjectType.CUBE], 0), False).level == 2
+
+
+def test_each_step_is_a_rule_a_rare_structure_or_a_move_no_lifted_rule_describes(world_rules):
+    """case_of, by which the export's check says where the rules lose to m(z)."""
+    from symlearn.export.lifted_export import case_of
+    pieces = world_rules.pieces(located_code(drop_all([(ObjectType.CUBE, 3)]), [ObjectType.CUBE], 0) for _ in [0])
+    assert case_of(world_rules, pieces, 3 * 6 + 0) == "rule"
+    assert case_of(world_rules, pieces, 3 * 6 + 3) == "same location"
+    assert case_of(world_rules, pieces, 4 * 6 + 0) == "nothing to pick"
+    assert case_of(dataclasses.replace(world_rules, rules=()), pieces, 3 * 6 + 0) == "no rule"
 
 
 def test_rules_reproduce_held_out_moves_of_the_world(world_rules):
@@ -431,6 +442,13 @@ def test_export_lifted_and_plan_with_stock_fast_downward_on_a_tiny_run(tiny_run_
     lifted = load_lifted(run / "pddl" / "lifted.json")
     report = json.loads((run / "pddl" / "lifted.json").read_text())["stats"]
     assert lifted.rules and report["model_hash"] == lifted.model_hash and "checks_test_split" in report
+    for group in report["checks_test_split"][str(tiny_data.path)].values():  # the cases add up, by case too
+        cases = group["by_case"].values()
+        assert sum(c["cases"] for c in cases) == group["cases"] and sum(c["disagree"] for c in cases) == group["disagree"]
+        assert group["disagree"] == round((1 - group["fidelity_to_net"]) * group["cases"])
+        assert group["world_sides_with_rules"] + group["world_sides_with_net"] <= group["disagree"]
+        assert group["by_case"].get("rule", {}).get("rule_fired", 1.0) == 1.0
+        assert all(c["rule_fired"] == 0 for name, c in group["by_case"].items() if name != "rule")
     before, after = training_codes(run, tiny_data.path, planning_models(run)[0])
     actions = load_split(tiny_data.path, "train").action
     case = next((row[row >= 0].tolist(), int(a)) for row, a in zip(before, actions)
@@ -466,8 +484,6 @@ def test_export_lifted_and_plan_with_stock_fast_downward_on_a_tiny_run(tiny_run_
 def test_moves_the_world_model_never_makes_still_write_a_domain_fast_downward_reads(world_rules, tmp_path):
     """Riders falling off a carried stick (staying, or landing elsewhere) and a cube ending off its location are
     outcomes m(z) gives that the symbolic world does not: their schemas must still be PDDL the translator reads."""
-    import dataclasses
-
     from pddl_export.lifted_rules import STRUCTURE, Rule
     from search.stock_planners import solve_texts
     base = {"cls": (1, 4), "o.stick": True, "o.place": 0, "o.level": 1, "u.level": 0, "v.level": 0,
@@ -509,8 +525,6 @@ def test_a_rule_keeps_its_outcome_share_and_the_cost_form_plans_on_its_alternati
     alternative. The deterministic domain states the rule's own outcome; the cost form one action per outcome,
     costing 10 (1 - ln share), so stock Fast Downward (A* with LM-cut) takes the cheaper one where both reach the
     goal and the alternative where only it does; the planner's predictions follow the outcome each step chose."""
-    import dataclasses
-
     import pyval
 
     from pddl_export.lifted_writer import outcome_cost, plan_decoder

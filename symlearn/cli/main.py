@@ -153,7 +153,8 @@ def cmd_export_lifted(args: argparse.Namespace) -> int:
         for group, c in checks.items():
             print(f"  {data} test split, {group} objects ({c['cases']} steps): fidelity to m(z) "
                   f"{c['fidelity_to_net']:.3f}; accuracy against what was observed: rules {c['accuracy_rules']:.3f}, "
-                  f"m(z) {c['accuracy_net']:.3f}")
+                  f"m(z) {c['accuracy_net']:.3f}; where they disagree ({c['disagree']}) the world sides with the rules "
+                  f"{c['world_sides_with_rules']} times, with m(z) {c['world_sides_with_net']}")
     print(f"wrote {where / LIFTED_DIR / 'domain.pddl'} and {where / LIFTED_FILE}")
     for d in args.problems or []:
         index = write_problem_folder(Path(args.run), Path(d), pddl_dir=out)

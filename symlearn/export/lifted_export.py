@@ -23,8 +23,8 @@ import numpy as np
 
 from pddl_export.files import atomic_write_text, sha256_file
 from pddl_export.lifted_rules import MIN_GAIN, LiftedRules, build_codebook, distil_lifted, observed_moves, \
-    stick_reader, with_network_answers
-from pddl_export.lifted_scene import FIELD_BITS, CodeLayout, kept_bits
+    participants, stick_reader, with_network_answers
+from pddl_export.lifted_scene import FIELD_BITS, CodeLayout, kept_bits, read_scene
 from pddl_export.lifted_writer import domain_pddl, schemas
 from pddl_export.rules_io import PDDL_DIR
 from pddl_export.symbolic import bits_from_codes
@@ -110,27 +110,50 @@ def _fields(rules: LiftedRules, pieces) -> list[tuple]:
     return [(p.kind, p.loc, p.place, p.level) for p in pieces]
 
 
+def case_of(rules: LiftedRules, pieces, action: int) -> str:
+    """What the rules make of a step: "rule" (a rule fires), "no rule" (a move whose structure has none: rarer
+    than min_count), or why no lifted rule describes it (lifted_rules.participants: "same location", "nothing to
+    pick", "a stick's end", ...)."""
+    move = participants(read_scene(pieces), *divmod(int(action), 6))
+    if isinstance(move, str):
+        return move
+    return "rule" if rules.step_pieces(pieces, action)[1] is not None else "no rule"
+
+
 def check_lifted(rules: LiftedRules, split: Split, net_next: np.ndarray) -> dict:
-    """Whole-scene agreement on a split, by object count: the rules against m(z), each against the observation."""
+    """Whole-scene agreement on a split, by object count: the rules against m(z), each against the observation;
+    where the two disagree, which one the world sides with; and the same by case (case_of), so the report says
+    where the rules lose to m(z)."""
     tally: dict = {}
     for n in range(len(split.action)):
         k = int(split.mask[n].sum())
         before = rules.pieces(split.before[n, :k].tolist())
-        mine, fired = rules.step_pieces(before, int(split.action[n]))
+        mine = _fields(rules, rules.step_pieces(before, int(split.action[n]))[0])
         net = _fields(rules, rules.pieces(net_next[n, :k].tolist()))
         seen = _fields(rules, rules.pieces(split.after[n, :k].tolist()))
-        mine = _fields(rules, mine)
+        case = case_of(rules, before, int(split.action[n]))
         for group in ("all", "1-3" if k <= 3 else "4-5"):
-            t = tally.setdefault(group, Counter())
-            t["cases"] += 1
-            t["rules_vs_net"] += mine == net
-            t["rules_vs_observed"] += mine == seen
-            t["net_vs_observed"] += net == seen
-            t["rule_fired"] += fired is not None
-    return {g: {"cases": t["cases"], "fidelity_to_net": round(t["rules_vs_net"] / t["cases"], 4),
+            g = tally.setdefault(group, {})
+            for t in (g.setdefault("", Counter()), g.setdefault(case, Counter())):
+                t["cases"] += 1
+                t["rules_vs_net"] += mine == net
+                t["rules_vs_observed"] += mine == seen
+                t["net_vs_observed"] += net == seen
+                t["rule_fired"] += case == "rule"
+                if mine != net:
+                    t["disagree"] += 1
+                    t["world_sides_with_rules"] += mine == seen
+                    t["world_sides_with_net"] += net == seen
+
+    def summary(t: Counter) -> dict:
+        return {"cases": t["cases"], "fidelity_to_net": round(t["rules_vs_net"] / t["cases"], 4),
                 "accuracy_rules": round(t["rules_vs_observed"] / t["cases"], 4),
                 "accuracy_net": round(t["net_vs_observed"] / t["cases"], 4),
-                "rule_fired": round(t["rule_fired"] / t["cases"], 4)} for g, t in tally.items()}
+                "rule_fired": round(t["rule_fired"] / t["cases"], 4), "disagree": t["disagree"],
+                "world_sides_with_rules": t["world_sides_with_rules"],
+                "world_sides_with_net": t["world_sides_with_net"]}
+    by_size = lambda g: sorted(((c, t) for c, t in g.items() if c), key=lambda x: -x[1]["cases"])  # noqa: E731
+    return {group: {**summary(g[""]), "by_case": {c: summary(t) for c, t in by_size(g)}} for group, g in tally.items()}
 
 
 def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = (), cfg: LiftedConfig = LiftedConfig(),
