@@ -10,9 +10,10 @@ left under a stick's end). The ends keep a move onto a stick's end and one onto 
 (the rules' `v.at`, `u.at`: without them both actions would apply to either). The learned bits a rule tests are unary
 predicates in both polarities (`bit-I`, `no-bit-I`; docs/DOMAIN.md says what they mean in a real run), and
 `(differ ?a ?b)`, `(is ?a ?b)` (the same location), `(near ?l)` and `(same-level ?t ?h)` are static facts of every
-problem. Each rule of `pddl_export.lifted_rules` is one robot action in plain STRIPS with typing: no negative preconditions, no equality, no conditional effects, no
-quantifiers, no axioms, so that Fast Downward (LM-cut included), pyperplan and pyval take it. `at` (or `holding`),
-`level`, `rests` and `height` hold one value per block or location, which Fast Downward's translator finds.
+problem. Each rule of `pddl_export.lifted_rules` is one robot action in plain STRIPS with typing: no negative
+preconditions, no equality, no conditional effects, no quantifiers, no axioms, so that Fast Downward (LM-cut
+included), pyperplan and pyval take it. `at` (or `holding`), `level`, `rests` and `height` hold one value per block
+or location, which Fast Downward's translator finds.
 
 A cube's move is stated in two halves, as a person would write it: `pick-cube ?o ?from ?h ?t` lifts the cube off
 the top of its location (which drops to what it rested on; `(liftable ?h ?t)` lists the pairs some rule puts
@@ -24,9 +25,11 @@ plan_decoder reads a plan back as robot actions.
 The cost form (`costs=True`: domain_pddl, problem_pddl) is the all-outcomes determinisation of the rules: one
 action per outcome of a rule (its own and its alternatives, `-altJ`), each costing OUTCOME_COST_UNIT * (1 - ln
 share) rounded (`:action-costs`, `(:metric minimize (total-cost))`; pick-cube costs nothing, the release carries
-its rule's cost), so that a cost-aware search (A* with LM-cut) takes the plan whose steps m(z) answered most often, as `rules-outcomes` does on the rules over whole codes.
+its rule's cost), so that a cost-aware search (A* with LM-cut) takes the plan whose steps m(z) answered most often,
+as `rules-outcomes` does on the rules over whole codes.
 
-A cube's rule and a stick's moved within the near row are lifted over both locations (`?from`, `?to`); a stick
+A cube's move is lifted over both locations (pick-cube's `?from`, the release's `?to`), and so is a stick's moved
+within the near row (`?from`, `?to`); a stick
 moved in or out of the far row covers its row neighbours with its ends, and which of those overlap depends on
 the pair, so its rules name the two locations (`pick-release-stick-l1-l2-...`).
 
@@ -387,13 +390,17 @@ def _schema_text(name: str, params, pre, eff, comment: str) -> str:
 
 
 PICK_CUBE = "pick-cube"
-PICK_CUBE_TEXT = """  ; a cube is lifted off the top of its location, which drops to what it rested on; its level and what it
-  ; rested on stay with it until a release-cube action puts it down (the pairs some release takes: liftable)
-  (:action pick-cube
-    :parameters (?o - cube ?from - location ?h - layer ?t - layer)
-    :precondition (and (hand-empty) (liftable ?h ?t) (at ?o ?from) (level ?o ?h) (rests ?o ?t) (height ?from ?h))
-    :effect (and (not (hand-empty)) (holding ?o) (not (at ?o ?from)) (not (height ?from ?h)) (height ?from ?t)))
-"""
+
+
+def _pick_cube() -> Schema:
+    """The pick half of every cube's plain move (schemas)."""
+    params = (("?o", "cube"), ("?from", "location"), ("?h", "layer"), ("?t", "layer"))
+    pre = ("(hand-empty)", "(liftable ?h ?t)", "(at ?o ?from)", "(level ?o ?h)", "(rests ?o ?t)", "(height ?from ?h)")
+    eff = ("(not (hand-empty))", "(holding ?o)", "(not (at ?o ?from))", "(not (height ?from ?h))", "(height ?from ?t)")
+    comment = ("; a cube is lifted off the top of its location, which drops to what it rested on; its level and what\n"
+               "  ; it rested on stay with it until a release-cube action puts it down (liftable: the pairs some does)")
+    return Schema(PICK_CUBE, None, None, _schema_text(PICK_CUBE, params, pre, eff, comment), params, pre, eff,
+                  step="pick")
 
 
 def _pick_side(s: Schema) -> tuple[str, str] | None:
@@ -469,13 +476,7 @@ def schemas(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
     halves = tuple(_halves(s) for s in found)
     if not any(s.step == "release" for s in halves):
         return halves
-    pick = Schema(PICK_CUBE, None, None, PICK_CUBE_TEXT,
-                  (("?o", "cube"), ("?from", "location"), ("?h", "layer"), ("?t", "layer")),
-                  ("(hand-empty)", "(liftable ?h ?t)", "(at ?o ?from)", "(level ?o ?h)", "(rests ?o ?t)",
-                   "(height ?from ?h)"),
-                  ("(not (hand-empty))", "(holding ?o)", "(not (at ?o ?from))", "(not (height ?from ?h))",
-                   "(height ?from ?t)"), step="pick")
-    return (pick,) + halves
+    return (_pick_cube(),) + halves
 
 
 def _distinct(found: Iterable[Schema]) -> tuple[Schema, ...]:

@@ -13,12 +13,14 @@
                (near ?l - location) (differ ?a - location ?b - location) (is ?a - location ?b - location)
                (hand-empty) (holding ?b - block) (liftable ?h - layer ?t - layer)
                (bit-0 ?b - block) (no-bit-0 ?b - block) (bit-5 ?b - block) (no-bit-5 ?b - block))
-  ; a cube is lifted off the top of its location, which drops to what it rested on; its level and what it
-  ; rested on stay with it until a release-cube action puts it down (the pairs some release takes: liftable)
+  ; a cube is lifted off the top of its location, which drops to what it rested on; its level and what
+  ; it rested on stay with it until a release-cube action puts it down (liftable: the pairs some does)
   (:action pick-cube
     :parameters (?o - cube ?from - location ?h - layer ?t - layer)
-    :precondition (and (hand-empty) (liftable ?h ?t) (at ?o ?from) (level ?o ?h) (rests ?o ?t) (height ?from ?h))
-    :effect (and (not (hand-empty)) (holding ?o) (not (at ?o ?from)) (not (height ?from ?h)) (height ?from ?t)))
+    :precondition (and (hand-empty) (liftable ?h ?t) (at ?o ?from) (level ?o ?h) (rests ?o ?t)
+      (height ?from ?h))
+    :effect (and (not (hand-empty)) (holding ?o) (not (at ?o ?from)) (not (height ?from ?h))
+      (height ?from ?t)))
   ; 3219 moves: a cube lands on its release location at level 2
   (:action release-cube-0
     :parameters (?o - cube ?to - location)
