@@ -110,14 +110,14 @@ def _fields(rules: LiftedRules, pieces) -> list[tuple]:
     return [(p.kind, p.loc, p.place, p.level) for p in pieces]
 
 
-def case_of(rules: LiftedRules, pieces, action: int) -> str:
-    """What the rules make of a step: "rule" (a rule fires), "no rule" (a move whose structure has none: rarer
-    than min_count), or why no lifted rule describes it (lifted_rules.participants: "same location", "nothing to
-    pick", "a stick's end", ...)."""
+def case_of(pieces, action: int, fired: bool) -> str:
+    """What the rules make of a step, given whether a rule fired on it (LiftedRules.step_pieces): "rule", "no
+    rule" (a move whose structure has none: rarer than min_count), or why no lifted rule describes it
+    (lifted_rules.participants: "same location", "nothing to pick", "a stick's end", ...)."""
+    if fired:
+        return "rule"
     move = participants(read_scene(pieces), *divmod(int(action), 6))
-    if isinstance(move, str):
-        return move
-    return "rule" if rules.step_pieces(pieces, action)[1] is not None else "no rule"
+    return move if isinstance(move, str) else "no rule"
 
 
 def check_lifted(rules: LiftedRules, split: Split, net_next: np.ndarray) -> dict:
@@ -128,10 +128,11 @@ def check_lifted(rules: LiftedRules, split: Split, net_next: np.ndarray) -> dict
     for n in range(len(split.action)):
         k = int(split.mask[n].sum())
         before = rules.pieces(split.before[n, :k].tolist())
-        mine = _fields(rules, rules.step_pieces(before, int(split.action[n]))[0])
+        after, rule = rules.step_pieces(before, int(split.action[n]))
+        mine = _fields(rules, after)
         net = _fields(rules, rules.pieces(net_next[n, :k].tolist()))
         seen = _fields(rules, rules.pieces(split.after[n, :k].tolist()))
-        case = case_of(rules, before, int(split.action[n]))
+        case = case_of(before, int(split.action[n]), rule is not None)
         for group in ("all", "1-3" if k <= 3 else "4-5"):
             g = tally.setdefault(group, {})
             for t in (g.setdefault("", Counter()), g.setdefault(case, Counter())):
@@ -241,7 +242,7 @@ def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None
     Returns the index; problems with more objects than the data ever showed are listed under `zero_shot`.
     """
     from pddl_export.lifted_rules import load_lifted
-    from pddl_export.lifted_writer import problem_pddl
+    from pddl_export.lifted_writer import liftable, moves, problem_pddl
     from symlearn.problems.problem import load_problems
     from symlearn.symbolic.scenes import scene_codes, symbolic_goal
     from symlearn.sim.simulator import TabletopSimulator
@@ -256,14 +257,15 @@ def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None
     index = {"domain": "domain.pddl", "cost_form": f"{COST_FORM_DIR}/domain.pddl", "model_hash": rules.model_hash,
              "source": str(problems_dir), "problems": {}, "zero_shot": []}
     texts = {}
+    pairs = {costs: liftable(moves(rules, costs)) for costs in (False, True)}  # once, not per problem
     sim = TabletopSimulator()
     try:
         for n, (path, problem) in enumerate(problems):
             name = f"p{n + 1:02d}"
             goal = symbolic_goal(sim, reader, problem)
             start = [int(c) for c in scene_codes(sim, reader, problem.initial)]
-            texts[name] = problem_pddl(rules, start, goal, name)
-            texts[f"{COST_FORM_DIR}/{name}"] = problem_pddl(rules, start, goal, name, costs=True)
+            texts[name] = problem_pddl(rules, start, goal, name, pairs=pairs[False])
+            texts[f"{COST_FORM_DIR}/{name}"] = problem_pddl(rules, start, goal, name, costs=True, pairs=pairs[True])
             index["problems"][name] = {"file": path.name, "objects": problem.k,
                                        "optimal_length": getattr(problem, "optimal_length", None)}
             if problem.k > MAX_DATA_OBJECTS:
