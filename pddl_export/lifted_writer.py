@@ -5,9 +5,11 @@ places as constants, and relations read from the location bits: `(at ?b ?l)` (ne
 (its top, in 5 cm layers), `(place ?b ?p)` (on its location, or which way and how far off), `(height ?l ?t)`
 (the top at a location: where a released object lands) and `(rests ?b ?t)` (what is left at its location when it
 is lifted), where the top `?t` is a layer (`h0`: the table; `h3`: a block standing there, its top at level 3) or
-the end of a far-row stick lying over the location from a neighbour (`h1-end`); and `(beneath ?l ?h)` (what is
-left under a stick's end). The ends keep a move onto a stick's end and one onto a tower of the same height apart
-(the rules' `v.at`, `u.at`: without them both actions would apply to either). The learned bits a rule tests are unary
+the end of a far-row stick lying over the location from a neighbour (`h1-end`); `(beneath ?l ?h)` (what is
+left under a stick's end); and `(stands ?b ?l ?h)`, `at` and `level` together, which lets Fast Downward's relaxed
+exploration refuse a goal no move builds in one place (_stands_effects). The ends keep a move onto a stick's end
+and one onto a tower of the same height apart (the rules' `v.at`, `u.at`: without them both actions would apply to
+either). The learned bits a rule tests are unary
 predicates in both polarities (`bit-I`, `no-bit-I`; docs/DOMAIN.md says what they mean in a real run), and
 `(differ ?a ?b)`, `(is ?a ?b)` (the same location), `(near ?l)` and `(same-level ?t ?h)` are static facts of every
 problem. Each rule of `pddl_export.lifted_rules` is one robot action in plain STRIPS with typing: no negative
@@ -222,6 +224,7 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
             pre += _bit_literals(rules, term, f[f"{role}.kind"])
         eff += _bit_effects(rules, term, kind, f.get(f"{role}.kind"))
     eff += _height_effects(before, after, under, landing, tops, lifted, ends, (to, hv), index)
+    eff += _stands_effects(pre, eff)
     # beneath facts a landing re-adds where it also lifted them cancel out; keep the effects consistent
     eff = _net_effects(eff)
     if cost is not None:
@@ -306,6 +309,24 @@ def _stick_ends(rules: LiftedRules, f: dict, pick: int, ho: str, before: dict, u
         pre.append(f"(beneath {loc_name(n)} {level_name(hb)})")
         eff.append(f"(not (beneath {loc_name(n)} {level_name(hb)}))")
     return riders
+
+
+def _stands_effects(pre: Sequence[str], eff: Sequence[str]) -> list[str]:
+    """The `stands` effects of a move: each block it moves from one (location, level) to another stops standing at
+    the first and stands at the second. `(stands ?b ?l ?h)` repeats `at` and `level` together, so that Fast
+    Downward's relaxed reachability sees which location and level a block can reach together: a goal no rule can
+    build (a stick on a tower in the far row, where no rule puts one) is refused by the translator at once, where
+    at and level alone are each reachable and the search would have to exhaust the task's states to prove it."""
+    def value(literals: Sequence[str], predicate: str, term: str) -> str | None:
+        head = f"({predicate} {term} "
+        return next((x[len(head):-1] for x in literals if x.startswith(head)), None)
+    out: list[str] = []
+    for term in dict.fromkeys(x.split()[1] for x in pre if x.startswith("(at ")):
+        loc, level = value(pre, "at", term), value(pre, "level", term)
+        new_loc, new_level = value(eff, "at", term) or loc, value(eff, "level", term) or level
+        if level is not None and (loc, level) != (new_loc, new_level):
+            out += [f"(not (stands {term} {loc} {level}))", f"(stands {term} {new_loc} {new_level})"]
+    return out
 
 
 def _replace(predicate: str, term: str, old: str, new: str) -> list[str]:
@@ -396,7 +417,8 @@ def _pick_cube() -> Schema:
     """The pick half of every cube's plain move (schemas)."""
     params = (("?o", "cube"), ("?from", "location"), ("?h", "layer"), ("?t", "layer"))
     pre = ("(hand-empty)", "(liftable ?h ?t)", "(at ?o ?from)", "(level ?o ?h)", "(rests ?o ?t)", "(height ?from ?h)")
-    eff = ("(not (hand-empty))", "(holding ?o)", "(not (at ?o ?from))", "(not (height ?from ?h))", "(height ?from ?t)")
+    eff = ("(not (hand-empty))", "(holding ?o)", "(not (at ?o ?from))", "(not (stands ?o ?from ?h))",
+           "(not (height ?from ?h))", "(height ?from ?t)")
     comment = ("; a cube is lifted off the top of its location, which drops to what it rested on; its level and what\n"
                "  ; it rested on stay with it until a release-cube action puts it down (liftable: the pairs some does)")
     return Schema(PICK_CUBE, None, None, _schema_text(PICK_CUBE, params, pre, eff, comment), params, pre, eff,
@@ -415,7 +437,8 @@ def _pick_side(s: Schema) -> tuple[str, str] | None:
     pre = {p for p in s.pre if "?from" in p}
     eff = {e for e in s.eff if "?from" in e}
     if pre != {"(at ?o ?from)", f"(height ?from {level})", "(differ ?from ?to)"} or \
-            eff != {"(not (at ?o ?from))", f"(not (height ?from {level}))", f"(height ?from {rests})"}:
+            eff != {"(not (at ?o ?from))", f"(not (stands ?o ?from {level}))", f"(not (height ?from {level}))",
+                    f"(height ?from {rests})"}:
         return None
     return level, rests
 
@@ -566,6 +589,7 @@ def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
             "  (:types\n    block location layer position - object\n    cube stick - block)\n"
             f"  (:constants {locs} - location {' '.join(PLACES)} - position\n    {lvls} - layer)\n"
             "  (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer)\n"
+            "               (stands ?b - block ?l - location ?h - layer)\n"
             "               (rests ?b - block ?t - layer) (height ?l - location ?t - layer) (same-level ?t - layer ?h - layer)\n"
             "               (beneath ?l - location ?h - layer) (place ?b - block ?p - position)\n"
             "               (near ?l - location) (differ ?a - location ?b - location) (is ?a - location ?b - location)\n"
@@ -602,7 +626,7 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
     for i, p in enumerate(pieces):
         o = object_name(i)
         if p.loc < N_LOCATIONS:
-            init.append(f"(at {o} {loc_name(p.loc)})")
+            init += [f"(at {o} {loc_name(p.loc)})", f"(stands {o} {loc_name(p.loc)} {level_name(p.level)})"]
         init.append(f"(level {o} {level_name(p.level)})")
         init += _bit_literals(rules, o, p.kind)
         init.append(f"(place {o} {place_name(p.place)})")
@@ -622,7 +646,7 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
         g = rules.layout.piece(code, pieces[i].stick)
         o = object_name(i)
         if g.loc < N_LOCATIONS:
-            goals.append(f"(at {o} {loc_name(g.loc)})")
+            goals += [f"(at {o} {loc_name(g.loc)})", f"(stands {o} {loc_name(g.loc)} {level_name(g.level)})"]
         goals.append(f"(level {o} {level_name(g.level)})")
         goals.append(f"(place {o} {place_name(g.place)})")
     if costs:

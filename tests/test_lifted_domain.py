@@ -232,6 +232,10 @@ def test_pddl_successors_are_the_rules(pair_rules):
                     at = [loc for loc in range(6) if nxt.get_value(problem.fluent("at")(o, problem.object(f"l{loc}"))).bool_constant_value()]
                     lvl = [h for h in range(8) if nxt.get_value(problem.fluent("level")(o, problem.object(f"h{h}"))).bool_constant_value()]
                     assert at == [p.loc] and lvl == [p.level], f"object {i} after action {a} from {start}"
+                    # stands repeats at and level together: exactly the one pair, whatever moved
+                    stands = [(loc, h) for loc in range(6) for h in range(8) if nxt.get_value(problem.fluent("stands")(
+                        o, problem.object(f"l{loc}"), problem.object(f"h{h}"))).bool_constant_value()]
+                    assert stands == [(p.loc, p.level)], f"object {i} stands at {stands} after action {a} from {start}"
     assert checked >= 3
 
 
@@ -372,6 +376,36 @@ def test_stock_planners_plan_a_tower_the_rules_build(world_rules, tmp_path, plan
         pieces, rule = world_rules.step_pieces(pieces, a)
         assert rule is not None
     assert [(p.loc, p.level) for p in pieces[1:]] == [(0, 2), (0, 4)]
+
+
+def test_a_goal_no_move_builds_in_one_place_is_refused_by_the_translator(world_rules, tmp_path):
+    """`stands` states a block's location and level together, so a goal that no move can build there (a stick on a
+    block in the far row, once the rules that put one there are taken out) is found unreachable by Fast Downward's
+    translator before any search, though a stick can reach l0 and level 3 each (the search would have had to
+    exhaust the task's states to prove it: with at and level alone it expands states)."""
+    from search.result import PlanStatus
+    from search.stock_planners import solve_files
+
+    def far_onto_block(r) -> bool:
+        f = r.fields()
+        return f["o.stick"] and isinstance(f["cls"], tuple) and f["cls"][1] in (0, 1, 2) and f["v.level"] > 0
+    rules = dataclasses.replace(world_rules, rules=tuple(r for r in world_rules.rules if not far_onto_block(r)))
+    assert len(rules.rules) < len(world_rules.rules)
+    types = [ObjectType.STICK, ObjectType.CUBE, ObjectType.CUBE]
+    start_state = drop_all([(ObjectType.STICK, 3), (ObjectType.CUBE, 0), (ObjectType.CUBE, 4)])
+    start = [located_code(start_state, types, i) for i in range(3)]
+    goal_state = act(start_state, types, 3, 0)  # the stick onto the cube at l0, in the world
+    goal = [located_code(goal_state, types, 0), None, None]
+    assert rules.pieces([goal[0]])[0].level == 3
+    adds = {e for s in schemas(rules) if dict(s.params).get("?o") == "stick" for e in s.eff}
+    assert {"(at ?o l0)", "(level ?o h3)"} <= adds  # each on its own, some stick move reaches it
+    (tmp_path / "domain.pddl").write_text(domain_pddl(rules))
+    (tmp_path / "p01.pddl").write_text(problem_pddl(rules, start, SymbolicGoal(tuple(goal)), "p01"))
+    res = solve_files(tmp_path / "domain.pddl", tmp_path / "p01.pddl", "fd-lama-first", timeout_s=60,
+                      action_ids=lambda steps: plan_actions(rules, steps))
+    assert res.status == PlanStatus.UNSOLVABLE, res.message
+    # the translator's relaxed exploration found no way to the goal: it wrote the trivially unsolvable task
+    assert res.extra["translator_operators"] == 0, f"{res.extra} (the search expanded {res.expansions} states)"
 
 
 def _pddlgym_env(domain, problems_dir):
