@@ -8,6 +8,7 @@
   (:constants l0 l1 l2 l3 l4 l5 - location on-spot minus-y-near minus-y-mid minus-y-far plus-y-near plus-y-mid plus-y-far off-x - position
     h0 h1 h2 h3 h4 h5 h6 h7 h1-end h2-end h3-end h4-end h5-end h6-end h7-end - layer)
   (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer)
+               (stands ?b - block ?l - location ?h - layer)
                (rests ?b - block ?t - layer) (height ?l - location ?t - layer) (same-level ?t - layer ?h - layer)
                (beneath ?l - location ?h - layer) (place ?b - block ?p - position)
                (near ?l - location) (differ ?a - location ?b - location) (is ?a - location ?b - location)
@@ -19,29 +20,29 @@
     :parameters (?o - cube ?from - location ?h - layer ?t - layer)
     :precondition (and (hand-empty) (liftable ?h ?t) (at ?o ?from) (level ?o ?h) (rests ?o ?t)
       (height ?from ?h))
-    :effect (and (not (hand-empty)) (holding ?o) (not (at ?o ?from)) (not (height ?from ?h))
-      (height ?from ?t)))
+    :effect (and (not (hand-empty)) (holding ?o) (not (at ?o ?from)) (not (stands ?o ?from ?h))
+      (not (height ?from ?h)) (height ?from ?t)))
   ; 3219 moves: a cube lands on its release location at level 2
   (:action release-cube-0
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (differ ?to l2)
       (height ?to h0))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (bit-0 ?o) (not (no-bit-0 ?o))
-      (no-bit-5 ?o) (not (bit-5 ?o)) (not (height ?to h0)) (height ?to h2)))
+      (no-bit-5 ?o) (not (bit-5 ?o)) (not (height ?to h0)) (height ?to h2) (stands ?o ?to h2)))
   ; 895 moves: a cube lands on its release location at level 2
   (:action release-cube-to-l2-1
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (is ?to l2)
       (height ?to h0))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (bit-0 ?o) (not (no-bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?to h0)) (height ?to h2)))
+      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?to h0)) (height ?to h2) (stands ?o ?to h2)))
   ; 135 moves: a cube lands on its release location at level 3
   (:action release-cube-2
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (height ?to h1-end))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h1-end)
       (not (level ?o h2)) (level ?o h3) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h1-end)) (height ?to h3)))
+      (not (height ?to h1-end)) (height ?to h3) (stands ?o ?to h3)))
   ; 640 moves: a cube lands on its release location at level 3
   (:action release-cube-3
     :parameters (?o - cube ?to - location)
@@ -49,7 +50,7 @@
       (height ?to h1))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h1)
       (not (level ?o h2)) (level ?o h3) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h1)) (height ?to h3)))
+      (not (height ?to h1)) (height ?to h3) (stands ?o ?to h3)))
   ; 170 moves: a cube lands on its release location at level 3
   (:action release-cube-to-l4-4
     :parameters (?o - cube ?to - location)
@@ -57,7 +58,7 @@
       (height ?to h1))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h1)
       (not (level ?o h2)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h1)) (height ?to h3)))
+      (not (height ?to h1)) (height ?to h3) (stands ?o ?to h3)))
   ; 635 moves: a cube lands on its release location at level 4
   (:action release-cube-5
     :parameters (?o - cube ?to - location)
@@ -65,7 +66,7 @@
       (height ?to h2))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h2)) (level ?o h4) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h2)) (height ?to h4)))
+      (not (height ?to h2)) (height ?to h4) (stands ?o ?to h4)))
   ; 196 moves: a cube lands on its release location at level 4
   (:action release-cube-to-l3-6
     :parameters (?o - cube ?to - location)
@@ -73,41 +74,43 @@
       (height ?to h2))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h2)) (level ?o h4) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h2)) (height ?to h4)))
+      (not (height ?to h2)) (height ?to h4) (stands ?o ?to h4)))
   ; 51 moves: a cube ends off its release location at level 1
   (:action release-cube-7
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (height ?to h3-end))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h3-end)
       (not (place ?o on-spot)) (place ?o plus-y-near) (not (level ?o h2)) (level ?o h1) (bit-0 ?o)
-      (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?to h3-end)) (height ?to h1)))
+      (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?to h3-end)) (height ?to h1)
+      (stands ?o ?to h1)))
   ; 333 moves: a cube lands on its release location at level 5
   (:action release-cube-8
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (height ?to h3))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h3)
       (not (level ?o h2)) (level ?o h5) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h3)) (height ?to h5)))
+      (not (height ?to h3)) (height ?to h5) (stands ?o ?to h5)))
   ; 103 moves: a cube lands on its release location at level 6
   (:action release-cube-9
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h2) (rests ?o h0) (place ?o on-spot) (height ?to h4))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h0)) (rests ?o h4)
       (not (level ?o h2)) (level ?o h6) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h4)) (height ?to h6)))
+      (not (height ?to h4)) (height ?to h6) (stands ?o ?to h6)))
   ; 110 moves: a cube lands on its release location at level 2
   (:action release-cube-10
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h2) (rests ?o h1) (place ?o on-spot) (height ?to h0))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h1)) (rests ?o h0)
-      (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o)) (not (height ?to h0)) (height ?to h2)))
+      (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o)) (not (height ?to h0)) (height ?to h2)
+      (stands ?o ?to h2)))
   ; 53 moves: a cube lands on its release location at level 2
   (:action release-cube-11
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h3) (rests ?o h1-end) (place ?o on-spot) (height ?to h0))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h1-end)) (rests ?o h0)
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2) (stands ?o ?to h2)))
   ; 396 moves: a cube lands on its release location at level 2
   (:action release-cube-12
     :parameters (?o - cube ?to - location)
@@ -115,7 +118,7 @@
       (height ?to h0))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h1)) (rests ?o h0)
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2) (stands ?o ?to h2)))
   ; 90 moves: a cube lands on its release location at level 2
   (:action release-cube-to-l2-13
     :parameters (?o - cube ?to - location)
@@ -123,14 +126,14 @@
       (height ?to h0))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h1)) (rests ?o h0)
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2) (stands ?o ?to h2)))
   ; 106 moves: a cube lands on its release location at level 4
   (:action release-cube-14
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h3) (rests ?o h1) (place ?o on-spot) (height ?to h2))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h1)) (rests ?o h2)
       (not (level ?o h3)) (level ?o h4) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h2)) (height ?to h4)))
+      (not (height ?to h2)) (height ?to h4) (stands ?o ?to h4)))
   ; 640 moves: a cube lands on its release location at level 2
   (:action release-cube-15
     :parameters (?o - cube ?to - location)
@@ -138,7 +141,7 @@
       (height ?to h0))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h2)) (rests ?o h0)
       (not (level ?o h4)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2) (stands ?o ?to h2)))
   ; 146 moves: a cube lands on its release location at level 2
   (:action release-cube-to-l2-16
     :parameters (?o - cube ?to - location)
@@ -146,48 +149,49 @@
       (height ?to h0))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h2)) (rests ?o h0)
       (not (level ?o h4)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2) (stands ?o ?to h2)))
   ; 144 moves: a cube lands on its release location at level 3
   (:action release-cube-17
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h4) (rests ?o h2) (place ?o on-spot) (height ?to h1))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h2)) (rests ?o h1)
       (not (level ?o h4)) (level ?o h3) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h1)) (height ?to h3)))
+      (not (height ?to h1)) (height ?to h3) (stands ?o ?to h3)))
   ; 94 moves: a cube lands on its release location at level 4
   (:action release-cube-18
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h4) (rests ?o h2) (place ?o on-spot) (height ?to h2))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (no-bit-0 ?o) (not (bit-0 ?o))
-      (no-bit-5 ?o) (not (bit-5 ?o)) (not (height ?to h2)) (height ?to h4)))
+      (no-bit-5 ?o) (not (bit-5 ?o)) (not (height ?to h2)) (height ?to h4) (stands ?o ?to h4)))
   ; 230 moves: a cube lands on its release location at level 2
   (:action release-cube-19
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h5) (rests ?o h3) (place ?o on-spot) (height ?to h0))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h3)) (rests ?o h0)
       (not (level ?o h5)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2) (stands ?o ?to h2)))
   ; 89 moves: a cube lands on its release location at level 1
   (:action release-cube-20
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h5) (rests ?o h4) (place ?o on-spot) (height ?to h0))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h4)) (rests ?o h0)
       (not (level ?o h5)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height ?to h0)) (height ?to h1)))
+      (not (height ?to h0)) (height ?to h1) (stands ?o ?to h1)))
   ; 74 moves: a cube lands on its release location at level 2
   (:action release-cube-21
     :parameters (?o - cube ?to - location)
     :precondition (and (holding ?o) (level ?o h6) (rests ?o h4) (place ?o on-spot) (height ?to h0))
     :effect (and (not (holding ?o)) (hand-empty) (at ?o ?to) (not (rests ?o h4)) (rests ?o h0)
       (not (level ?o h6)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?to h0)) (height ?to h2)))
+      (not (height ?to h0)) (height ?to h2) (stands ?o ?to h2)))
   ; 318 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-22
     :parameters (?o - stick ?from - location ?to - location)
     :precondition (and (hand-empty) (at ?o ?from) (level ?o h1) (rests ?o h0) (place ?o on-spot)
       (differ ?from ?to) (near ?from) (near ?to) (height ?from h1) (height ?to h0))
     :effect (and (not (at ?o ?from)) (at ?o ?to) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o)
-      (not (no-bit-5 ?o)) (not (height ?from h1)) (height ?from h0) (not (height ?to h0)) (height ?to h1)))
+      (not (no-bit-5 ?o)) (not (height ?from h1)) (height ?from h0) (not (height ?to h0)) (height ?to h1)
+      (not (stands ?o ?from h1)) (stands ?o ?to h1)))
   ; 251 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-23
     :parameters (?o - stick ?from - location ?to - location)
@@ -195,7 +199,8 @@
       (differ ?from ?to) (near ?from) (near ?to) (height ?from h1) (height ?to h2))
     :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h1)) (height ?from h0) (not (height ?to h2)) (height ?to h3)))
+      (not (height ?from h1)) (height ?from h0) (not (height ?to h2)) (height ?to h3)
+      (not (stands ?o ?from h1)) (stands ?o ?to h3)))
   ; 61 moves: a stick lands on its release location at level 5
   (:action pick-release-stick-24
     :parameters (?o - stick ?from - location ?to - location)
@@ -203,7 +208,8 @@
       (differ ?from ?to) (near ?from) (near ?to) (height ?from h1) (height ?to h4))
     :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h4)
       (not (level ?o h1)) (level ?o h5) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height ?from h1)) (height ?from h0) (not (height ?to h4)) (height ?to h5)))
+      (not (height ?from h1)) (height ?from h0) (not (height ?to h4)) (height ?to h5)
+      (not (stands ?o ?from h1)) (stands ?o ?to h5)))
   ; 117 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-25
     :parameters (?o - stick ?from - location ?to - location)
@@ -211,7 +217,8 @@
       (differ ?from ?to) (near ?from) (near ?to) (height ?from h3) (height ?to h0))
     :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h2)) (rests ?o h0)
       (not (level ?o h3)) (level ?o h1) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height ?from h3)) (height ?from h2) (not (height ?to h0)) (height ?to h1)))
+      (not (height ?from h3)) (height ?from h2) (not (height ?to h0)) (height ?to h1)
+      (not (stands ?o ?from h3)) (stands ?o ?to h1)))
   ; 18 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l1-26
     :parameters (?o - stick)
@@ -219,7 +226,8 @@
       (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l2 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l1) (beneath l0 h0) (beneath l2 h0)
       (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h1-end)
-      (not (height l1 h1-end)) (height l1 h1) (not (height l2 h0)) (height l2 h1-end)))
+      (not (height l1 h1-end)) (height l1 h1) (not (height l2 h0)) (height l2 h1-end) (not (stands ?o l0 h1))
+      (stands ?o l1 h1)))
   ; 6 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l0-l1-27
     :parameters (?o - stick ?t-l2 - layer)
@@ -228,14 +236,15 @@
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l1) (beneath l0 h0) (beneath l2 h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l0 h1)) (height l0 h3-end) (not (height l1 h1-end)) (height l1 h3) (not (height l2 ?t-l2))
-      (height l2 h3-end)))
+      (height l2 h3-end) (not (stands ?o l0 h1)) (stands ?o l1 h3)))
   ; 31 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l2-28
     :parameters (?o - stick)
     :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
       (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l2 h0))
     :effect (and (not (at ?o l0)) (at ?o l2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
-      (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0) (not (height l2 h0)) (height l2 h1)))
+      (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0) (not (height l2 h0)) (height l2 h1)
+      (not (stands ?o l0 h1)) (stands ?o l2 h1)))
   ; 5 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l2-29
     :parameters (?o - stick ?r0 - block)
@@ -245,7 +254,8 @@
     :effect (and (not (at ?o l0)) (at ?o l2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (place ?r0 on-spot))
       (place ?r0 plus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
-      (not (height l0 h1)) (height l0 h0) (not (height l2 h0)) (height l2 h1)))
+      (not (height l0 h1)) (height l0 h0) (not (height l2 h0)) (height l2 h1) (not (stands ?o l0 h1))
+      (stands ?o l2 h1)))
   ; 7 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l2-30
     :parameters (?o - stick)
@@ -253,7 +263,8 @@
       (beneath l1 h0) (height l0 h3) (height l1 h3-end) (height l2 h0))
     :effect (and (not (at ?o l0)) (at ?o l2) (not (rests ?o h2)) (rests ?o h0) (not (level ?o h3))
       (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h3))
-      (height l0 h2) (not (height l1 h3-end)) (height l1 h1-end) (not (height l2 h0)) (height l2 h1)))
+      (height l0 h2) (not (height l1 h3-end)) (height l1 h1-end) (not (height l2 h0)) (height l2 h1)
+      (not (stands ?o l0 h3)) (stands ?o l2 h1)))
   ; 11 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l3-31
     :parameters (?o - stick)
@@ -261,7 +272,7 @@
       (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l3 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l3) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end))
-      (height l1 h0) (not (height l3 h0)) (height l3 h1)))
+      (height l1 h0) (not (height l3 h0)) (height l3 h1) (not (stands ?o l0 h1)) (stands ?o l3 h1)))
   ; 3 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l3-32
     :parameters (?o - stick ?r0 - block)
@@ -272,7 +283,8 @@
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (at ?r0 l1)) (at ?r0 l4)
       (not (place ?r0 on-spot)) (place ?r0 minus-y-mid) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0)
       (not (bit-5 ?r0)) (not (height l0 h1)) (height l0 h0) (not (height l1 h3)) (height l1 h0)
-      (not (height l3 h0)) (height l3 h1)))
+      (not (height l3 h0)) (height l3 h1) (not (stands ?o l0 h1)) (stands ?o l3 h1) (not (stands ?r0 l1 h3))
+      (stands ?r0 l4 h3)))
   ; 8 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l0-l3-33
     :parameters (?o - stick)
@@ -281,7 +293,7 @@
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l3) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l3 h2))
-      (height l3 h3)))
+      (height l3 h3) (not (stands ?o l0 h1)) (stands ?o l3 h3)))
   ; 8 moves: a stick ends off its release location at level 1
   (:action pick-release-stick-l0-l3-34
     :parameters (?o - stick)
@@ -289,7 +301,7 @@
       (height l0 h1) (height l3 h0))
     :effect (and (not (at ?o l0)) (at ?o l3) (not (place ?o minus-y-far)) (place ?o minus-y-mid)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0)
-      (not (height l3 h0)) (height l3 h1)))
+      (not (height l3 h0)) (height l3 h1) (not (stands ?o l0 h1)) (stands ?o l3 h1)))
   ; 14 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l4-35
     :parameters (?o - stick)
@@ -297,7 +309,7 @@
       (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l4 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l4) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end))
-      (height l1 h0) (not (height l4 h0)) (height l4 h1)))
+      (height l1 h0) (not (height l4 h0)) (height l4 h1) (not (stands ?o l0 h1)) (stands ?o l4 h1)))
   ; 4 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l4-36
     :parameters (?o - stick ?r0 - block)
@@ -308,7 +320,8 @@
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (at ?r0 l1)) (at ?r0 l5)
       (not (place ?r0 on-spot)) (place ?r0 minus-y-mid) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0)
       (not (bit-5 ?r0)) (not (height l0 h1)) (height l0 h0) (not (height l1 h3)) (height l1 h0)
-      (not (height l4 h0)) (height l4 h1)))
+      (not (height l4 h0)) (height l4 h1) (not (stands ?o l0 h1)) (stands ?o l4 h1) (not (stands ?r0 l1 h3))
+      (stands ?r0 l5 h3)))
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l0-l4-37
     :parameters (?o - stick)
@@ -317,7 +330,7 @@
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l4) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l4 h2))
-      (height l4 h3)))
+      (height l4 h3) (not (stands ?o l0 h1)) (stands ?o l4 h3)))
   ; 14 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l5-38
     :parameters (?o - stick)
@@ -325,7 +338,7 @@
       (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l5 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l5) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end))
-      (height l1 h0) (not (height l5 h0)) (height l5 h1)))
+      (height l1 h0) (not (height l5 h0)) (height l5 h1) (not (stands ?o l0 h1)) (stands ?o l5 h1)))
   ; 3 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l5-39
     :parameters (?o - stick ?r0 - block)
@@ -335,7 +348,8 @@
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l5) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (place ?r0 on-spot))
       (place ?r0 plus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
-      (not (height l0 h1)) (height l0 h0) (not (height l5 h0)) (height l5 h1)))
+      (not (height l0 h1)) (height l0 h0) (not (height l5 h0)) (height l5 h1) (not (stands ?o l0 h1))
+      (stands ?o l5 h1)))
   ; 6 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l0-l5-40
     :parameters (?o - stick)
@@ -344,7 +358,7 @@
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l5) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l5 h2))
-      (height l5 h3)))
+      (height l5 h3) (not (stands ?o l0 h1)) (stands ?o l5 h3)))
   ; 21 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l0-41
     :parameters (?o - stick)
@@ -352,7 +366,8 @@
       (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end))
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l0)
       (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l1 h1))
-      (height l1 h1-end) (not (height l0 h1-end)) (height l0 h1) (not (height l2 h1-end)) (height l2 h0)))
+      (height l1 h1-end) (not (height l0 h1-end)) (height l0 h1) (not (height l2 h1-end)) (height l2 h0)
+      (not (stands ?o l1 h1)) (stands ?o l0 h1)))
   ; 6 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l0-42
     :parameters (?o - stick)
@@ -361,7 +376,7 @@
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h2)) (not (at ?o l1)) (at ?o l0)
       (beneath l1 h0) (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (height l1 h3)) (height l1 h1-end) (not (height l0 h3-end)) (height l0 h1)
-      (not (height l2 h3-end)) (height l2 h2)))
+      (not (height l2 h3-end)) (height l2 h2) (not (stands ?o l1 h3)) (stands ?o l0 h1)))
   ; 25 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l2-43
     :parameters (?o - stick)
@@ -369,7 +384,8 @@
       (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end))
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l2)
       (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l1 h1))
-      (height l1 h1-end) (not (height l0 h1-end)) (height l0 h0) (not (height l2 h1-end)) (height l2 h1)))
+      (height l1 h1-end) (not (height l0 h1-end)) (height l0 h0) (not (height l2 h1-end)) (height l2 h1)
+      (not (stands ?o l1 h1)) (stands ?o l2 h1)))
   ; 5 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l2-44
     :parameters (?o - stick ?r0 - block)
@@ -380,7 +396,7 @@
       (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end))
       (rests ?r0 h0) (not (place ?r0 on-spot)) (place ?r0 plus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0))
       (no-bit-5 ?r0) (not (bit-5 ?r0)) (not (height l1 h1)) (height l1 h1-end) (not (height l0 h1-end))
-      (height l0 h0)))
+      (height l0 h0) (not (stands ?o l1 h1)) (stands ?o l2 h1)))
   ; 11 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l3-45
     :parameters (?o - stick)
@@ -389,7 +405,7 @@
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l1 h1)) (height l1 h0)
       (not (height l0 h1-end)) (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l3 h0))
-      (height l3 h1)))
+      (height l3 h1) (not (stands ?o l1 h1)) (stands ?o l3 h1)))
   ; 8 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l1-l3-46
     :parameters (?o - stick)
@@ -398,7 +414,8 @@
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l3)
       (not (rests ?o h0)) (rests ?o h2) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o))
       (no-bit-5 ?o) (not (bit-5 ?o)) (not (height l1 h1)) (height l1 h0) (not (height l0 h1-end))
-      (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l3 h2)) (height l3 h3)))
+      (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l3 h2)) (height l3 h3)
+      (not (stands ?o l1 h1)) (stands ?o l3 h3)))
   ; 10 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l4-47
     :parameters (?o - stick)
@@ -407,7 +424,7 @@
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l4)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l1 h1)) (height l1 h0)
       (not (height l0 h1-end)) (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l4 h0))
-      (height l4 h1)))
+      (height l4 h1) (not (stands ?o l1 h1)) (stands ?o l4 h1)))
   ; 10 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l5-48
     :parameters (?o - stick)
@@ -416,7 +433,7 @@
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l5)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l1 h1)) (height l1 h0)
       (not (height l0 h1-end)) (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l5 h0))
-      (height l5 h1)))
+      (height l5 h1) (not (stands ?o l1 h1)) (stands ?o l5 h1)))
   ; 9 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l1-l5-49
     :parameters (?o - stick)
@@ -425,7 +442,8 @@
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l5)
       (not (rests ?o h0)) (rests ?o h2) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o))
       (no-bit-5 ?o) (not (bit-5 ?o)) (not (height l1 h1)) (height l1 h0) (not (height l0 h1-end))
-      (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l5 h2)) (height l5 h3)))
+      (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l5 h2)) (height l5 h3)
+      (not (stands ?o l1 h1)) (stands ?o l5 h3)))
   ; 7 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l5-50
     :parameters (?o - stick)
@@ -434,14 +452,15 @@
     :effect (and (not (beneath l0 h0)) (not (beneath l2 h2)) (not (at ?o l1)) (at ?o l5)
       (not (level ?o h3)) (level ?o h1) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l1 h3)) (height l1 h0) (not (height l0 h3-end)) (height l0 h0) (not (height l2 h3-end))
-      (height l2 h2) (not (height l5 h0)) (height l5 h1)))
+      (height l2 h2) (not (height l5 h0)) (height l5 h1) (not (stands ?o l1 h3)) (stands ?o l5 h1)))
   ; 23 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l0-51
     :parameters (?o - stick)
     :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
       (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l0 h0))
     :effect (and (not (at ?o l2)) (at ?o l0) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
-      (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l0 h0)) (height l0 h1)))
+      (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l0 h0)) (height l0 h1)
+      (not (stands ?o l2 h1)) (stands ?o l0 h1)))
   ; 3 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l0-52
     :parameters (?o - stick ?r0 - block)
@@ -451,7 +470,8 @@
     :effect (and (not (at ?o l2)) (at ?o l0) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (place ?r0 on-spot))
       (place ?r0 minus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
-      (not (height l2 h1)) (height l2 h0) (not (height l0 h0)) (height l0 h1)))
+      (not (height l2 h1)) (height l2 h0) (not (height l0 h0)) (height l0 h1) (not (stands ?o l2 h1))
+      (stands ?o l0 h1)))
   ; 6 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l0-53
     :parameters (?o - stick)
@@ -459,7 +479,8 @@
       (beneath l1 h0) (height l2 h3) (height l1 h3-end) (height l0 h0))
     :effect (and (not (at ?o l2)) (at ?o l0) (not (rests ?o h2)) (rests ?o h0) (not (level ?o h3))
       (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h3))
-      (height l2 h2) (not (height l1 h3-end)) (height l1 h1-end) (not (height l0 h0)) (height l0 h1)))
+      (height l2 h2) (not (height l1 h3-end)) (height l1 h1-end) (not (height l0 h0)) (height l0 h1)
+      (not (stands ?o l2 h3)) (stands ?o l0 h1)))
   ; 22 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l1-54
     :parameters (?o - stick)
@@ -467,7 +488,8 @@
       (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l0 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l1) (beneath l0 h0) (beneath l2 h0)
       (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h1-end)
-      (not (height l1 h1-end)) (height l1 h1) (not (height l0 h0)) (height l0 h1-end)))
+      (not (height l1 h1-end)) (height l1 h1) (not (height l0 h0)) (height l0 h1-end) (not (stands ?o l2 h1))
+      (stands ?o l1 h1)))
   ; 6 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l1-55
     :parameters (?o - stick ?r0 - block)
@@ -477,7 +499,8 @@
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l1) (beneath l0 h0) (beneath l2 h0)
       (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (at ?r0 l1)) (at ?r0 l0) (bit-0 ?r0)
       (not (no-bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0)) (not (height l2 h1)) (height l2 h1-end)
-      (not (height l1 h3)) (height l1 h1) (not (height l0 h0)) (height l0 h3)))
+      (not (height l1 h3)) (height l1 h1) (not (height l0 h0)) (height l0 h3) (not (stands ?o l2 h1))
+      (stands ?o l1 h1) (not (stands ?r0 l1 h3)) (stands ?r0 l0 h3)))
   ; 13 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l3-56
     :parameters (?o - stick)
@@ -485,7 +508,7 @@
       (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l3 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l3) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end))
-      (height l1 h0) (not (height l3 h0)) (height l3 h1)))
+      (height l1 h0) (not (height l3 h0)) (height l3 h1) (not (stands ?o l2 h1)) (stands ?o l3 h1)))
   ; 4 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l3-57
     :parameters (?o - stick ?r0 - block)
@@ -495,7 +518,8 @@
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l3) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (place ?r0 on-spot))
       (place ?r0 minus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
-      (not (height l2 h1)) (height l2 h0) (not (height l3 h0)) (height l3 h1)))
+      (not (height l2 h1)) (height l2 h0) (not (height l3 h0)) (height l3 h1) (not (stands ?o l2 h1))
+      (stands ?o l3 h1)))
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l2-l3-58
     :parameters (?o - stick)
@@ -504,7 +528,7 @@
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l3) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l3 h2))
-      (height l3 h3)))
+      (height l3 h3) (not (stands ?o l2 h1)) (stands ?o l3 h3)))
   ; 3 moves: a stick lands on its release location at level 4
   (:action pick-release-stick-l2-l3-59
     :parameters (?o - stick ?r0 - block)
@@ -516,7 +540,7 @@
       (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (place ?r0 on-spot)) (place ?r0 minus-y-far)
       (not (level ?r0 h3)) (level ?r0 h1) (bit-0 ?r0) (not (no-bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
       (not (height l2 h1)) (height l2 h0) (not (height l1 h3)) (height l1 h1) (not (height l3 h2))
-      (height l3 h4)))
+      (height l3 h4) (not (stands ?o l2 h1)) (stands ?o l3 h4) (not (stands ?r0 l1 h3)) (stands ?r0 l1 h1)))
   ; 8 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l3-60
     :parameters (?o - stick)
@@ -524,7 +548,8 @@
       (beneath l1 h2) (height l2 h3) (height l1 h3-end) (height l3 h0))
     :effect (and (not (beneath l1 h2)) (not (at ?o l2)) (at ?o l3) (not (level ?o h3)) (level ?o h1)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h3)) (height l2 h0)
-      (not (height l1 h3-end)) (height l1 h2) (not (height l3 h0)) (height l3 h1)))
+      (not (height l1 h3-end)) (height l1 h2) (not (height l3 h0)) (height l3 h1) (not (stands ?o l2 h3))
+      (stands ?o l3 h1)))
   ; 13 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l4-61
     :parameters (?o - stick)
@@ -532,7 +557,7 @@
       (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l4 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l4) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end))
-      (height l1 h0) (not (height l4 h0)) (height l4 h1)))
+      (height l1 h0) (not (height l4 h0)) (height l4 h1) (not (stands ?o l2 h1)) (stands ?o l4 h1)))
   ; 7 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l4-62
     :parameters (?o - stick ?r0 - block)
@@ -543,7 +568,8 @@
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (at ?r0 l1)) (at ?r0 l3)
       (not (place ?r0 on-spot)) (place ?r0 plus-y-mid) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0)
       (not (bit-5 ?r0)) (not (height l2 h1)) (height l2 h0) (not (height l1 h3)) (height l1 h0)
-      (not (height l4 h0)) (height l4 h1)))
+      (not (height l4 h0)) (height l4 h1) (not (stands ?o l2 h1)) (stands ?o l4 h1) (not (stands ?r0 l1 h3))
+      (stands ?r0 l3 h3)))
   ; 14 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l2-l4-63
     :parameters (?o - stick)
@@ -552,14 +578,15 @@
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l4) (not (rests ?o h0)) (rests ?o h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l4 h2))
-      (height l4 h3)))
+      (height l4 h3) (not (stands ?o l2 h1)) (stands ?o l4 h3)))
   ; 14 moves: a stick ends off its release location at level 1
   (:action pick-release-stick-l2-l4-64
     :parameters (?o - stick)
     :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o plus-y-mid)
       (height l2 h1) (height l4 h0))
     :effect (and (not (at ?o l2)) (at ?o l4) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o)
-      (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l4 h0)) (height l4 h1)))
+      (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l4 h0)) (height l4 h1)
+      (not (stands ?o l2 h1)) (stands ?o l4 h1)))
   ; 25 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l5-65
     :parameters (?o - stick)
@@ -567,7 +594,7 @@
       (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l5 h0))
     :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l5) (no-bit-0 ?o) (not (bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end))
-      (height l1 h0) (not (height l5 h0)) (height l5 h1)))
+      (height l1 h0) (not (height l5 h0)) (height l5 h1) (not (stands ?o l2 h1)) (stands ?o l5 h1)))
   ; 5 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l5-66
     :parameters (?o - stick ?r0 - block)
@@ -578,7 +605,8 @@
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (at ?r0 l1)) (at ?r0 l4)
       (not (place ?r0 on-spot)) (place ?r0 plus-y-mid) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0)
       (not (bit-5 ?r0)) (not (height l2 h1)) (height l2 h0) (not (height l1 h3)) (height l1 h0)
-      (not (height l5 h0)) (height l5 h1)))
+      (not (height l5 h0)) (height l5 h1) (not (stands ?o l2 h1)) (stands ?o l5 h1) (not (stands ?r0 l1 h3))
+      (stands ?r0 l4 h3)))
   ; 6 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l5-67
     :parameters (?o - stick)
@@ -586,14 +614,16 @@
       (beneath l1 h2) (height l2 h3) (height l1 h3-end) (height l5 h0))
     :effect (and (not (beneath l1 h2)) (not (at ?o l2)) (at ?o l5) (not (level ?o h3)) (level ?o h1)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h3)) (height l2 h0)
-      (not (height l1 h3-end)) (height l1 h2) (not (height l5 h0)) (height l5 h1)))
+      (not (height l1 h3-end)) (height l1 h2) (not (height l5 h0)) (height l5 h1) (not (stands ?o l2 h3))
+      (stands ?o l5 h1)))
   ; 6 moves: a stick ends off its release location at level 1
   (:action pick-release-stick-l2-l5-68
     :parameters (?o - stick)
     :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o plus-y-mid)
       (height l2 h1) (height l5 h0))
     :effect (and (not (at ?o l2)) (at ?o l5) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o)
-      (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l5 h0)) (height l5 h1)))
+      (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l5 h0)) (height l5 h1)
+      (not (stands ?o l2 h1)) (stands ?o l5 h1)))
   ; 80 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l3-l0-69
     :parameters (?o - stick)
@@ -601,7 +631,7 @@
       (height l3 h1) (height l0 h0) (height l1 h0))
     :effect (and (not (at ?o l3)) (at ?o l0) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0) (not (height l0 h0)) (height l0 h1)
-      (not (height l1 h0)) (height l1 h1-end)))
+      (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l3 h1)) (stands ?o l0 h1)))
   ; 13 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l0-70
     :parameters (?o - stick ?t-l1 - layer)
@@ -609,7 +639,8 @@
       (height l3 h1) (height l0 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
     :effect (and (not (at ?o l3)) (at ?o l0) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0)
-      (not (height l0 h0)) (height l0 h3) (not (height l1 ?t-l1)) (height l1 h3-end)))
+      (not (height l0 h0)) (height l0 h3) (not (height l1 ?t-l1)) (height l1 h3-end) (not (stands ?o l3 h1))
+      (stands ?o l0 h3)))
   ; 17 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l0-71
     :parameters (?o - stick)
@@ -618,7 +649,7 @@
     :effect (and (not (at ?o l3)) (at ?o l0) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l3 h1)) (height l3 h0) (not (height l0 h2)) (height l0 h3) (not (height l1 h0))
-      (height l1 h3-end)))
+      (height l1 h3-end) (not (stands ?o l3 h1)) (stands ?o l0 h3)))
   ; 21 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l3-l0-72
     :parameters (?o - stick)
@@ -627,7 +658,7 @@
     :effect (and (not (at ?o l3)) (at ?o l0) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l3 h3)) (height l3 h2) (not (height l0 h0)) (height l0 h1) (not (height l1 h0))
-      (height l1 h1-end)))
+      (height l1 h1-end) (not (stands ?o l3 h3)) (stands ?o l0 h1)))
   ; 9 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l0-73
     :parameters (?o - stick)
@@ -635,7 +666,7 @@
       (height l3 h3) (height l0 h2) (height l1 h0))
     :effect (and (not (at ?o l3)) (at ?o l0) (beneath l1 h0) (no-bit-0 ?o) (not (bit-0 ?o))
       (no-bit-5 ?o) (not (bit-5 ?o)) (not (height l3 h3)) (height l3 h2) (not (height l0 h2)) (height l0 h3)
-      (not (height l1 h0)) (height l1 h3-end)))
+      (not (height l1 h0)) (height l1 h3-end) (not (stands ?o l3 h3)) (stands ?o l0 h3)))
   ; 51 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l3-l1-74
     :parameters (?o - stick)
@@ -644,7 +675,7 @@
     :effect (and (not (at ?o l3)) (at ?o l1) (beneath l0 h0) (beneath l2 h0) (bit-0 ?o)
       (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0)
       (not (height l1 h0)) (height l1 h1) (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0))
-      (height l2 h1-end)))
+      (height l2 h1-end) (not (stands ?o l3 h1)) (stands ?o l1 h1)))
   ; 15 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l1-75
     :parameters (?o - stick ?t-l2 - layer)
@@ -653,7 +684,7 @@
     :effect (and (not (at ?o l3)) (at ?o l1) (beneath l0 h0) (beneath l2 h2) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1))
       (height l3 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?t-l2)) (height l2 h3-end)))
+      (not (height l2 ?t-l2)) (height l2 h3-end) (not (stands ?o l3 h1)) (stands ?o l1 h3)))
   ; 11 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l1-76
     :parameters (?o - stick ?t-l0 - layer)
@@ -662,7 +693,7 @@
     :effect (and (not (at ?o l3)) (at ?o l1) (beneath l0 h2) (beneath l2 h0) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1))
       (height l3 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?t-l0)) (height l0 h3-end)
-      (not (height l2 h0)) (height l2 h3-end)))
+      (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l3 h1)) (stands ?o l1 h3)))
   ; 13 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l1-77
     :parameters (?o - stick)
@@ -671,7 +702,8 @@
     :effect (and (not (at ?o l3)) (at ?o l1) (not (rests ?o h0)) (rests ?o h2) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o)
       (not (bit-5 ?o)) (not (height l3 h1)) (height l3 h0) (not (height l1 h2)) (height l1 h3)
-      (not (height l0 h0)) (height l0 h3-end) (not (height l2 h0)) (height l2 h3-end)))
+      (not (height l0 h0)) (height l0 h3-end) (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l3 h1))
+      (stands ?o l1 h3)))
   ; 12 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l3-l1-78
     :parameters (?o - stick)
@@ -680,7 +712,8 @@
     :effect (and (not (at ?o l3)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (height l3 h3)) (height l3 h2) (not (height l1 h0)) (height l1 h1)
-      (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0)) (height l2 h1-end)))
+      (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0)) (height l2 h1-end) (not (stands ?o l3 h3))
+      (stands ?o l1 h1)))
   ; 69 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l3-l2-79
     :parameters (?o - stick)
@@ -688,7 +721,7 @@
       (height l3 h1) (height l2 h0) (height l1 h0))
     :effect (and (not (at ?o l3)) (at ?o l2) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0) (not (height l2 h0)) (height l2 h1)
-      (not (height l1 h0)) (height l1 h1-end)))
+      (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l3 h1)) (stands ?o l2 h1)))
   ; 15 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l2-80
     :parameters (?o - stick ?t-l1 - layer)
@@ -696,7 +729,8 @@
       (height l3 h1) (height l2 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
     :effect (and (not (at ?o l3)) (at ?o l2) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0)
-      (not (height l2 h0)) (height l2 h3) (not (height l1 ?t-l1)) (height l1 h3-end)))
+      (not (height l2 h0)) (height l2 h3) (not (height l1 ?t-l1)) (height l1 h3-end) (not (stands ?o l3 h1))
+      (stands ?o l2 h3)))
   ; 12 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l2-81
     :parameters (?o - stick)
@@ -705,7 +739,7 @@
     :effect (and (not (at ?o l3)) (at ?o l2) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l3 h1)) (height l3 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 h0))
-      (height l1 h3-end)))
+      (height l1 h3-end) (not (stands ?o l3 h1)) (stands ?o l2 h3)))
   ; 7 moves: a stick lands on its release location at level 5
   (:action pick-release-stick-l3-l2-82
     :parameters (?o - stick ?v - block)
@@ -714,7 +748,8 @@
     :effect (and (not (at ?o l3)) (at ?o l2) (not (rests ?o h0)) (rests ?o h4) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h5) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (bit-0 ?v) (not (no-bit-0 ?v)) (bit-5 ?v) (not (no-bit-5 ?v)) (not (height l3 h1)) (height l3 h0)
-      (not (height l2 h4)) (height l2 h5) (not (height l1 h0)) (height l1 h5-end)))
+      (not (height l2 h4)) (height l2 h5) (not (height l1 h0)) (height l1 h5-end) (not (stands ?o l3 h1))
+      (stands ?o l2 h5)))
   ; 17 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l3-l2-83
     :parameters (?o - stick)
@@ -723,7 +758,7 @@
     :effect (and (not (at ?o l3)) (at ?o l2) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l3 h3)) (height l3 h2) (not (height l2 h0)) (height l2 h1) (not (height l1 h0))
-      (height l1 h1-end)))
+      (height l1 h1-end) (not (stands ?o l3 h3)) (stands ?o l2 h1)))
   ; 65 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l0-84
     :parameters (?o - stick)
@@ -731,7 +766,7 @@
       (height l4 h1) (height l0 h0) (height l1 h0))
     :effect (and (not (at ?o l4)) (at ?o l0) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0) (not (height l0 h0)) (height l0 h1)
-      (not (height l1 h0)) (height l1 h1-end)))
+      (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l4 h1)) (stands ?o l0 h1)))
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l0-85
     :parameters (?o - stick ?t-l1 - layer)
@@ -739,7 +774,8 @@
       (height l4 h1) (height l0 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
     :effect (and (not (at ?o l4)) (at ?o l0) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0)
-      (not (height l0 h0)) (height l0 h3) (not (height l1 ?t-l1)) (height l1 h3-end)))
+      (not (height l0 h0)) (height l0 h3) (not (height l1 ?t-l1)) (height l1 h3-end) (not (stands ?o l4 h1))
+      (stands ?o l0 h3)))
   ; 18 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l0-86
     :parameters (?o - stick)
@@ -748,7 +784,7 @@
     :effect (and (not (at ?o l4)) (at ?o l0) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l4 h1)) (height l4 h0) (not (height l0 h2)) (height l0 h3) (not (height l1 h0))
-      (height l1 h3-end)))
+      (height l1 h3-end) (not (stands ?o l4 h1)) (stands ?o l0 h3)))
   ; 21 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l0-87
     :parameters (?o - stick)
@@ -757,7 +793,7 @@
     :effect (and (not (at ?o l4)) (at ?o l0) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l4 h3)) (height l4 h2) (not (height l0 h0)) (height l0 h1) (not (height l1 h0))
-      (height l1 h1-end)))
+      (height l1 h1-end) (not (stands ?o l4 h3)) (stands ?o l0 h1)))
   ; 7 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l0-88
     :parameters (?o - stick)
@@ -765,7 +801,7 @@
       (height l4 h3) (height l0 h2) (height l1 h0))
     :effect (and (not (at ?o l4)) (at ?o l0) (beneath l1 h0) (no-bit-0 ?o) (not (bit-0 ?o))
       (no-bit-5 ?o) (not (bit-5 ?o)) (not (height l4 h3)) (height l4 h2) (not (height l0 h2)) (height l0 h3)
-      (not (height l1 h0)) (height l1 h3-end)))
+      (not (height l1 h0)) (height l1 h3-end) (not (stands ?o l4 h3)) (stands ?o l0 h3)))
   ; 56 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l1-89
     :parameters (?o - stick)
@@ -774,7 +810,7 @@
     :effect (and (not (at ?o l4)) (at ?o l1) (beneath l0 h0) (beneath l2 h0) (bit-0 ?o)
       (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0)
       (not (height l1 h0)) (height l1 h1) (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0))
-      (height l2 h1-end)))
+      (height l2 h1-end) (not (stands ?o l4 h1)) (stands ?o l1 h1)))
   ; 17 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-90
     :parameters (?o - stick ?t-l2 - layer)
@@ -783,7 +819,7 @@
     :effect (and (not (at ?o l4)) (at ?o l1) (beneath l0 h0) (beneath l2 h2) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1))
       (height l4 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?t-l2)) (height l2 h3-end)))
+      (not (height l2 ?t-l2)) (height l2 h3-end) (not (stands ?o l4 h1)) (stands ?o l1 h3)))
   ; 8 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-91
     :parameters (?o - stick ?t-l0 - layer)
@@ -792,7 +828,7 @@
     :effect (and (not (at ?o l4)) (at ?o l1) (beneath l0 h2) (beneath l2 h0) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1))
       (height l4 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?t-l0)) (height l0 h3-end)
-      (not (height l2 h0)) (height l2 h3-end)))
+      (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l4 h1)) (stands ?o l1 h3)))
   ; 9 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-92
     :parameters (?o - stick)
@@ -801,7 +837,8 @@
     :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h0)) (rests ?o h2) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o)
       (not (bit-5 ?o)) (not (height l4 h1)) (height l4 h0) (not (height l1 h2)) (height l1 h3)
-      (not (height l0 h0)) (height l0 h3-end) (not (height l2 h0)) (height l2 h3-end)))
+      (not (height l0 h0)) (height l0 h3-end) (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l4 h1))
+      (stands ?o l1 h3)))
   ; 8 moves: a stick lands on its release location at level 2
   (:action pick-release-stick-l4-l1-93
     :parameters (?o - stick)
@@ -810,7 +847,8 @@
     :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h1)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o)
       (not (bit-5 ?o)) (not (height l4 h3)) (height l4 h1) (not (height l1 h0)) (height l1 h2)
-      (not (height l0 h0)) (height l0 h2-end) (not (height l2 h0)) (height l2 h2-end)))
+      (not (height l0 h0)) (height l0 h2-end) (not (height l2 h0)) (height l2 h2-end) (not (stands ?o l4 h3))
+      (stands ?o l1 h2)))
   ; 14 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l1-94
     :parameters (?o - stick)
@@ -819,7 +857,8 @@
     :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (height l4 h3)) (height l4 h2) (not (height l1 h0)) (height l1 h1)
-      (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0)) (height l2 h1-end)))
+      (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0)) (height l2 h1-end) (not (stands ?o l4 h3))
+      (stands ?o l1 h1)))
   ; 8 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-95
     :parameters (?o - stick ?t-l2 - layer)
@@ -828,7 +867,7 @@
     :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h2) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h3))
       (height l4 h2) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?t-l2)) (height l2 h3-end)))
+      (not (height l2 ?t-l2)) (height l2 h3-end) (not (stands ?o l4 h3)) (stands ?o l1 h3)))
   ; 7 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-96
     :parameters (?o - stick ?t-l0 - layer)
@@ -837,7 +876,7 @@
     :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h2)
       (beneath l2 h0) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h3))
       (height l4 h2) (not (height l1 h0)) (height l1 h3) (not (height l0 ?t-l0)) (height l0 h3-end)
-      (not (height l2 h0)) (height l2 h3-end)))
+      (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l4 h3)) (stands ?o l1 h3)))
   ; 53 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l2-97
     :parameters (?o - stick)
@@ -845,7 +884,7 @@
       (height l4 h1) (height l2 h0) (height l1 h0))
     :effect (and (not (at ?o l4)) (at ?o l2) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0) (not (height l2 h0)) (height l2 h1)
-      (not (height l1 h0)) (height l1 h1-end)))
+      (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l4 h1)) (stands ?o l2 h1)))
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l2-98
     :parameters (?o - stick ?t-l1 - layer)
@@ -853,7 +892,8 @@
       (height l4 h1) (height l2 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
     :effect (and (not (at ?o l4)) (at ?o l2) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0)
-      (not (height l2 h0)) (height l2 h3) (not (height l1 ?t-l1)) (height l1 h3-end)))
+      (not (height l2 h0)) (height l2 h3) (not (height l1 ?t-l1)) (height l1 h3-end) (not (stands ?o l4 h1))
+      (stands ?o l2 h3)))
   ; 19 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l2-99
     :parameters (?o - stick)
@@ -862,7 +902,7 @@
     :effect (and (not (at ?o l4)) (at ?o l2) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l4 h1)) (height l4 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 h0))
-      (height l1 h3-end)))
+      (height l1 h3-end) (not (stands ?o l4 h1)) (stands ?o l2 h3)))
   ; 10 moves: a stick lands on its release location at level 2
   (:action pick-release-stick-l4-l2-100
     :parameters (?o - stick)
@@ -871,7 +911,7 @@
     :effect (and (not (at ?o l4)) (at ?o l2) (not (rests ?o h1)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l4 h3)) (height l4 h1) (not (height l2 h0)) (height l2 h2) (not (height l1 h0))
-      (height l1 h2-end)))
+      (height l1 h2-end) (not (stands ?o l4 h3)) (stands ?o l2 h2)))
   ; 19 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l2-101
     :parameters (?o - stick)
@@ -880,7 +920,7 @@
     :effect (and (not (at ?o l4)) (at ?o l2) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l4 h3)) (height l4 h2) (not (height l2 h0)) (height l2 h1) (not (height l1 h0))
-      (height l1 h1-end)))
+      (height l1 h1-end) (not (stands ?o l4 h3)) (stands ?o l2 h1)))
   ; 58 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l5-l0-102
     :parameters (?o - stick)
@@ -888,7 +928,7 @@
       (height l5 h1) (height l0 h0) (height l1 h0))
     :effect (and (not (at ?o l5)) (at ?o l0) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0) (not (height l0 h0)) (height l0 h1)
-      (not (height l1 h0)) (height l1 h1-end)))
+      (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l5 h1)) (stands ?o l0 h1)))
   ; 12 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l0-103
     :parameters (?o - stick ?t-l1 - layer)
@@ -896,7 +936,8 @@
       (height l5 h1) (height l0 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
     :effect (and (not (at ?o l5)) (at ?o l0) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0)
-      (not (height l0 h0)) (height l0 h3) (not (height l1 ?t-l1)) (height l1 h3-end)))
+      (not (height l0 h0)) (height l0 h3) (not (height l1 ?t-l1)) (height l1 h3-end) (not (stands ?o l5 h1))
+      (stands ?o l0 h3)))
   ; 17 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l0-104
     :parameters (?o - stick)
@@ -905,7 +946,7 @@
     :effect (and (not (at ?o l5)) (at ?o l0) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l5 h1)) (height l5 h0) (not (height l0 h2)) (height l0 h3) (not (height l1 h0))
-      (height l1 h3-end)))
+      (height l1 h3-end) (not (stands ?o l5 h1)) (stands ?o l0 h3)))
   ; 6 moves: a stick lands on its release location at level 2
   (:action pick-release-stick-l5-l0-105
     :parameters (?o - stick)
@@ -914,7 +955,7 @@
     :effect (and (not (at ?o l5)) (at ?o l0) (not (rests ?o h1)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l5 h3)) (height l5 h1) (not (height l0 h0)) (height l0 h2) (not (height l1 h0))
-      (height l1 h2-end)))
+      (height l1 h2-end) (not (stands ?o l5 h3)) (stands ?o l0 h2)))
   ; 25 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l5-l0-106
     :parameters (?o - stick)
@@ -923,7 +964,7 @@
     :effect (and (not (at ?o l5)) (at ?o l0) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l5 h3)) (height l5 h2) (not (height l0 h0)) (height l0 h1) (not (height l1 h0))
-      (height l1 h1-end)))
+      (height l1 h1-end) (not (stands ?o l5 h3)) (stands ?o l0 h1)))
   ; 51 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l5-l1-107
     :parameters (?o - stick)
@@ -932,7 +973,7 @@
     :effect (and (not (at ?o l5)) (at ?o l1) (beneath l0 h0) (beneath l2 h0) (bit-0 ?o)
       (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0)
       (not (height l1 h0)) (height l1 h1) (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0))
-      (height l2 h1-end)))
+      (height l2 h1-end) (not (stands ?o l5 h1)) (stands ?o l1 h1)))
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l1-108
     :parameters (?o - stick ?t-l2 - layer)
@@ -941,7 +982,7 @@
     :effect (and (not (at ?o l5)) (at ?o l1) (beneath l0 h0) (beneath l2 h2) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1))
       (height l5 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?t-l2)) (height l2 h3-end)))
+      (not (height l2 ?t-l2)) (height l2 h3-end) (not (stands ?o l5 h1)) (stands ?o l1 h3)))
   ; 9 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l1-109
     :parameters (?o - stick ?t-l0 - layer)
@@ -950,7 +991,7 @@
     :effect (and (not (at ?o l5)) (at ?o l1) (beneath l0 h2) (beneath l2 h0) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1))
       (height l5 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?t-l0)) (height l0 h3-end)
-      (not (height l2 h0)) (height l2 h3-end)))
+      (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l5 h1)) (stands ?o l1 h3)))
   ; 17 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l1-110
     :parameters (?o - stick)
@@ -959,7 +1000,8 @@
     :effect (and (not (at ?o l5)) (at ?o l1) (not (rests ?o h0)) (rests ?o h2) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o)
       (not (bit-5 ?o)) (not (height l5 h1)) (height l5 h0) (not (height l1 h2)) (height l1 h3)
-      (not (height l0 h0)) (height l0 h3-end) (not (height l2 h0)) (height l2 h3-end)))
+      (not (height l0 h0)) (height l0 h3-end) (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l5 h1))
+      (stands ?o l1 h3)))
   ; 10 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l5-l1-111
     :parameters (?o - stick)
@@ -968,7 +1010,8 @@
     :effect (and (not (at ?o l5)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h0) (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
       (not (no-bit-5 ?o)) (not (height l5 h3)) (height l5 h2) (not (height l1 h0)) (height l1 h1)
-      (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0)) (height l2 h1-end)))
+      (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0)) (height l2 h1-end) (not (stands ?o l5 h3))
+      (stands ?o l1 h1)))
   ; 6 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l1-112
     :parameters (?o - stick ?t-l2 - layer)
@@ -977,7 +1020,7 @@
     :effect (and (not (at ?o l5)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h2) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h3))
       (height l5 h2) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?t-l2)) (height l2 h3-end)))
+      (not (height l2 ?t-l2)) (height l2 h3-end) (not (stands ?o l5 h3)) (stands ?o l1 h3)))
   ; 63 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l5-l2-113
     :parameters (?o - stick)
@@ -985,7 +1028,7 @@
       (height l5 h1) (height l2 h0) (height l1 h0))
     :effect (and (not (at ?o l5)) (at ?o l2) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
       (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0) (not (height l2 h0)) (height l2 h1)
-      (not (height l1 h0)) (height l1 h1-end)))
+      (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l5 h1)) (stands ?o l2 h1)))
   ; 11 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l2-114
     :parameters (?o - stick ?t-l1 - layer)
@@ -993,7 +1036,8 @@
       (height l5 h1) (height l2 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
     :effect (and (not (at ?o l5)) (at ?o l2) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0)
-      (not (height l2 h0)) (height l2 h3) (not (height l1 ?t-l1)) (height l1 h3-end)))
+      (not (height l2 h0)) (height l2 h3) (not (height l1 ?t-l1)) (height l1 h3-end) (not (stands ?o l5 h1))
+      (stands ?o l2 h3)))
   ; 14 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l2-115
     :parameters (?o - stick)
@@ -1002,7 +1046,7 @@
     :effect (and (not (at ?o l5)) (at ?o l2) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l5 h1)) (height l5 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 h0))
-      (height l1 h3-end)))
+      (height l1 h3-end) (not (stands ?o l5 h1)) (stands ?o l2 h3)))
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l2-116
     :parameters (?o - stick ?t-l1 - layer)
@@ -1011,7 +1055,7 @@
     :effect (and (not (at ?o l5)) (at ?o l2) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l5 h1)) (height l5 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 ?t-l1))
-      (height l1 h3-end)))
+      (height l1 h3-end) (not (stands ?o l5 h1)) (stands ?o l2 h3)))
   ; 11 moves: a stick lands on its release location at level 2
   (:action pick-release-stick-l5-l2-117
     :parameters (?o - stick)
@@ -1020,7 +1064,7 @@
     :effect (and (not (at ?o l5)) (at ?o l2) (not (rests ?o h1)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l5 h3)) (height l5 h1) (not (height l2 h0)) (height l2 h2) (not (height l1 h0))
-      (height l1 h2-end)))
+      (height l1 h2-end) (not (stands ?o l5 h3)) (stands ?o l2 h2)))
   ; 19 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l5-l2-118
     :parameters (?o - stick)
@@ -1029,5 +1073,5 @@
     :effect (and (not (at ?o l5)) (at ?o l2) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
       (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l5 h3)) (height l5 h2) (not (height l2 h0)) (height l2 h1) (not (height l1 h0))
-      (height l1 h1-end)))
+      (height l1 h1-end) (not (stands ?o l5 h3)) (stands ?o l2 h1)))
 )

@@ -1,0 +1,92 @@
+"""Two forms of a PDDL domain on the same problems, interleaved: stock Fast Downward's translate + search time.
+
+A change to the writer (a predicate added, an action split) is judged against the form before it on the same
+tasks, in one process, each problem run on both forms in turn and the order swapped every repeat, so that the load
+of the machine falls on both alike. Folder A and folder B each hold a domain.pddl and the same pNN.pddl names (the
+problems as each form writes them); the JSON has every call and, per object count where the folders' index.json
+gives it, the medians of both and their ratio.
+
+    # the shipped test folder against the same export without `stands` (each fact is one line of a problem)
+    mkdir -p base && git show be6739b:pretrained/recommended/pddl/lifted/domain.pddl > base/domain.pddl
+    for f in RUN/pddl/lifted/test/p*.pddl; do grep -v '(stands ' "$f" > base/$(basename "$f"); done
+    python bench/domain_ab.py --a base --b RUN/pddl/lifted/test --out bench/results/stands_ab.json
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+from datetime import date
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+
+def _problems(folder: Path) -> list[str]:
+    names = sorted(f.stem for f in folder.glob("p*.pddl") if f.is_file())
+    if not (folder / "domain.pddl").is_file() or not names:
+        raise SystemExit(f"domain_ab: {folder} needs a domain.pddl and pNN.pddl problems")
+    return names
+
+
+def main(argv: list[str] | None = None) -> int:
+    from search.stock_planners import solve_files
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--a", required=True, type=Path, help="the baseline folder (domain.pddl, pNN.pddl)")
+    ap.add_argument("--b", required=True, type=Path, help="the folder compared with it, the same problem names")
+    ap.add_argument("--planner", default="fd-lama-first", help="a search.stock_planners name")
+    ap.add_argument("--repeats", type=int, default=2, help="runs of each problem on each form (order swapped)")
+    ap.add_argument("--timeout", type=float, default=10.0, help="seconds per call")
+    ap.add_argument("--out", required=True, type=Path)
+    args = ap.parse_args(argv)
+    names = _problems(args.a)
+    missing = sorted(set(names) - set(_problems(args.b)))
+    if missing:
+        raise SystemExit(f"domain_ab: {args.b} lacks {', '.join(missing[:5])}")
+    if args.repeats < 1:
+        raise SystemExit(f"domain_ab: --repeats {args.repeats} must be at least 1")
+    index = args.b / "index.json"
+    objects = {}
+    if index.is_file() and index.stat().st_size < 16 << 20:
+        objects = {n: v.get("objects") for n, v in json.loads(index.read_text()).get("problems", {}).items()}
+    calls: list[dict] = []
+    for rep in range(args.repeats):
+        for name in names:
+            for form in (("a", "b") if rep % 2 == 0 else ("b", "a")):
+                folder = args.a if form == "a" else args.b
+                r = solve_files(folder / "domain.pddl", folder / f"{name}.pddl", args.planner, timeout_s=args.timeout)
+                e = dict(r.extra)
+                calls.append({"problem": name, "form": form, "repeat": rep, "status": r.status.value,
+                              "objects": objects.get(name),
+                              "translate_plus_search_s": round(e.get("fd_translate_time_s", 0.0)
+                                                               + e.get("fd_total_time_s", 0.0), 4),
+                              "call_time_s": round(r.planning_time_s, 4)})
+    groups: dict = {}
+    for c in calls:
+        for key in ("all", str(c["objects"])):
+            groups.setdefault(key, {"a": [], "b": []})[c["form"]].append(c["translate_plus_search_s"])
+    summary = {k: {"calls": len(v["a"]), "median_a_s": round(statistics.median(v["a"]), 4),
+                   "median_b_s": round(statistics.median(v["b"]), 4),
+                   "b_over_a": round(statistics.median(v["b"]) / max(statistics.median(v["a"]), 1e-9), 3)}
+               for k, v in sorted(groups.items())}
+    same = all(ca["status"] == cb["status"] for ca, cb in
+               zip(sorted((c for c in calls if c["form"] == "a"), key=lambda c: (c["problem"], c["repeat"])),
+                   sorted((c for c in calls if c["form"] == "b"), key=lambda c: (c["problem"], c["repeat"]))))
+    result = {"a": str(args.a), "b": str(args.b), "planner": args.planner, "repeats": args.repeats,
+              "timeout_s": args.timeout, "date": date.today().isoformat(), "same_status": same,
+              "summary": summary, "calls": calls}
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = args.out.with_suffix(".tmp")
+    tmp.write_text(json.dumps(result, indent=1))
+    tmp.replace(args.out)
+    for k, v in summary.items():
+        print(f"{k:>4}: {v['calls']} calls, median A {v['median_a_s']:.3f} s, B {v['median_b_s']:.3f} s, "
+              f"B/A {v['b_over_a']:.2f}")
+    print(f"same status on every problem: {same}; wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
