@@ -61,7 +61,7 @@ def surface(level: int, stands: bool) -> str:
 
 def top_name(layer: str, what: str) -> str:
     """The layer constant of a top: `h3` (the table at h0, or a block standing there), `h3-end` (a stick's end);
-    a parameter (`?t-...`) stands for itself. One value per location or block, so that Fast Downward's invariant
+    a parameter (`?top_l4`) stands for itself. One value per location or block, so that Fast Downward's invariant
     synthesis (one counted argument per predicate) finds `height` and `rests` as multi-valued variables."""
     if what.startswith("?"):
         return what
@@ -241,13 +241,14 @@ def rule_schema(rules: LiftedRules, rule: Rule, index: int, alternative: int = 0
 def _landing_tops(landing: dict, before: dict, under: dict, tops: dict, params: list, pre: list, index: int) -> None:
     """Preconditions on the locations a far-row stick's ends will cover, and their tops in `tops`: what lies under
     the stick where it covered them already, else the table at h0, or a layer parameter tied to the level
-    (`(same-level ?t-l4 h2)`: a block standing there or a stick's end, which the rule's key does not say)."""
+    (`(same-level ?top_l4 h2)`: a block standing there or a stick's end, which the rule's key does not say)."""
     for loc, h in landing.items():
         if loc in before:
             if under[loc] != h:
                 raise ValueError(f"rule {index}: a neighbour's level {h} is not what lies under the stick")
             continue
-        tops[loc] = "table" if h == level_name(0) else f"?t-{loc}"
+        # no hyphen in a parameter's name: pddlgym's parser splits `?t-l4 - layer` at its first one
+        tops[loc] = "table" if h == level_name(0) else f"?top_{loc}"
         if tops[loc] != "table":
             params.append((tops[loc], "layer"))
             pre.append(f"(same-level {tops[loc]} {h})")

@@ -84,3 +84,18 @@ def test_the_recommended_run_builds_its_goals_in_simulation(tmp_path):
     assert deep["max_distance_m"] < 0.02
     tower = rows[("tower_of_two", "fast-downward-lifted", True)]
     assert tower["success"] and tower["plan_length"] == tower["optimal_length"] == 2, tower
+
+
+def test_pddlgym_parses_the_shipped_domain():
+    """pddlgym's own parser reads the shipped lifted domain, every action schema of it, including the far-row stick
+    moves whose layer parameter stands for a neighbour's top (a hyphen in a parameter's name broke its parser)."""
+    import warnings
+    with warnings.catch_warnings():  # gym 0.26 warns on import that it is unmaintained
+        warnings.simplefilter("ignore")
+        from pddlgym.parser import PDDLDomainParser
+    path = RECOMMENDED / "pddl" / "lifted" / "domain.pddl"
+    text = path.read_text()
+    assert "?top_l" in text  # the case that broke it is in the file
+    parsed = PDDLDomainParser(str(path), expect_action_preds=False, operators_as_actions=True)
+    assert len(parsed.operators) == text.count("(:action ")
+    assert {"at", "level", "stands", "height", "rests"} <= {str(p) for p in parsed.predicates}

@@ -230,13 +230,13 @@
       (stands ?o l1 h1)))
   ; 6 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l0-l1-27
-    :parameters (?o - stick ?t-l2 - layer)
+    :parameters (?o - stick ?top_l2 - layer)
     :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (same-level ?t-l2 h2) (height l2 ?t-l2))
+      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (same-level ?top_l2 h2) (height l2 ?top_l2))
     :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l1) (beneath l0 h0) (beneath l2 h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height l0 h1)) (height l0 h3-end) (not (height l1 h1-end)) (height l1 h3) (not (height l2 ?t-l2))
-      (height l2 h3-end) (not (stands ?o l0 h1)) (stands ?o l1 h3)))
+      (not (height l0 h1)) (height l0 h3-end) (not (height l1 h1-end)) (height l1 h3)
+      (not (height l2 ?top_l2)) (height l2 h3-end) (not (stands ?o l0 h1)) (stands ?o l1 h3)))
   ; 31 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l2-28
     :parameters (?o - stick)
@@ -634,12 +634,12 @@
       (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l3 h1)) (stands ?o l0 h1)))
   ; 13 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l0-70
-    :parameters (?o - stick ?t-l1 - layer)
+    :parameters (?o - stick ?top_l1 - layer)
     :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l0 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
+      (height l3 h1) (height l0 h0) (same-level ?top_l1 h2) (height l1 ?top_l1))
     :effect (and (not (at ?o l3)) (at ?o l0) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0)
-      (not (height l0 h0)) (height l0 h3) (not (height l1 ?t-l1)) (height l1 h3-end) (not (stands ?o l3 h1))
+      (not (height l0 h0)) (height l0 h3) (not (height l1 ?top_l1)) (height l1 h3-end) (not (stands ?o l3 h1))
       (stands ?o l0 h3)))
   ; 17 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l0-71
@@ -678,21 +678,21 @@
       (height l2 h1-end) (not (stands ?o l3 h1)) (stands ?o l1 h1)))
   ; 15 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l1-75
-    :parameters (?o - stick ?t-l2 - layer)
+    :parameters (?o - stick ?top_l2 - layer)
     :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
+      (height l3 h1) (height l1 h0) (height l0 h0) (same-level ?top_l2 h2) (height l2 ?top_l2))
     :effect (and (not (at ?o l3)) (at ?o l1) (beneath l0 h0) (beneath l2 h2) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1))
       (height l3 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?t-l2)) (height l2 h3-end) (not (stands ?o l3 h1)) (stands ?o l1 h3)))
+      (not (height l2 ?top_l2)) (height l2 h3-end) (not (stands ?o l3 h1)) (stands ?o l1 h3)))
   ; 11 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l1-76
-    :parameters (?o - stick ?t-l0 - layer)
+    :parameters (?o - stick ?top_l0 - layer)
     :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l1 h0) (same-level ?t-l0 h2) (height l0 ?t-l0) (height l2 h0))
+      (height l3 h1) (height l1 h0) (same-level ?top_l0 h2) (height l0 ?top_l0) (height l2 h0))
     :effect (and (not (at ?o l3)) (at ?o l1) (beneath l0 h2) (beneath l2 h0) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1))
-      (height l3 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?t-l0)) (height l0 h3-end)
+      (height l3 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?top_l0)) (height l0 h3-end)
       (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l3 h1)) (stands ?o l1 h3)))
   ; 13 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l1-77
@@ -724,12 +724,12 @@
       (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l3 h1)) (stands ?o l2 h1)))
   ; 15 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l2-80
-    :parameters (?o - stick ?t-l1 - layer)
+    :parameters (?o - stick ?top_l1 - layer)
     :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l2 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
+      (height l3 h1) (height l2 h0) (same-level ?top_l1 h2) (height l1 ?top_l1))
     :effect (and (not (at ?o l3)) (at ?o l2) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0)
-      (not (height l2 h0)) (height l2 h3) (not (height l1 ?t-l1)) (height l1 h3-end) (not (stands ?o l3 h1))
+      (not (height l2 h0)) (height l2 h3) (not (height l1 ?top_l1)) (height l1 h3-end) (not (stands ?o l3 h1))
       (stands ?o l2 h3)))
   ; 12 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l3-l2-81
@@ -769,12 +769,12 @@
       (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l4 h1)) (stands ?o l0 h1)))
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l0-85
-    :parameters (?o - stick ?t-l1 - layer)
+    :parameters (?o - stick ?top_l1 - layer)
     :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l0 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
+      (height l4 h1) (height l0 h0) (same-level ?top_l1 h2) (height l1 ?top_l1))
     :effect (and (not (at ?o l4)) (at ?o l0) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0)
-      (not (height l0 h0)) (height l0 h3) (not (height l1 ?t-l1)) (height l1 h3-end) (not (stands ?o l4 h1))
+      (not (height l0 h0)) (height l0 h3) (not (height l1 ?top_l1)) (height l1 h3-end) (not (stands ?o l4 h1))
       (stands ?o l0 h3)))
   ; 18 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l0-86
@@ -813,21 +813,21 @@
       (height l2 h1-end) (not (stands ?o l4 h1)) (stands ?o l1 h1)))
   ; 17 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-90
-    :parameters (?o - stick ?t-l2 - layer)
+    :parameters (?o - stick ?top_l2 - layer)
     :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
+      (height l4 h1) (height l1 h0) (height l0 h0) (same-level ?top_l2 h2) (height l2 ?top_l2))
     :effect (and (not (at ?o l4)) (at ?o l1) (beneath l0 h0) (beneath l2 h2) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1))
       (height l4 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?t-l2)) (height l2 h3-end) (not (stands ?o l4 h1)) (stands ?o l1 h3)))
+      (not (height l2 ?top_l2)) (height l2 h3-end) (not (stands ?o l4 h1)) (stands ?o l1 h3)))
   ; 8 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-91
-    :parameters (?o - stick ?t-l0 - layer)
+    :parameters (?o - stick ?top_l0 - layer)
     :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l1 h0) (same-level ?t-l0 h2) (height l0 ?t-l0) (height l2 h0))
+      (height l4 h1) (height l1 h0) (same-level ?top_l0 h2) (height l0 ?top_l0) (height l2 h0))
     :effect (and (not (at ?o l4)) (at ?o l1) (beneath l0 h2) (beneath l2 h0) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1))
-      (height l4 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?t-l0)) (height l0 h3-end)
+      (height l4 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?top_l0)) (height l0 h3-end)
       (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l4 h1)) (stands ?o l1 h3)))
   ; 9 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-92
@@ -861,21 +861,21 @@
       (stands ?o l1 h1)))
   ; 8 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-95
-    :parameters (?o - stick ?t-l2 - layer)
+    :parameters (?o - stick ?top_l2 - layer)
     :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l4 h3) (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
+      (height l4 h3) (height l1 h0) (height l0 h0) (same-level ?top_l2 h2) (height l2 ?top_l2))
     :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h2) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h3))
       (height l4 h2) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?t-l2)) (height l2 h3-end) (not (stands ?o l4 h3)) (stands ?o l1 h3)))
+      (not (height l2 ?top_l2)) (height l2 h3-end) (not (stands ?o l4 h3)) (stands ?o l1 h3)))
   ; 7 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-96
-    :parameters (?o - stick ?t-l0 - layer)
+    :parameters (?o - stick ?top_l0 - layer)
     :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l4 h3) (height l1 h0) (same-level ?t-l0 h2) (height l0 ?t-l0) (height l2 h0))
+      (height l4 h3) (height l1 h0) (same-level ?top_l0 h2) (height l0 ?top_l0) (height l2 h0))
     :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h2)
       (beneath l2 h0) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h3))
-      (height l4 h2) (not (height l1 h0)) (height l1 h3) (not (height l0 ?t-l0)) (height l0 h3-end)
+      (height l4 h2) (not (height l1 h0)) (height l1 h3) (not (height l0 ?top_l0)) (height l0 h3-end)
       (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l4 h3)) (stands ?o l1 h3)))
   ; 53 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l4-l2-97
@@ -887,12 +887,12 @@
       (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l4 h1)) (stands ?o l2 h1)))
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l2-98
-    :parameters (?o - stick ?t-l1 - layer)
+    :parameters (?o - stick ?top_l1 - layer)
     :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l2 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
+      (height l4 h1) (height l2 h0) (same-level ?top_l1 h2) (height l1 ?top_l1))
     :effect (and (not (at ?o l4)) (at ?o l2) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0)
-      (not (height l2 h0)) (height l2 h3) (not (height l1 ?t-l1)) (height l1 h3-end) (not (stands ?o l4 h1))
+      (not (height l2 h0)) (height l2 h3) (not (height l1 ?top_l1)) (height l1 h3-end) (not (stands ?o l4 h1))
       (stands ?o l2 h3)))
   ; 19 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l2-99
@@ -931,12 +931,12 @@
       (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l5 h1)) (stands ?o l0 h1)))
   ; 12 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l0-103
-    :parameters (?o - stick ?t-l1 - layer)
+    :parameters (?o - stick ?top_l1 - layer)
     :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l0 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
+      (height l5 h1) (height l0 h0) (same-level ?top_l1 h2) (height l1 ?top_l1))
     :effect (and (not (at ?o l5)) (at ?o l0) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0)
-      (not (height l0 h0)) (height l0 h3) (not (height l1 ?t-l1)) (height l1 h3-end) (not (stands ?o l5 h1))
+      (not (height l0 h0)) (height l0 h3) (not (height l1 ?top_l1)) (height l1 h3-end) (not (stands ?o l5 h1))
       (stands ?o l0 h3)))
   ; 17 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l0-104
@@ -976,21 +976,21 @@
       (height l2 h1-end) (not (stands ?o l5 h1)) (stands ?o l1 h1)))
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l1-108
-    :parameters (?o - stick ?t-l2 - layer)
+    :parameters (?o - stick ?top_l2 - layer)
     :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
+      (height l5 h1) (height l1 h0) (height l0 h0) (same-level ?top_l2 h2) (height l2 ?top_l2))
     :effect (and (not (at ?o l5)) (at ?o l1) (beneath l0 h0) (beneath l2 h2) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1))
       (height l5 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?t-l2)) (height l2 h3-end) (not (stands ?o l5 h1)) (stands ?o l1 h3)))
+      (not (height l2 ?top_l2)) (height l2 h3-end) (not (stands ?o l5 h1)) (stands ?o l1 h3)))
   ; 9 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l1-109
-    :parameters (?o - stick ?t-l0 - layer)
+    :parameters (?o - stick ?top_l0 - layer)
     :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l1 h0) (same-level ?t-l0 h2) (height l0 ?t-l0) (height l2 h0))
+      (height l5 h1) (height l1 h0) (same-level ?top_l0 h2) (height l0 ?top_l0) (height l2 h0))
     :effect (and (not (at ?o l5)) (at ?o l1) (beneath l0 h2) (beneath l2 h0) (not (level ?o h1))
       (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1))
-      (height l5 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?t-l0)) (height l0 h3-end)
+      (height l5 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?top_l0)) (height l0 h3-end)
       (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l5 h1)) (stands ?o l1 h3)))
   ; 17 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l1-110
@@ -1014,13 +1014,13 @@
       (stands ?o l1 h1)))
   ; 6 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l1-112
-    :parameters (?o - stick ?t-l2 - layer)
+    :parameters (?o - stick ?top_l2 - layer)
     :precondition (and (hand-empty) (at ?o l5) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l5 h3) (height l1 h0) (height l0 h0) (same-level ?t-l2 h2) (height l2 ?t-l2))
+      (height l5 h3) (height l1 h0) (height l0 h0) (same-level ?top_l2 h2) (height l2 ?top_l2))
     :effect (and (not (at ?o l5)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
       (beneath l2 h2) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h3))
       (height l5 h2) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?t-l2)) (height l2 h3-end) (not (stands ?o l5 h3)) (stands ?o l1 h3)))
+      (not (height l2 ?top_l2)) (height l2 h3-end) (not (stands ?o l5 h3)) (stands ?o l1 h3)))
   ; 63 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l5-l2-113
     :parameters (?o - stick)
@@ -1031,12 +1031,12 @@
       (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l5 h1)) (stands ?o l2 h1)))
   ; 11 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l2-114
-    :parameters (?o - stick ?t-l1 - layer)
+    :parameters (?o - stick ?top_l1 - layer)
     :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l2 h0) (same-level ?t-l1 h2) (height l1 ?t-l1))
+      (height l5 h1) (height l2 h0) (same-level ?top_l1 h2) (height l1 ?top_l1))
     :effect (and (not (at ?o l5)) (at ?o l2) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0)
-      (not (height l2 h0)) (height l2 h3) (not (height l1 ?t-l1)) (height l1 h3-end) (not (stands ?o l5 h1))
+      (not (height l2 h0)) (height l2 h3) (not (height l1 ?top_l1)) (height l1 h3-end) (not (stands ?o l5 h1))
       (stands ?o l2 h3)))
   ; 14 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l2-115
@@ -1049,12 +1049,12 @@
       (height l1 h3-end) (not (stands ?o l5 h1)) (stands ?o l2 h3)))
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l2-116
-    :parameters (?o - stick ?t-l1 - layer)
+    :parameters (?o - stick ?top_l1 - layer)
     :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l2 h2) (same-level ?t-l1 h2) (height l1 ?t-l1))
+      (height l5 h1) (height l2 h2) (same-level ?top_l1 h2) (height l1 ?top_l1))
     :effect (and (not (at ?o l5)) (at ?o l2) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h2)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height l5 h1)) (height l5 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 ?t-l1))
+      (not (height l5 h1)) (height l5 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 ?top_l1))
       (height l1 h3-end) (not (stands ?o l5 h1)) (stands ?o l2 h3)))
   ; 11 moves: a stick lands on its release location at level 2
   (:action pick-release-stick-l5-l2-117
