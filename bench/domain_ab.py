@@ -14,13 +14,13 @@ gives it, the medians of both and their ratio.
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
 import sys
-from datetime import date
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from stock_fd import row  # noqa: E402  (one problem's record, as stock_fd.py writes it)
 
 
 def _problems(folder: Path) -> list[str]:
@@ -31,7 +31,9 @@ def _problems(folder: Path) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from pddl_export.bounded_json import read_json_file
     from search.stock_planners import solve_files
+    from symlearn.provenance import atomic_write_json, bench_context
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--a", required=True, type=Path, help="the baseline folder (domain.pddl, pNN.pddl)")
@@ -49,38 +51,32 @@ def main(argv: list[str] | None = None) -> int:
         raise SystemExit(f"domain_ab: --repeats {args.repeats} must be at least 1")
     index = args.b / "index.json"
     objects = {}
-    if index.is_file() and index.stat().st_size < 16 << 20:
-        objects = {n: v.get("objects") for n, v in json.loads(index.read_text()).get("problems", {}).items()}
+    if index.is_file():
+        problems = read_json_file(index, what="problem folder index", max_bytes=16 << 20).get("problems", {})
+        objects = {n: v.get("objects") for n, v in problems.items()}
     calls: list[dict] = []
     for rep in range(args.repeats):
         for name in names:
             for form in (("a", "b") if rep % 2 == 0 else ("b", "a")):
                 folder = args.a if form == "a" else args.b
-                r = solve_files(folder / "domain.pddl", folder / f"{name}.pddl", args.planner, timeout_s=args.timeout)
-                e = dict(r.extra)
-                calls.append({"problem": name, "form": form, "repeat": rep, "status": r.status.value,
-                              "objects": objects.get(name),
-                              "translate_plus_search_s": round(e.get("fd_translate_time_s", 0.0)
-                                                               + e.get("fd_total_time_s", 0.0), 4),
-                              "call_time_s": round(r.planning_time_s, 4)})
+                rec = row(solve_files(folder / "domain.pddl", folder / f"{name}.pddl", args.planner,
+                                      timeout_s=args.timeout))
+                calls.append({"problem": name, "form": form, "repeat": rep, "objects": objects.get(name),
+                              **{k: rec.get(k) for k in ("status", "translate_plus_search_s", "call_time_s")}})
     groups: dict = {}
-    for c in calls:
-        for key in ("all", str(c["objects"])):
-            groups.setdefault(key, {"a": [], "b": []})[c["form"]].append(c["translate_plus_search_s"])
+    for c in calls:  # a call without Fast Downward's own clocks (a timeout, an error) has no translate + search time
+        if c["translate_plus_search_s"] is not None:
+            for key in ("all", str(c["objects"])):
+                groups.setdefault(key, {"a": [], "b": []})[c["form"]].append(c["translate_plus_search_s"])
     summary = {k: {"calls": len(v["a"]), "median_a_s": round(statistics.median(v["a"]), 4),
                    "median_b_s": round(statistics.median(v["b"]), 4),
                    "b_over_a": round(statistics.median(v["b"]) / max(statistics.median(v["a"]), 1e-9), 3)}
-               for k, v in sorted(groups.items())}
-    same = all(ca["status"] == cb["status"] for ca, cb in
-               zip(sorted((c for c in calls if c["form"] == "a"), key=lambda c: (c["problem"], c["repeat"])),
-                   sorted((c for c in calls if c["form"] == "b"), key=lambda c: (c["problem"], c["repeat"]))))
-    result = {"a": str(args.a), "b": str(args.b), "planner": args.planner, "repeats": args.repeats,
-              "timeout_s": args.timeout, "date": date.today().isoformat(), "same_status": same,
-              "summary": summary, "calls": calls}
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = args.out.with_suffix(".tmp")
-    tmp.write_text(json.dumps(result, indent=1))
-    tmp.replace(args.out)
+               for k, v in sorted(groups.items()) if v["a"] and v["b"]}
+    status = {(c["problem"], c["repeat"], c["form"]): c["status"] for c in calls}
+    same = all(status[(n, r, "a")] == status[(n, r, "b")] for n in names for r in range(args.repeats))
+    atomic_write_json(args.out, {"a": str(args.a), "b": str(args.b), "planner": args.planner,
+                                 "repeats": args.repeats, "timeout_s": args.timeout, "same_status": same,
+                                 "summary": summary, "calls": calls, **bench_context()})
     for k, v in summary.items():
         print(f"{k:>4}: {v['calls']} calls, median A {v['median_a_s']:.3f} s, B {v['median_b_s']:.3f} s, "
               f"B/A {v['b_over_a']:.2f}")
