@@ -21,6 +21,16 @@ row neighbours, and which ones overlap before and after depends on the pair.
 `LiftedRules.step_pieces` and `step_codes` apply them to a state (the Python form of the PDDL that
 `lifted_writer` writes): a move no rule covers leaves the state as it is, as the PDDL offers no action for it.
 
+A structure seen fewer than min_count times has no rule of its own. Those of a cube or a near-row stick
+(`POOLED_CLASSES`: lifted over both locations) are pooled (`pool_key`: the class, o's place, what it lands on);
+where the pooled moves mostly agree on what o does relative to the top it lands on (`relative_change`: a cube
+ends two levels above it), every structure of the pool seen at least `pool_structure_min` times gets that
+outcome, as a rule marked with the pool's number (`Rule.pool`). The writer states a pool as one schema lifted
+over the levels, with a static relation listing its structures.
+
+Picks at a far-row stick's end are no move of `participants`; their rules (`pddl_export.end_moves`) are kept
+beside the others (`LiftedRules.end_rules`), and `step_pieces` applies them too.
+
 A rule also keeps how often its outcome was m(z)'s answer among the moves of its descriptions (`share`) and the
 other writable outcomes seen at least ALTERNATIVE_MIN_SHARE of the time (`alternatives`): the all-outcomes
 determinisation that the cost form of the domain writes, one action per outcome costing by its -log share.
@@ -36,6 +46,7 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from pddl_export.bounded_json import read_json_file
+from pddl_export.end_moves import EndRule, end_change, end_participants, end_rule_json, end_rule_of_json
 from pddl_export.lifted_scene import FAR_ROW, N_LOCATIONS, NEAR_ROW, CodeLayout, Piece, SceneGraph, neighbours, read_scene, \
     top_of
 
@@ -48,6 +59,9 @@ REFINEMENTS = (("to",), ("o.kind",), ("v.kind",), ("u.kind",), ("riders.kind",))
 MIN_GAIN = 0.05  # a split must explain this share of its node's moves more (distil_lifted, LiftedConfig)
 ALTERNATIVE_MIN_SHARE = 0.1  # an outcome this often m(z)'s answer among a rule's moves becomes an alternative
 MAX_ALTERNATIVES = 2  # per rule, the most frequent ones (the cost form writes 1 + this many actions per rule)
+POOLED_CLASSES = ("cube", "near")  # the lifted move classes whose rarer structures can be pooled (distil_lifted)
+POOL_MIN_COUNT = 20  # moves a pool needs before its majority outcome is given to its structures
+POOL_STRUCTURE_MIN = 5  # moves a structure needs to join its pool (each one is a static fact of every problem)
 WHERE = ("to", "from", "stay", "shift")  # where a piece ends, relative to the action; an int is a location
 
 
@@ -185,6 +199,7 @@ class Rule:
     support: int  # observed moves it was distilled from (all of its key's)
     share: float = 1.0  # how often `outcome` was m(z)'s answer among those moves
     alternatives: tuple = ()  # ((outcome, share), ...): other writable answers, at least ALTERNATIVE_MIN_SHARE each
+    pool: int | None = None  # a pooled rule: the number of its pool (its structure was rarer than min_count)
 
     def outcomes(self) -> tuple:
         """((outcome, share), ...): the rule's own outcome first, then its alternatives."""
@@ -206,8 +221,10 @@ class LiftedRules:
     # (stick, kind, loc, place, level) -> the learned code observed most often with them: what a moved piece's
     # whole code is predicted to be (its position-tracking bits follow its new location)
     codebook: dict = field(default_factory=dict, hash=False)
+    end_rules: tuple[EndRule, ...] = ()  # picks at a far-row stick's end (pddl_export.end_moves)
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "_ends", {r.cls: r for r in self.end_rules})
         index, splits = {}, {}
         for r in self.rules:
             for key in _scalar_keys(r.key):  # a rule naming several release locations answers for each
@@ -238,13 +255,26 @@ class LiftedRules:
             key = key + ((name, sig[name]),)
         return self._index[key]
 
+    def end_rule_for(self, graph: SceneGraph, pick: int, release: int) -> EndRule | None:
+        """The end rule of a pick at a far-row stick's end, or None (no such pick, or no rule for it)."""
+        m = end_participants(graph, pick, release)
+        rule = None if m is None else self._ends.get(m.cls)
+        return rule if rule is not None and rule.after(graph, m) is not None else None
+
     def step_pieces(self, pieces: Sequence[Piece], action: int, alternative: int = 0
-                    ) -> tuple[tuple[Piece, ...], Rule | None]:
+                    ) -> tuple[tuple[Piece, ...], Rule | EndRule | None]:
         """The pieces after an action (pick * 6 + release), and the rule that fired (None: nothing changes); with
         `alternative` j > 0, the rule's j-th alternative outcome instead of its own."""
         pick, release = divmod(int(action), 6)
         graph = read_scene(pieces)
         m = participants(graph, pick, release)
+        if m == "a stick's end" and (end := self.end_rule_for(graph, pick, release)) is not None:
+            if alternative:
+                raise ValueError(f"the end rule of action {action} has no alternatives, not {alternative}")
+            out = list(pieces)
+            m = end_participants(graph, pick, release)
+            out[m.o] = end.after(graph, m)
+            return tuple(out), end
         if isinstance(m, str):
             return tuple(pieces), None
         rule = self.rule_for(signature(graph, m))
@@ -284,9 +314,10 @@ class LiftedRules:
                 "stick_of": [[int(a), int(b), bool(s)] for (a, b), s in sorted(self.stick_of.items())],
                 "rules": [{"depth": r.depth, "key": [[k, v] for k, v in r.key],
                            "outcome": _outcome_json(r.outcome), "support": r.support, "share": r.share,
-                           "alternatives": [[_outcome_json(o), p] for o, p in r.alternatives]} for r in self.rules],
+                           "alternatives": [[_outcome_json(o), p] for o, p in r.alternatives],
+                           **({} if r.pool is None else {"pool": r.pool})} for r in self.rules],
                 "codebook": [[bool(k[0]), *map(int, k[1:]), int(v)] for k, v in sorted(self.codebook.items())],
-                "stats": self.stats}
+                "end_rules": [end_rule_json(r) for r in self.end_rules], "stats": self.stats}
 
 
 def _outcome_json(outcome: Outcome) -> list:
@@ -327,9 +358,78 @@ def observed_moves(rules_like: LiftedRules, before: np.ndarray, after: np.ndarra
     return moves, why
 
 
+def observed_end_moves(rules_like: LiftedRules, before: np.ndarray, after: np.ndarray, actions: np.ndarray,
+                       mask: np.ndarray) -> list[tuple]:
+    """Every pick at a far-row stick's end in (N, K) code arrays: (scene, end move, where the stick ended)."""
+    out = []
+    for n in range(len(actions)):
+        k = int(np.asarray(mask[n]).sum())
+        graph = read_scene(rules_like.pieces(before[n, :k].tolist()))
+        m = end_participants(graph, *divmod(int(actions[n]), 6))
+        if m is not None:
+            out.append((graph, m, end_change(graph, rules_like.pieces(after[n, :k].tolist()), m)))
+    return out
+
+
+def pool_key(sig: dict) -> tuple:
+    """What pools a rarer structure with others: its class (POOLED_CLASSES), o's place, and what it lands on (a
+    block standing at the release location or not, the table or not)."""
+    return (sig["cls"], sig["o.place"], sig["v.at"], sig["v.level"] > 0)
+
+
+def relative_change(sig: dict, outcome: Outcome) -> tuple:
+    """What o does in a move, its new level relative to the top it lands on: (where, place, levels above, kind)."""
+    where, place, level, kind = outcome[0]
+    return (where, place, level - sig["v.level"] if where == "to" else level, kind)
+
+
+def _pooled(sig: dict, change: tuple) -> Outcome | None:
+    """The outcome of a pool's relative change in a structure: o lands change[2] levels above the top it lands on,
+    nothing else changes (None where that level is off the scale)."""
+    where, place, up, kind = change
+    level = sig["v.level"] + up
+    return ((where, place, level, kind), None, None) if where == "to" and 0 <= level < 8 else None
+
+
+def _pool_rules(moves: Sequence[tuple[dict, Outcome]], handled: set, pool_min_count: int,
+                pool_structure_min: int, classes: Sequence[str] = POOLED_CLASSES) -> list[Rule]:
+    """Rules of the pooled structures: every structure of a lifted class with no rule of its own (`handled`: those
+    distil_lifted grew a tree for), seen at least pool_structure_min times, takes its pool's majority relative
+    change where the pool has pool_min_count moves."""
+    pools: dict = defaultdict(Counter)
+    seen: dict = defaultdict(list)
+    for sig, out in moves:
+        key = key_of(sig, 0)
+        if sig["cls"] in classes and not sig["riders.sides"] and key not in handled:
+            pools[pool_key(sig)][relative_change(sig, out)] += 1
+            seen[key].append(sig)
+    # pools whose structures all take the same change in the same way (class, o's place) are one schema: the
+    # structures its static facts list say which pool key each came from
+    written = {k: _written(k, c.most_common(1)[0][0]) for k, c in pools.items()}
+    numbers = {w: i for i, w in enumerate(sorted(set(written.values()), key=repr))}
+    out: list[Rule] = []
+    for key, sigs in seen.items():
+        tally = pools[pool_key(sigs[0])]
+        total = sum(tally.values())
+        if len(sigs) < pool_structure_min or total < pool_min_count:
+            continue
+        change, n = tally.most_common(1)[0]
+        outcome = _pooled(sigs[0], change)
+        if outcome is not None:
+            out.append(Rule(0, key, outcome, len(sigs), round(n / total, 4), (), numbers[written[pool_key(sigs[0])]]))
+    return out
+
+
+def _written(key: tuple, change: tuple) -> tuple:
+    """What a pool's schema states: its class, o's place and the change (pool_key's other fields are in its facts)."""
+    return (key[0], key[1], change)
+
+
 def distil_lifted(layout: CodeLayout, stick_of: dict, moves: Sequence[tuple[dict, Outcome]], min_count: int = 3,
                   model_hash: str = "", rider_min_count: int | None = None,
-                  pair_min_count: int | None = None, min_gain: float = MIN_GAIN) -> LiftedRules:
+                  pair_min_count: int | None = None, min_gain: float = MIN_GAIN,
+                  pool_min_count: int | None = None, pool_structure_min: int = POOL_STRUCTURE_MIN,
+                  pool_classes: Sequence[str] = POOLED_CLASSES) -> LiftedRules:
     """Rules from (signature, outcome) moves, as a decision tree per move structure.
 
     The moves of one STRUCTURE key are a node. A node becomes a rule (its majority outcome) unless some refinement
@@ -341,6 +441,9 @@ def distil_lifted(layout: CodeLayout, stick_of: dict, moves: Sequence[tuple[dict
     in any data; pair_min_count where the move's class names its two locations, a far-row stick's, whose schema
     grounds to a handful of actions however many objects a task has). A value with fewer moves under a split node
     takes the node's majority: too few to tell it apart.
+
+    With pool_min_count, the rarer structures of pool_classes (some of POOLED_CLASSES) are pooled (_pool_rules; the
+    module docstring).
     """
     rider_min = min_count if rider_min_count is None else rider_min_count
     pair_min = min_count if pair_min_count is None else pair_min_count
@@ -394,15 +497,21 @@ def distil_lifted(layout: CodeLayout, stick_of: dict, moves: Sequence[tuple[dict
         if split == "to":
             rules[first:] = _merge_destinations(key, rules[first:], best, tallies)
 
+    handled = set()
     for key, node in groups.items():
         out = Counter(o for _, o in node).most_common(1)[0][0]
         if len(node) >= needed(key, out):
+            handled.add(key)
             grow(key, node, ())
+    n_own = len(rules)
+    if pool_min_count is not None:
+        rules += _pool_rules(moves, handled, pool_min_count, pool_structure_min, pool_classes)
     lookup = LiftedRules(layout, stick_of, tuple(rules))
     hits = [lookup.rule_for(sig) for sig, _ in moves]
     agree = sum(h is not None and h.outcome == out for h, (_, out) in zip(hits, moves))
     n_covered = sum(h is not None for h in hits)
-    stats = {"moves": len(moves), "structures": len(groups), "rules": len(rules),
+    stats = {"moves": len(moves), "structures": len(groups), "rules": len(rules), "pooled_rules": len(rules) - n_own,
+             "pools": len({r.pool for r in rules if r.pool is not None}),
              "structures_without_move": unwritable, "covered_moves": n_covered,
              "agreement": round(agree / n_covered, 4) if n_covered else 0.0}
     return LiftedRules(layout, stick_of, tuple(sorted(rules, key=lambda r: (repr(r.key), r.depth))),
@@ -443,12 +552,23 @@ def with_network_answers(rules: LiftedRules, answers: Sequence[tuple[dict, Outco
     moves it covers: rules distilled from observed outcomes state what the world did; the cost form then weighs
     each outcome by how often m(z) gives it."""
     tallies: dict = defaultdict(Counter)
+    pooled: dict = defaultdict(Counter)  # a pool's answers: m(z)'s relative changes over all its structures
     for sig, out in answers:
         r = rules.rule_for(sig)
-        if r is not None:
+        if r is not None and r.pool is not None:
+            pooled[r.pool][relative_change(sig, out) if writable(out) else None] += 1
+        elif r is not None:
             tallies[r.key][out] += 1
     redone = []
     for r in rules.rules:
+        if r.pool is not None:  # one share for the pool, as its schema states one outcome for all its structures
+            t = pooled.get(r.pool)
+            if t:
+                n = t[relative_change(r.fields(), r.outcome)]
+                r = dataclasses.replace(r, share=round(n / sum(t.values()), 4) if n else
+                                        round(1 / (sum(t.values()) + 1), 4))
+            redone.append(r)
+            continue
         t = tallies.get(r.key)
         if not t:
             redone.append(r)
@@ -484,7 +604,8 @@ def load_lifted(path) -> LiftedRules:
         codebook = {(bool(e[0]), int(e[1]), int(e[2]), int(e[3]), int(e[4])): int(e[5]) for e in d.get("codebook", [])}
         rules = tuple(Rule(int(r["depth"]), tuple((k, tuple(v) if isinstance(v, list) else v) for k, v in r["key"]),
                            _outcome_of_json(r["outcome"]), int(r["support"]), float(r.get("share", 1.0)),
-                           tuple((_outcome_of_json(o), float(p)) for o, p in r.get("alternatives", [])))
+                           tuple((_outcome_of_json(o), float(p)) for o, p in r.get("alternatives", [])),
+                           None if r.get("pool") is None else int(r["pool"]))
                       for r in d["rules"])
         for r in rules:
             if not all(0 < share <= 1 for _, share in r.outcomes()):
@@ -497,9 +618,19 @@ def load_lifted(path) -> LiftedRules:
                     or r.depth != len(extra):
                 raise ValueError(f"a rule's refinements {extra} must be distinct fields of {REFINEMENTS}, "
                                  f"as many as its depth {r.depth}")
+            if r.pool is not None and (r.depth or r.alternatives or dict(r.key)["cls"] not in POOLED_CLASSES):
+                raise ValueError(f"pooled rule of pool {r.pool} must be a {' or '.join(POOLED_CLASSES)} move's "
+                                 f"structure, with no refinement and no alternative")
+        pools: dict = defaultdict(set)
+        for r in rules:
+            if r.pool is not None:
+                pools[r.pool].add(_written(pool_key(r.fields()), relative_change(r.fields(), r.outcome)))
+        if any(len(v) > 1 for v in pools.values()):
+            raise ValueError("the rules of one pool must share its key and relative outcome")
+        ends = tuple(end_rule_of_json(e) for e in d.get("end_rules", []))
     except (KeyError, TypeError, ValueError, OverflowError) as e:
         raise ValueError(f"{path}: malformed lifted rules ({str(e).splitlines()[0][:200]})") from None
-    return LiftedRules(layout, stick_of, rules, str(d.get("model_hash", "")), dict(d.get("stats", {})), codebook)
+    return LiftedRules(layout, stick_of, rules, str(d.get("model_hash", "")), dict(d.get("stats", {})), codebook, ends)
 
 
 def build_codebook(rules_like: LiftedRules, codes: np.ndarray, mask: np.ndarray) -> dict:

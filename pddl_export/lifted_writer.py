@@ -24,6 +24,11 @@ once per cube and pair of locations, and the translator's time follows its opera
 `(hand-empty)` holds between robot actions; every other move (a stick's) is one action that needs it.
 plan_decoder reads a plan back as robot actions.
 
+The `accurate` export adds schemas lifted over the levels too (pool_schema: a pool of rarer structures; end_schema:
+a pick at a far-row stick's end), each with a static relation whose facts list the cases it applies to
+(Schema.statics; every problem states them, static_facts), so that every robot action still has at most one
+ground action.
+
 The cost form (`costs=True`: domain_pddl, problem_pddl) is the all-outcomes determinisation of the rules: one
 action per outcome of a rule (its own and its alternatives, `-altJ`), each costing OUTCOME_COST_UNIT * (1 - ln
 share) rounded (`:action-costs`, `(:metric minimize (total-cost))`; pick-cube costs nothing, the release carries
@@ -45,7 +50,8 @@ import math
 from dataclasses import dataclass
 from typing import Iterable, Sequence
 
-from pddl_export.lifted_rules import LiftedRules, Rule, release_locations
+from pddl_export.end_moves import EndRule
+from pddl_export.lifted_rules import LiftedRules, Rule, relative_change, release_locations
 from pddl_export.lifted_scene import FAR_ROW, NEAR_ROW, N_LOCATIONS, neighbours, read_scene, top_of
 from pddl_export.symbolic import SymbolicGoal
 
@@ -107,6 +113,8 @@ class Schema:
     alternative: int = 0  # which of its rule's outcomes (0: the rule's own)
     cost: int | None = None  # the cost form's action cost (its last effect increases total-cost by it)
     step: str = "move"  # "move": one robot action; "pick" / "release": its two halves (a cube's move, split)
+    statics: tuple = ()  # facts every problem states for it: a pooled schema's structures (pool_schema)
+    predicate: str = ""  # the static relation a pooled schema declares, with its typed parameters
 
 
 def _bit_literals(rules: LiftedRules, term: str, kind: int, present: bool = True) -> list[str]:
@@ -460,8 +468,19 @@ def _halves(s: Schema) -> Schema:
 
 
 def liftable(found: Iterable[Schema]) -> list[tuple[str, str]]:
-    """The (level, rests) pairs of a cube that some release-cube action puts down: pick-cube lifts only these."""
-    return sorted({pair for s in found if (pair := _pick_side(s)) is not None})
+    """The (level, rests) pairs of a cube that some release-cube action puts down: pick-cube lifts only these (a
+    pooled schema's are those of the structures its static facts list)."""
+    pairs = set()
+    for s in found:
+        if (pair := _pick_side(s)) is not None:
+            pairs |= {tuple(fact.strip("()").split()[1:3]) for fact in s.statics} if s.statics else {pair}
+    return sorted(pairs)
+
+
+def static_facts(found: Sequence[Schema]) -> list[str]:
+    """The facts of the rules' static relations, which every problem states: the liftable pairs and the pooled
+    schemas' structures."""
+    return [f"(liftable {h} {t})" for h, t in liftable(found)] + list(dict.fromkeys(x for s in found for x in s.statics))
 
 
 def moves(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
@@ -472,10 +491,19 @@ def moves(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
     actions, but Fast Downward's translator then works out, for every fact one clause adds and another
     deletes, the negation of the other clauses' conditions: a 4-object task did not translate in 10 minutes.)
     """
+    pools: dict[int, list[Rule]] = {}
+    for r in rules.rules:
+        if r.pool is not None:
+            pools.setdefault(r.pool, []).append(r)
+    pooled = [pool_schema(rules, number, members, outcome_cost(members[0].share) if costs else None)
+              for number, members in sorted(pools.items())]
+    pooled += [end_schema(rules, r, i, outcome_cost(r.share) if costs else None) for i, r in enumerate(rules.end_rules)]
     if not costs:
-        return _distinct(rule_schema(rules, r, i) for i, r in enumerate(rules.rules))
+        return _distinct([rule_schema(rules, r, i) for i, r in enumerate(rules.rules) if r.pool is None] + pooled)
     out = []
     for i, r in enumerate(rules.rules):
+        if r.pool is not None:
+            continue
         for j, (_, share) in enumerate(r.outcomes()):
             try:
                 out.append(rule_schema(rules, r, i, j, outcome_cost(share)))
@@ -483,7 +511,90 @@ def moves(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
                 if j == 0:  # the rule's own outcome always writes (export_lifted checks it)
                     raise
                 # an alternative whose heights cannot be stated from the rule's key: no action for it
-    return _distinct(out)
+    return _distinct(out + pooled)
+
+
+def end_schema(rules: LiftedRules, rule: EndRule, index: int, cost: int | None = None) -> Schema:
+    """The schema of an end rule (pddl_export.end_moves): the robot picks at `pick`, where the top is the end of a
+    stick lying at `s` (its level ?h, `?e` the end's layer), and releases at `release`; the stick ends at the
+    rule's destination, lying on the top it finds there (what it rested on at s, `?u`; what lay under one of its
+    ends, `?b_l0`; or the top there, `?top`), one layer above it (`?new`). The static relation
+    `(end-case-N ?h ?e ?u ?b_l.. [?top] ?new)` lists the rule's cases (Schema.statics): lifted over the levels
+    without it, the schema grounds to thousands of actions per stick."""
+    s, pick, release = rule.cls
+    n, ends = rule.destination, neighbours(rule.cls[0])
+    under = {q: f"?b_{loc_name(q)}" for q in ends}
+    found = "?u" if n == s else under.get(n, "?top")
+    params = [("?o", "stick"), ("?h", "layer"), ("?e", "layer"), ("?u", "layer")] + \
+        [(t, "layer") for t in under.values()] + ([("?top", "layer")] if found == "?top" else []) + [("?new", "layer")]
+    predicate = f"end-case-{index}"
+    facts = []
+    for h, (u, u_at), beneath, top in rule.cases:
+        words = [level_name(h), f"{level_name(h)}-end", top_name(level_name(u), surface(u, u_at))]
+        words += [level_name(b) for b in beneath]
+        words += [top_name(level_name(top[0]), surface(*top))] if top is not None else []
+        facts.append(f"({predicate} {' '.join(words)} {level_name(rule.new_level((h, (u, u_at), beneath, top)))})")
+    ls, ln = loc_name(s), loc_name(n)
+    pre = [f"(at ?o {ls})", "(level ?o ?h)", f"(place ?o {place_name(0)})", "(rests ?o ?u)", f"(height {ls} ?h)"]
+    for q, b in under.items():
+        pre += [f"(height {loc_name(q)} ?e)", f"(beneath {loc_name(q)} {b})"]
+    if found == "?top":
+        pre.append(f"(height {ln} ?top)")
+    pre.append(f"({predicate} {' '.join(p for p, _ in params[1:])})")
+    eff = [f"(not (at ?o {ls}))", f"(at ?o {ln})", "(not (rests ?o ?u))", f"(rests ?o {found})"] if n != s else []
+    eff += _replace("place", "?o", place_name(0), place_name(rule.place))
+    eff += ["(not (level ?o ?h))", "(level ?o ?new)"] + _bit_effects(rules, "?o", rule.kind, None)
+    eff += [f"(not (beneath {loc_name(q)} {b}))" for q, b in under.items()]
+    eff += [f"(not (height {ls} ?h))", f"(height {ls} {'?new' if n == s else '?u'})"]
+    for q, b in under.items():
+        eff += [f"(not (height {loc_name(q)} ?e))", f"(height {loc_name(q)} {'?new' if n == q else b})"]
+    if found == "?top":
+        eff += [f"(not (height {ln} ?top))", f"(height {ln} ?new)"]
+    eff += [f"(not (stands ?o {ls} ?h))", f"(stands ?o {ln} ?new)"]
+    if cost is not None:
+        eff.append(f"(increase (total-cost) {int(cost)})")
+    name = f"pick-release-stick-end-{loc_name(pick)}-{loc_name(release)}-{index}"
+    comment = (f"; {rule.support} moves: picked at its end, a stick at {ls} ends at {ln} ({place_name(rule.place)}); "
+               f"{predicate} lists its cases")
+    params = tuple(params)
+    signature = " ".join(f"{p} - layer" for p, _ in params[1:])
+    return Schema(name, pick, release, _schema_text(name, params, pre, eff, comment), params, tuple(pre), tuple(eff),
+                  0, cost, statics=tuple(facts), predicate=f"({predicate} {signature})")
+
+
+def pool_schema(rules: LiftedRules, number: int, members: Sequence[Rule], cost: int | None = None) -> Schema:
+    """The one schema of a pool (lifted_rules._pool_rules): a cube's or near-row stick's move lifted over the
+    levels as well as the locations. `?h` (o's level), `?t` (what it rests on), `?top` (the top at ?to) and `?new`
+    (o's level after) are parameters, tied by the static relation `(pooled-N ?h ?t ?top ?new)` whose facts (in every
+    problem: Schema.statics) list the pool's structures: the rule applies to no other, and no other rule to these.
+    A release onto what it rested on (?t = ?top) deletes and adds the same fact: the add stands (PDDL's semantics)."""
+    f = members[0].fields()
+    where, place, up, kind = relative_change(f, members[0].outcome)
+    predicate = f"pooled-{number}"
+    facts = sorted({f"({predicate} {level_name(r.fields()['o.level'])} "
+                    f"{top_name(level_name(r.fields()['u.level']), surface(r.fields()['u.level'], r.fields()['u.at']))} "
+                    f"{top_name(level_name(r.fields()['v.level']), surface(r.fields()['v.level'], r.fields()['v.at']))} "
+                    f"{level_name(r.fields()['v.level'] + up)})" for r in members})
+    stick = f["o.stick"]
+    params = (("?o", "stick" if stick else "cube"), ("?from", "location"), ("?to", "location"),
+              ("?h", "layer"), ("?t", "layer"), ("?top", "layer"), ("?new", "layer"))
+    pre = ["(at ?o ?from)", "(level ?o ?h)", "(rests ?o ?t)", f"(place ?o {place_name(f['o.place'])})",
+           "(differ ?from ?to)"] + (["(near ?from)", "(near ?to)"] if f["cls"] == "near" else []) + \
+        ["(height ?from ?h)", "(height ?to ?top)", f"({predicate} ?h ?t ?top ?new)"]
+    eff = ["(not (at ?o ?from))", "(at ?o ?to)", "(not (rests ?o ?t))", "(rests ?o ?top)"]
+    eff += _replace("place", "?o", place_name(f["o.place"]), place_name(place))
+    eff += ["(not (level ?o ?h))", "(level ?o ?new)"] + _bit_effects(rules, "?o", kind, None)
+    eff += ["(not (height ?from ?h))", "(height ?from ?t)", "(not (height ?to ?top))", "(height ?to ?new)"]
+    eff += _stands_effects(pre, eff)
+    if cost is not None:
+        eff.append(f"(increase (total-cost) {int(cost)})")
+    what = "a stick" if stick else "a cube"
+    comment = (f"; {sum(r.support for r in members)} moves of {len(members)} rarer structures ({predicate} lists "
+               f"them): {what} lands {up} levels above the top at ?to")
+    name = f"pick-release-{'stick' if stick else 'cube'}-pooled-{number}"
+    return Schema(name, None, None, _schema_text(name, params, pre, eff, comment), params, tuple(pre), tuple(eff),
+                  0, cost, statics=tuple(facts),
+                  predicate=f"({predicate} ?h - layer ?t - layer ?top - layer ?new - layer)")
 
 
 def schemas(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
@@ -579,7 +690,9 @@ def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
     bits = " ".join(f"(bit-{b} ?b - block) (no-bit-{b} ?b - block)" for b in rules.layout.kept)
     locs = " ".join(loc_name(i) for i in range(N_LOCATIONS))
     lvls = " ".join(layer_names())
-    body = "".join(s.text for s in schemas(rules, costs))
+    found = schemas(rules, costs)
+    body = "".join(s.text for s in found)
+    pooled = " ".join(dict.fromkeys(s.predicate for s in found if s.predicate))
     requirements = ":strips :typing :action-costs" if costs else ":strips :typing"
     functions = "  (:functions (total-cost) - number)\n" if costs else ""
     return (f"; A lifted domain distilled from the transition model {rules.model_hash or '(no hash)'} by symlearn.\n"
@@ -595,7 +708,7 @@ def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
             "               (beneath ?l - location ?h - layer) (place ?b - block ?p - position)\n"
             "               (near ?l - location) (differ ?a - location ?b - location) (is ?a - location ?b - location)\n"
             "               (hand-empty) (holding ?b - block) (liftable ?h - layer ?t - layer)"
-            + (f"\n               {bits}" if bits else "") + ")\n"
+            + (f"\n               {bits}" if bits else "") + (f"\n               {pooled}" if pooled else "") + ")\n"
             + functions + body + ")\n")
 
 
@@ -609,10 +722,10 @@ def _surface_of(pieces, t: int | None, loc: int) -> str:
 
 
 def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicGoal, name: str,
-                 costs: bool = False, pairs: Sequence[tuple[str, str]] | None = None) -> str:
+                 costs: bool = False, statics: Sequence[str] | None = None) -> str:
     """A problem of the lifted domain (of its cost form, with costs): the start scene read from its codes, the goal's
-    located fields and an empty hand. `pairs`: the domain's liftable pairs where the caller has them (else worked
-    out from the rules)."""
+    located fields and an empty hand. `statics`: static_facts of the domain's schemas where the caller has them
+    (else worked out from the rules)."""
     if len(goal.codes) != len(start_codes):
         raise ValueError(f"the goal has {len(goal.codes)} objects, the start {len(start_codes)}")
     pieces = rules.pieces(start_codes)
@@ -622,8 +735,7 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
     init += [f"(same-level {t} {t.removesuffix('-end')})" for t in layer_names() if t != level_name(0)]
     init += [f"(differ {loc_name(a)} {loc_name(b)})" for a in range(N_LOCATIONS) for b in range(N_LOCATIONS) if a != b]
     init += [f"(is {loc_name(a)} {loc_name(a)})" for a in range(N_LOCATIONS)]
-    pairs = liftable(moves(rules, costs)) if pairs is None else pairs
-    init += ["(hand-empty)"] + [f"(liftable {h} {t})" for h, t in pairs]
+    init += ["(hand-empty)"] + list(static_facts(moves(rules, costs)) if statics is None else statics)
     for i, p in enumerate(pieces):
         o = object_name(i)
         if p.loc < N_LOCATIONS:

@@ -78,14 +78,14 @@ def _arrays(moves):
     return before, np.array([m[1] for m in moves]), after, before >= 0, stick
 
 
-def _distil(moves_list) -> LiftedRules:
+def _distil(moves_list, min_count: int = 1, **pooling) -> LiftedRules:
     before, actions, after, mask, stick = _arrays(moves_list)
     objs = before[mask]
     learned = (objs[:, None] >> (9 + np.arange(7, -1, -1))) & 1
     layout = CodeLayout(8, kept_bits(learned, (objs >> 6) & 7))
     stick_of = stick_reader(before, mask, stick, layout)
     moves, _ = observed_moves(LiftedRules(layout, stick_of), before, after, actions, mask)
-    return distil_lifted(layout, stick_of, moves, min_count=1, model_hash="0123456789abcdef")
+    return distil_lifted(layout, stick_of, moves, min_count=min_count, model_hash="0123456789abcdef", **pooling)
 
 
 @pytest.fixture(scope="module")
@@ -97,6 +97,15 @@ def world_rules() -> LiftedRules:
 def pair_rules() -> LiftedRules:
     """Rules of two-object scenes only: a domain small enough for unified-planning's reader in seconds."""
     return _distil(world_moves(400, seed=3, objects=(2, 2)))
+
+
+@pytest.fixture(scope="module")
+def pooled_pair_rules() -> LiftedRules:
+    """Two-object rules where a structure needs 30 moves of its own: the rarer ones (a cube on a tower, a stick
+    placed off its spot) are pooled."""
+    rules = _distil(world_moves(400, seed=3, objects=(2, 2)), min_count=30, pool_min_count=3, pool_structure_min=1)
+    assert rules.stats["pooled_rules"] >= 3 and rules.stats["pools"] >= 2
+    return rules
 
 
 def test_the_bits_that_track_the_location_are_dropped(world_rules):
@@ -202,15 +211,17 @@ def _robot_moves(sim, state, rules: LiftedRules) -> list[tuple[int, object]]:
     return out
 
 
-def test_pddl_successors_are_the_rules(pair_rules):
+@pytest.mark.parametrize("fixture", ["pair_rules", "pooled_pair_rules"])
+def test_pddl_successors_are_the_rules(fixture, request):
     """Every action of sampled states has one applicable ground action in the PDDL where the rules have a rule for it,
-    and none elsewhere, and it leads where the rules lead."""
+    and none elsewhere, and it leads where the rules lead; pooled rules too (their schemas lifted over levels)."""
     from unified_planning.io import PDDLReader
     from unified_planning.shortcuts import SequentialSimulator, get_environment
     get_environment().credits_stream = None
+    pair_rules = request.getfixturevalue(fixture)
     domain = domain_pddl(pair_rules)
-    states = [m[0] for m in world_moves(3, seed=2, objects=(2, 2))]
-    checked = 0
+    states = [m[0] for m in world_moves(3 if fixture == "pair_rules" else 12, seed=2, objects=(2, 2))]
+    checked = pooled = 0
     for start in states:
         goal = SymbolicGoal(tuple(start))
         problem = PDDLReader().parse_problem_string(domain, problem_pddl(pair_rules, start, goal, "p"))
@@ -227,6 +238,7 @@ def test_pddl_successors_are_the_rules(pair_rules):
             assert len(by_action.get(a, [])) <= 1, f"action {a} from {start}: {len(by_action[a])} ground actions"
             for nxt in by_action.get(a, []):
                 checked += 1
+                pooled += rule.pool is not None
                 for i, p in enumerate(want):
                     o = problem.object(object_name(i))
                     at = [loc for loc in range(6) if nxt.get_value(problem.fluent("at")(o, problem.object(f"l{loc}"))).bool_constant_value()]
@@ -236,7 +248,7 @@ def test_pddl_successors_are_the_rules(pair_rules):
                     stands = [(loc, h) for loc in range(6) for h in range(8) if nxt.get_value(problem.fluent("stands")(
                         o, problem.object(f"l{loc}"), problem.object(f"h{h}"))).bool_constant_value()]
                     assert stands == [(p.loc, p.level)], f"object {i} stands at {stands} after action {a} from {start}"
-    assert checked >= 3
+    assert checked >= 3 and (pooled >= 5 if fixture == "pooled_pair_rules" else pooled == 0)
 
 
 def _facts(problem_text: str) -> tuple[set[str], dict[str, list[str]]]:
@@ -663,10 +675,190 @@ def test_a_kind_that_follows_the_release_location_splits_the_rule_there_and_the_
     assert checked >= 6
 
 
+def test_rarer_structures_take_their_pools_change_and_reproduce_the_world(tmp_path):
+    """A structure seen fewer than min_count times takes its pool's change relative to the top it lands on (a cube
+    ends 2 levels above it, a stick 1): exact on held-out moves of the world, one schema per pool whose static
+    facts list its structures, and back through JSON; a pool whose rules disagree is refused."""
+    import json
+    from pddl_export.lifted_writer import moves, static_facts
+    rules = _distil(world_moves(1500, seed=0), min_count=60, pool_min_count=10, pool_structure_min=2)
+    plain = _distil(world_moves(1500, seed=0), min_count=60)
+    pooled = [r for r in rules.rules if r.pool is not None]
+    assert rules.stats["pooled_rules"] == len(pooled) >= 10 and len(rules.rules) == len(plain.rules) + len(pooled)
+    assert {r.outcome[0][2] - r.fields()["v.level"] for r in pooled if not r.fields()["o.stick"]} == {2}
+    fired = exact = 0
+    for before, action, after, _ in world_moves(600, seed=1):
+        got, rule = rules.step_pieces(rules.pieces(before), action)
+        if rule is None or rule.pool is None:
+            assert plain.step_pieces(plain.pieces(before), action)[1] == rule  # the others are the plain rules'
+            continue
+        assert plain.step_pieces(plain.pieces(before), action)[1] is None
+        fired += 1
+        exact += [(p.loc, p.place, p.level, p.kind) for p in got] == \
+                 [(p.loc, p.place, p.level, p.kind) for p in rules.pieces(after)]
+    assert fired >= 20 and exact == fired
+    written = [s for s in moves(rules) if s.statics]
+    assert len(written) == rules.stats["pools"]
+    facts = static_facts(moves(rules))
+    assert sum(len(s.statics) for s in written) == len({f for f in facts if f.startswith("(pooled-")}) == \
+        len({(r.pool, r.fields()["o.level"], r.fields()["u.level"], r.fields()["u.at"], r.fields()["v.level"],
+              r.fields()["v.at"]) for r in pooled})
+    text = domain_pddl(rules)
+    assert all(f"({s.predicate[1:].split()[0]} ?h ?t ?top ?new)" in text for s in written)
+    path = tmp_path / "lifted.json"
+    path.write_text(json.dumps(rules.to_json()))
+    assert load_lifted(path).rules == rules.rules
+    d = rules.to_json()
+    first = next(r for r in d["rules"] if "pool" in r)
+    other = next(r for r in d["rules"] if r.get("pool") not in (None, first["pool"]))
+    other["pool"] = first["pool"]
+    path.write_text(json.dumps(d))
+    with pytest.raises(ValueError, match="the rules of one pool must share its key and relative outcome"):
+        load_lifted(path)
+
+
 @pytest.mark.parametrize("change, message", [({"source": "net"}, "source='net' must be one of observed, network"),
+                                             ({"pool_min_count": -1}, "pool_min_count=-1 must be a non-negative"),
+                                             ({"end_min_count": -2}, "end_min_count=-2 must be a non-negative"),
                                              ({"pair_min_count": 0}, "pair_min_count=0 must be a positive integer"),
                                              ({"min_gain": 1.0}, "min_gain=1.0 must lie in [0, 1)")])
 def test_lifted_settings_are_refused_in_one_line(change, message):
     from symlearn.export.lifted_export import LiftedConfig
     with pytest.raises(ValueError, match=message.replace("[", r"\[").replace("(", r"\(").replace(")", r"\)")):
         LiftedConfig(**change)
+
+
+def _true_atoms(problem, state, predicates) -> set[str]:
+    """The ground atoms of the given predicates that hold in a unified-planning state, as '(p a b)' strings."""
+    out = set()
+    for name in predicates:
+        fluent = problem.fluent(name)
+        domains = [[o for o in problem.all_objects if o.type == p.type or o.type.is_subtype(p.type)]
+                   for p in fluent.signature]
+        for args in itertools.product(*domains):
+            if state.get_value(fluent(*args)).bool_constant_value():
+                out.add(f"({name} {' '.join(a.name for a in args)})")
+    return out
+
+
+END_STATE_PREDICATES = ("at", "level", "stands", "place", "height", "beneath", "rests")
+
+
+def test_a_pick_at_a_stick_end_drags_the_stick_and_the_pddl_does_the_same(pair_rules):
+    """End rules (pddl_export.end_moves): one per (stick's location, pick, release) class, its most frequent change,
+    refused where the PDDL cannot state it; the PDDL's successor of every end move is the rules' successor, whole
+    (locations, levels, places, heights, what lies beneath the stick's ends), and no other action stands for it."""
+    from unified_planning.io import PDDLReader
+    from unified_planning.shortcuts import SequentialSimulator, get_environment
+    from pddl_export.end_moves import EndRule, distil_end_rules, end_case, end_participants
+    get_environment().credits_stream = None
+    stick, cube = (lambda loc, level: Piece(1, True, loc, 0, level)), (lambda loc, level: Piece(2, False, loc, 0, level))
+    code = lambda p: pair_rules.code_of(p, 0)  # noqa: E731
+    # distilled: the majority per class, min_count, its cases seen case_min times, and no rule for a stick ending
+    # on its spot in the far row
+    g = read_scene((stick(0, 1),))
+    m13, m12 = end_participants(g, 1, 3), end_participants(g, 1, 2)
+    assert m13.cls == (0, 1, 3) and end_participants(g, 0, 3) is None and end_participants(g, 2, 3) is None
+    triples = [(g, m13, (3, 2, 1, 0))] * 5 + [(g, m13, (4, 2, 1, 0))] * 2 + [(g, m12, (1, 0, 1, 1))] * 9
+    case = end_case(g, m13, 3)
+    assert case == (1, (0, False), (0,), (0, False))
+    assert distil_end_rules(triples, min_count=6) == (EndRule((0, 1, 3), 3, 2, 0, 7, round(5 / 7, 4), (case,)),)
+    assert distil_end_rules(triples, min_count=6, case_min=8) == ()
+    assert distil_end_rules(triples[:5], min_count=6) == ()
+    templates = (EndRule((0, 1, 3), 3, 2, 0, 7, 0.7), EndRule((1, 0, 1), 1, 4, 1, 9, 0.6),
+                 EndRule((1, 2, 0), 0, 5, 1, 9, 0.6), EndRule((2, 1, 4), 4, 0, 0, 9, 0.6))
+    scenes = [(stick(0, 1),), (stick(0, 1), cube(3, 2)), (stick(1, 1), cube(0, 2)), (cube(1, 2), stick(1, 3)),
+              (stick(2, 1),), (stick(2, 1), cube(4, 2), cube(5, 2)), (stick(1, 1),)]
+    unlisted = scenes[5]  # a case of no rule: the stick at l2 with a cube at l4 is not dragged there
+    cases: dict = {}
+    for pieces in scenes:
+        graph = read_scene(pieces)
+        for t in templates:
+            m = end_participants(graph, t.cls[1], t.cls[2])
+            if m is not None and m.cls == t.cls and pieces != unlisted:
+                cases.setdefault(t.cls, set()).add(end_case(graph, m, t.destination))
+    ends = tuple(dataclasses.replace(t, cases=tuple(sorted(cases[t.cls], key=repr))) for t in templates)
+    rules = dataclasses.replace(pair_rules, end_rules=ends)
+    assert rules.step_pieces(unlisted, 1 * 6 + 4) == (unlisted, None)
+    domain = domain_pddl(rules)
+    fired = set()
+    for pieces in scenes:
+        start = [code(p) for p in pieces]
+        problem = PDDLReader().parse_problem_string(domain, problem_pddl(rules, start, SymbolicGoal(tuple(start)), "p"))
+        with SequentialSimulator(problem) as sim:
+            by_action: dict = {}
+            for a, nxt in _robot_moves(sim, sim.get_initial_state(), rules):
+                by_action.setdefault(a, []).append(nxt)
+        for a in range(36):
+            want, rule = rules.step_pieces(rules.pieces(start), a)
+            assert (rule is not None) == (a in by_action) and len(by_action.get(a, [])) <= 1, f"action {a}, {pieces}"
+            if not isinstance(rule, EndRule):
+                continue
+            fired.add((rule.cls, pieces))
+            after = [code(p) for p in want]
+            expected, _ = _facts(problem_pddl(rules, after, SymbolicGoal(tuple(after)), "p"))
+            got = _true_atoms(problem, by_action[a][0], END_STATE_PREDICATES)
+            assert got == {f for f in expected if f.split()[0][1:] in END_STATE_PREDICATES}, f"action {a}, {pieces}"
+    assert {cls for cls, _ in fired} == {r.cls for r in ends}
+    # the stick lands one layer above the top it finds: on the cube at l3, on the table at l1, back at l1 on the cube
+    assert rules.step_pieces((stick(0, 1), cube(3, 2)), 1 * 6 + 3)[0][0] == Piece(0, True, 3, 2, 3)
+    assert rules.step_pieces((cube(1, 2), stick(1, 3)), 0 * 6 + 0)[0] == (cube(1, 2), stick(1, 3))  # same location
+    assert rules.step_pieces((cube(1, 2), stick(1, 3)), 0 * 6 + 3)[0] == (cube(1, 2), stick(1, 3))  # no rule
+    assert rules.step_pieces((cube(1, 2), stick(1, 3)), 0 * 6 + 1)[0][1] == Piece(1, True, 1, 4, 3)  # back on it
+    assert rules.step_pieces((cube(1, 2), stick(1, 3)), 2 * 6 + 0)[0][1] == Piece(1, True, 0, 5, 1)
+
+
+def test_end_rules_round_trip_through_json_and_a_bad_one_is_refused(pair_rules, tmp_path):
+    import json
+    from pddl_export.end_moves import EndRule
+    rules = dataclasses.replace(pair_rules, end_rules=(EndRule((0, 1, 3), 3, 2, 0, 7, 0.7, (
+        (1, (0, False), (0,), (0, False)), (3, (2, True), (0,), (2, True)))),))
+    path = tmp_path / "lifted.json"
+    path.write_text(json.dumps(rules.to_json()))
+    assert load_lifted(path).end_rules == rules.end_rules
+    for bad, message in (({"class": [0, 2, 3]}, "no pick at a far-row stick's end"),
+                         ({"destination": 1, "place": 0}, "is not one the PDDL states"),
+                         ({"cases": [[1, [0, False], [0, 0], [0, False]]]}, "does not fit its class")):
+        d = rules.to_json()
+        d["end_rules"][0].update(bad)
+        path.write_text(json.dumps(d))
+        with pytest.raises(ValueError, match=f"malformed lifted rules .*{message}"):
+            load_lifted(path)
+
+
+@pytest.mark.parametrize("planner", ["fd-lmcut", "pyperplan"])
+def test_stock_planners_drag_a_stick_by_its_end_in_a_domain_with_pools(pooled_pair_rules, tmp_path,
+                                                                        planner):
+    """The schemas of end rules and of pools, with the static facts they list, are plain typed STRIPS that stock
+    planners take: a stick lying at l0 is picked at its end (l1) and dragged to l3, a 1-step plan pyval accepts."""
+    import pyval
+
+    from pddl_export.end_moves import EndRule
+    from search.stock_planners import solve_files
+    rules = dataclasses.replace(pooled_pair_rules, end_rules=(EndRule((0, 1, 3), 3, 2, 0, 7, 0.7,
+                                                                      ((1, (0, False), (0,), (0, False)),)),))
+    start_pieces = (Piece(1, True, 0, 0, 1), Piece(2, False, 5, 0, 2))
+    want, rule = rules.step_pieces(start_pieces, 1 * 6 + 3)
+    assert isinstance(rule, EndRule) and want[0] == Piece(0, True, 3, 2, 1)
+    start = [rules.code_of(p, 0) for p in start_pieces]
+    goal = [rules.code_of(want[0], 0), None]
+    (tmp_path / "domain.pddl").write_text(domain_pddl(rules))
+    (tmp_path / "p01.pddl").write_text(problem_pddl(rules, start, SymbolicGoal(tuple(goal)), "p01"))
+    res = solve_files(tmp_path / "domain.pddl", tmp_path / "p01.pddl", planner, timeout_s=120,
+                      action_ids=lambda steps: plan_actions(rules, steps))
+    assert res.found and tuple(res.plan) == (1 * 6 + 3,), res.message
+    (tmp_path / "plan.txt").write_text("".join(f"{s}\n" for s in res.steps))
+    verdict = pyval.PDDLValidator().validate(str(tmp_path / "domain.pddl"), str(tmp_path / "p01.pddl"),
+                                             str(tmp_path / "plan.txt"))
+    assert verdict.status == "VALID"
+    assert any(s.statics for s in schemas(rules) if "pooled" in s.name)  # the pools' schemas were in the domain
+
+
+def test_the_presets_of_export_pddl():
+    """fast (the default): no pools, no end rules; accurate: both; --preset with --rules is refused in one line."""
+    from symlearn.export.lifted_export import LIFTED_PRESETS, LiftedConfig
+    assert LIFTED_PRESETS["fast"] == LiftedConfig() and LiftedConfig().pool_min_count == 0 == LiftedConfig().end_min_count
+    acc = LIFTED_PRESETS["accurate"]
+    assert acc.pool_min_count > 0 and acc.end_min_count > 0 and set(acc.pool_classes) == {"cube", "near"}
+    with pytest.raises(ValueError, match="pool_classes=.* must name some of cube, near"):
+        LiftedConfig(pool_classes=("pair",))

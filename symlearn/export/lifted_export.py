@@ -14,6 +14,7 @@ and RUN/pddl/lifted/domain.pddl.
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections import Counter
 from dataclasses import asdict, dataclass
@@ -21,9 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
+from pddl_export.end_moves import distil_end_rules
 from pddl_export.files import atomic_write_text, sha256_file
-from pddl_export.lifted_rules import MIN_GAIN, LiftedRules, build_codebook, distil_lifted, observed_moves, \
-    participants, stick_reader, with_network_answers
+from pddl_export.lifted_rules import MIN_GAIN, POOL_MIN_COUNT, POOL_STRUCTURE_MIN, POOLED_CLASSES, LiftedRules, \
+    build_codebook, distil_lifted, observed_end_moves, observed_moves, participants, stick_reader, \
+    with_network_answers
 from pddl_export.lifted_scene import FIELD_BITS, CodeLayout, kept_bits, read_scene
 from pddl_export.lifted_writer import domain_pddl, schemas
 from pddl_export.rules_io import PDDL_DIR
@@ -56,20 +59,51 @@ class LiftedConfig:
     rider_min_count: int = 3
     # a far-row stick's move names its two locations and grounds to a few actions: it needs only this many
     pair_min_count: int = 6
+    # a structure of pool_classes rarer than min_count takes the majority of its pool (lifted_rules: the class,
+    # place and what it lands on) once the pool has this many moves; 0 (the "fast" preset): no pooling. Each pooled
+    # structure grounds once per block and pair of locations, and the schemas' layer parameters weigh on Fast
+    # Downward's translator: the "accurate" preset (LIFTED_PRESETS) pools, at 1.7-1.9x the translator time
+    pool_min_count: int = 0
+    pool_classes: tuple = POOLED_CLASSES
+    # a structure joins its pool once seen this often: each is a static fact of every problem and, per cube and
+    # location, a ground action for the translator (5 keeps all of the validation splits' gain at 66 facts)
+    pool_structure_min: int = POOL_STRUCTURE_MIN
+    # a pick at a far-row stick's end (pddl_export.end_moves) names its three locations, as a far-row stick's move
+    # names two: a class of them needs this many moves to become a rule; 0 (the "fast" preset): no end rules
+    end_min_count: int = 0
+    # and applies to the cases (the stick's level, the tops it leaves and finds) seen this often: each is a
+    # static fact of every problem and one ground action per stick
+    end_case_min: int = 2
     min_gain: float = MIN_GAIN  # a refinement must explain this share of a node's moves more (distil_lifted)
     min_info: float = 0.25  # a learned bit with this much mutual information (bits) with the location tracks it
 
     def __post_init__(self) -> None:
-        for name in ("min_count", "rider_min_count", "pair_min_count"):
+        for name in ("min_count", "rider_min_count", "pair_min_count", "pool_structure_min", "end_case_min"):
             v = getattr(self, name)
             if not (isinstance(v, int) and not isinstance(v, bool) and v >= 1):
                 raise ValueError(f"{name}={v!r} must be a positive integer")
+        if not (isinstance(self.pool_classes, (tuple, list)) and set(self.pool_classes) <= set(POOLED_CLASSES)):
+            raise ValueError(f"pool_classes={self.pool_classes!r} must name some of {', '.join(POOLED_CLASSES)}")
+        object.__setattr__(self, "pool_classes", tuple(self.pool_classes))
+        for name in ("pool_min_count", "end_min_count"):
+            v = getattr(self, name)
+            if not (isinstance(v, int) and not isinstance(v, bool) and v >= 0):
+                raise ValueError(f"{name}={v!r} must be a non-negative integer (0: none)")
         if self.source not in SOURCES:
             raise ValueError(f"source={self.source!r} must be one of {', '.join(SOURCES)}")
         if not 0 <= self.min_gain < 1:
             raise ValueError(f"min_gain={self.min_gain!r} must lie in [0, 1)")
         if not 0 < self.min_info <= 3:
             raise ValueError(f"min_info={self.min_info!r} must lie in (0, 3]")
+
+
+# Named settings of `export-pddl` (--preset). "fast", the default and the shipped domain: the rules of structures
+# seen min_count times, which Fast Downward translates fastest. "accurate": also the rarer structures of cubes and
+# near-row sticks, pooled, and picks at a far-row stick's end (pair_min_count 8 keeps the file under 100 KB); on
+# the held-out test splits it predicts what the robot saw next more often, and the translator takes 1.7-1.9x as
+# long (docs/DOMAIN.md, "Two presets")
+LIFTED_PRESETS = {"fast": LiftedConfig(),
+                  "accurate": LiftedConfig(pool_min_count=POOL_MIN_COUNT, end_min_count=6, pair_min_count=8)}
 
 
 @dataclass(frozen=True)
@@ -114,9 +148,9 @@ def case_of(pieces, action: int, fired: bool) -> str:
     """What the rules make of a step, given whether a rule fired on it (LiftedRules.step_pieces): "rule", "no
     rule" (a move whose structure has none: rarer than min_count), or why no lifted rule describes it
     (lifted_rules.participants: "same location", "nothing to pick", "a stick's end", ...)."""
-    if fired:
-        return "rule"
     move = participants(read_scene(pieces), *divmod(int(action), 6))
+    if fired:
+        return "rule" if not isinstance(move, str) else f"{move}: an end rule"
     return move if isinstance(move, str) else "no rule"
 
 
@@ -140,7 +174,7 @@ def check_lifted(rules: LiftedRules, split: Split, net_next: np.ndarray) -> dict
                 t["rules_vs_net"] += mine == net
                 t["rules_vs_observed"] += mine == seen
                 t["net_vs_observed"] += net == seen
-                t["rule_fired"] += case == "rule"
+                t["rule_fired"] += rule is not None
                 if mine != net:
                     t["disagree"] += 1
                     t["world_sides_with_rules"] += mine == seen
@@ -185,19 +219,25 @@ def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = 
                             np.concatenate([_pad(s.mask, width) for s in train]),
                             np.concatenate([_pad(s.stick, width) for s in train]), layout)
     probe = LiftedRules(layout, stick_of)
-    moves, answers, why = [], [], Counter()
+    moves, answers, why, ends = [], [], Counter(), []
     for s in train:
         net = network_steps(transition, s.before, s.action, s.mask)
         m, w = observed_moves(probe, s.before, s.after if cfg.source == "observed" else net, s.action, s.mask)
+        ends += observed_end_moves(probe, s.before, s.after if cfg.source == "observed" else net, s.action, s.mask)
         moves += m
         why.update(w)
         if cfg.source == "observed":
             answers += observed_moves(probe, s.before, net, s.action, s.mask)[0]
     rules = distil_lifted(layout, stick_of, moves, cfg.min_count, model_hash,
                           rider_min_count=min(cfg.rider_min_count, cfg.min_count),
-                          pair_min_count=cfg.pair_min_count, min_gain=cfg.min_gain)
+                          pair_min_count=cfg.pair_min_count, min_gain=cfg.min_gain,
+                          pool_min_count=cfg.pool_min_count or None, pool_structure_min=cfg.pool_structure_min,
+                          pool_classes=cfg.pool_classes)
     if answers:  # each rule's share and alternatives are m(z)'s answers on the moves it covers
         rules = with_network_answers(rules, answers)
+    found = distil_end_rules(ends, cfg.end_min_count, cfg.end_case_min) if cfg.end_min_count else ()
+    rules = dataclasses.replace(rules, end_rules=found,
+                                stats={**rules.stats, "end_moves": len(ends)})
     t_distil = time.perf_counter() - t0
     checks = {}
     for d in sets:
@@ -213,7 +253,8 @@ def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = 
     codebook = build_codebook(probe, np.concatenate([_pad(s.before, width) for s in train]
                                                     + [_pad(s.after, width) for s in train]),
                               np.concatenate([_pad(s.mask, width) for s in train] * 2))
-    rules = LiftedRules(layout, stick_of, rules.rules, model_hash, {**rules.stats, **report}, codebook)
+    rules = LiftedRules(layout, stick_of, rules.rules, model_hash,
+                        {**rules.stats, **report, "end_rules": len(rules.end_rules)}, codebook, rules.end_rules)
     (out / LIFTED_DIR).mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / LIFTED_DIR / "domain.pddl", domain)
     atomic_write_json(out / LIFTED_FILE, rules.to_json())
@@ -242,7 +283,7 @@ def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None
     Returns the index; problems with more objects than the data ever showed are listed under `zero_shot`.
     """
     from pddl_export.lifted_rules import load_lifted
-    from pddl_export.lifted_writer import liftable, moves, problem_pddl
+    from pddl_export.lifted_writer import moves, problem_pddl, static_facts
     from symlearn.problems.problem import load_problems
     from symlearn.symbolic.scenes import scene_codes, symbolic_goal
     from symlearn.sim.simulator import TabletopSimulator
@@ -257,15 +298,15 @@ def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None
     index = {"domain": "domain.pddl", "cost_form": f"{COST_FORM_DIR}/domain.pddl", "model_hash": rules.model_hash,
              "source": str(problems_dir), "problems": {}, "zero_shot": []}
     texts = {}
-    pairs = {costs: liftable(moves(rules, costs)) for costs in (False, True)}  # once, not per problem
+    statics = {costs: static_facts(moves(rules, costs)) for costs in (False, True)}  # once, not per problem
     sim = TabletopSimulator()
     try:
         for n, (path, problem) in enumerate(problems):
             name = f"p{n + 1:02d}"
             goal = symbolic_goal(sim, reader, problem)
             start = [int(c) for c in scene_codes(sim, reader, problem.initial)]
-            texts[name] = problem_pddl(rules, start, goal, name, pairs=pairs[False])
-            texts[f"{COST_FORM_DIR}/{name}"] = problem_pddl(rules, start, goal, name, costs=True, pairs=pairs[True])
+            texts[name] = problem_pddl(rules, start, goal, name, statics=statics[False])
+            texts[f"{COST_FORM_DIR}/{name}"] = problem_pddl(rules, start, goal, name, costs=True, statics=statics[True])
             index["problems"][name] = {"file": path.name, "objects": problem.k,
                                        "optimal_length": getattr(problem, "optimal_length", None)}
             if problem.k > MAX_DATA_OBJECTS:

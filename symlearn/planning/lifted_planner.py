@@ -22,7 +22,7 @@ import numpy as np
 
 from pddl_export.files import atomic_write_text
 from pddl_export.lifted_rules import LiftedRules, LiftedTransition
-from pddl_export.lifted_writer import domain_pddl, liftable, moves, plan_decoder, problem_pddl
+from pddl_export.lifted_writer import domain_pddl, moves, plan_decoder, problem_pddl, static_facts
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
 from search.result import PlanResult, PlanStatus, failed
 from search.stock_planners import solve_texts
@@ -42,7 +42,7 @@ class LiftedPlanner:
         self.lifted, self.name, self.engine, self.costs = rules, name, engine, costs
         self.domain = domain_pddl(rules, costs)
         self.decode = plan_decoder(rules, costs)
-        self.pairs = liftable(moves(rules, costs))
+        self.statics = static_facts(moves(rules, costs))
         self.write_dir = None if write_dir is None else Path(write_dir)
         self.calls = 0
 
@@ -68,7 +68,7 @@ class LiftedPlanner:
         t0 = time.perf_counter()
         init = [int(c) for c in start]
         try:
-            problem = problem_pddl(self.lifted, init, goal, "task", self.costs, self.pairs)
+            problem = problem_pddl(self.lifted, init, goal, "task", self.costs, self.statics)
         except ValueError as e:
             return failed(self.name, PlanStatus.ERROR, t0, str(e))
         self._save(problem)
