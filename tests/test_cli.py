@@ -333,7 +333,7 @@ def test_plan_from_tampered_rules_fails_at_rules_vs_net(tiny_run_copy, tmp_path)
     (["export-pddl", "--run", "{run}", "--data", "{data}", "--rules", "--config", "{ratio0}"],
      "outcome_min_ratio=0.0 must lie in (0, 1]"),
     (["export-pddl", "--run", "{run}", "--data", "{data}", "--config", "{typo}"],
-     "typo.toml: [lifted] has no setting 'min_cont'; settings: source, min_count, rider_min_count, pair_min_count, min_gain, min_info"),
+     "typo.toml: [lifted] has no setting 'min_cont'; settings: source, min_count, rider_min_count, pair_min_count, pool_min_count, pool_classes, pool_structure_min, end_min_count, end_case_min, min_gain, min_info"),
     (["plan", "--run", "{run}", "--problem", "{problem}", "--config", "{wrongtype}"],
      "wrongtype.toml: [execution] closed_loop must be a bool, not 'yes'"),
     (["train", "--data", "{data}", "--out", "{empty}/r", "--config", "{table}"],

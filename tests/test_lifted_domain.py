@@ -826,12 +826,17 @@ def test_end_rules_round_trip_through_json_and_a_bad_one_is_refused(pair_rules, 
             load_lifted(path)
 
 
-@pytest.mark.parametrize("planner", ["fd-lmcut", "pyperplan"])
+@pytest.mark.parametrize("planner", ["fd-lmcut", "fd-lama-first"])
 def test_stock_planners_drag_a_stick_by_its_end_in_a_domain_with_pools(pooled_pair_rules, tmp_path,
                                                                         planner):
     """The schemas of end rules and of pools, with the static facts they list, are plain typed STRIPS that stock
-    planners take: a stick lying at l0 is picked at its end (l1) and dragged to l3, a 1-step plan pyval accepts."""
-    import pyval
+    Fast Downward takes: a stick lying at l0 is picked at its end (l1) and dragged to l3, a 1-step plan that
+    unified-planning's validator, reading the files with its own parser, accepts. (pyperplan's grounder enumerates
+    every binding of their six layer parameters before it reads the static facts, and pyval spends minutes on its
+    state bookkeeping for this task: both are left out here; docs/DOMAIN.md.)"""
+    from unified_planning.io import PDDLReader
+    from unified_planning.plans import SequentialPlan
+    from unified_planning.shortcuts import PlanValidator
 
     from pddl_export.end_moves import EndRule
     from search.stock_planners import solve_files
@@ -848,9 +853,12 @@ def test_stock_planners_drag_a_stick_by_its_end_in_a_domain_with_pools(pooled_pa
                       action_ids=lambda steps: plan_actions(rules, steps))
     assert res.found and tuple(res.plan) == (1 * 6 + 3,), res.message
     (tmp_path / "plan.txt").write_text("".join(f"{s}\n" for s in res.steps))
-    verdict = pyval.PDDLValidator().validate(str(tmp_path / "domain.pddl"), str(tmp_path / "p01.pddl"),
-                                             str(tmp_path / "plan.txt"))
-    assert verdict.status == "VALID"
+    reader = PDDLReader()
+    problem = reader.parse_problem(str(tmp_path / "domain.pddl"), str(tmp_path / "p01.pddl"))
+    plan = reader.parse_plan(problem, str(tmp_path / "plan.txt"))
+    with PlanValidator(problem_kind=problem.kind) as validator:
+        assert validator.validate(problem, plan).status.name == "VALID"
+        assert validator.validate(problem, SequentialPlan([])).status.name == "INVALID"  # the stick stays at l0
     assert any(s.statics for s in schemas(rules) if "pooled" in s.name)  # the pools' schemas were in the domain
 
 

@@ -410,7 +410,7 @@ def test_extra_data_joins_training_and_is_tested_apart(tiny_run, tiny_run_copy, 
     extra = tiny_k45
     sizes = {s: len(load_split(extra, s).action) for s in ("train", "val", "test")}
     assert load_split(extra, "train").mask.shape[1] == 5
-    out = cli_json("train-transition", "--run", tiny_run_copy, "--data", tiny_run.data, "--extra-data", extra,
+    out = cli_json("train-transition", "--run", tiny_run_copy, "--data", tiny_run.data, extra,
                    *TINY_TRANSITION_ARGS, "--quiet")
     m = json.loads((tiny_run_copy / METRICS_FILE).read_text())
     assert m["n_samples"] == {"train": 40 + sizes["train"], "val": 4 + sizes["val"], "test": 4}
@@ -429,7 +429,7 @@ def test_extra_data_joins_training_and_is_tested_apart(tiny_run, tiny_run_copy, 
     # the main test split is the same 4 samples as without extra data
     assert m["test"]["n"] == 4
     capsys.readouterr()
-    rc, _ = cli("train-transition", "--run", tiny_run_copy, "--data", tiny_run.data, "--extra-data",
+    rc, _ = cli("train-transition", "--run", tiny_run_copy, "--data", tiny_run.data,
                 tiny_run.data, *TINY_TRANSITION_ARGS, "--quiet")
     assert rc != 0 and "must differ" in capsys.readouterr().err
 

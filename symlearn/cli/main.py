@@ -144,7 +144,7 @@ def cmd_export_lifted(args: argparse.Namespace) -> int:
         load_problems(Path(d))  # a missing, empty or malformed problem set is refused before any work
     set_threads(args.threads)
     out = Path(args.out) if args.out else None
-    rep = export_lifted(Path(args.run), Path(args.data), tuple(Path(d) for d in args.extra_data), cfg, out)
+    rep = export_lifted(Path(args.run), Path(args.data[0]), tuple(Path(d) for d in args.data[1:]), cfg, out)
     where = out or Path(args.run) / "pddl"
     print(f"kept learned bits {rep['kept_bits']} (bits {rep['position_bits']} track the location); "
           f"{rep['moves']} moves on training scenes ({rep['config']['source']} outcomes) -> {rep['rules']} lifted rules "
@@ -179,7 +179,7 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
     cfg = replace_nested(ExportConfig(), read_config_file(args.config).get("export", {}))  # [export]
     out = folder_output(Path(args.out), "--out") if args.out else None  # before hours of enumeration
     set_threads(args.threads)
-    rep = export_pddl(Path(args.run), Path(args.data), cfg, out, extra_data=tuple(Path(d) for d in args.extra_data))
+    rep = export_pddl(Path(args.run), Path(args.data[0]), cfg, out, extra_data=tuple(Path(d) for d in args.data[1:]))
     where = out or Path(args.run) / "pddl"
     print(f"vocabulary {rep['vocabulary_size']} codes; {rep['n_enumerated_cases']} enumerated cases at "
           f"{rep['enumeration_queries_per_s']:.0f} queries/s; rules {rep['n_rules_before_generalization']} -> "
@@ -267,9 +267,9 @@ def add_export_pddl_command(sub) -> None:
     x = sub.add_parser("export-pddl", help="distil the transition network into PDDL: the lifted domain (default) "
                                            "or the rules over whole codes (--rules)")
     x.add_argument("--run", required=True)
-    x.add_argument("--data", required=True, help="the data set whose training scenes m(z) is asked about")
-    x.add_argument("--extra-data", nargs="+", default=[], metavar="DIR",
-                   help="more data sets whose training scenes (and, with --rules, codes) join the main set's")
+    x.add_argument("--data", required=True, nargs="+", metavar="DIR",
+                   help="the data sets whose training scenes m(z) is asked about: the first is the main set, the "
+                        "others' training scenes (and, with --rules, codes) join it")
     x.add_argument("--out", help="output directory (default RUN/pddl)")
     x.add_argument("--rules", action="store_true",
                    help="the rules over whole codes (rules.json, outcomes.json, domain.pddl; read by the rules-* and "
@@ -282,8 +282,8 @@ def add_export_pddl_command(sub) -> None:
                        "(ExportConfig: max_objects, min_count, scenes, larger_scenes, pddl_fidelity_cases, ...)")
     x.add_argument("--preset", default="fast", choices=("fast", "accurate"),
                    help="lifted domain: fast (default: the rules Fast Downward translates fastest) or accurate (also "
-                        "rarer structures, pooled, and picks at a stick's end: closer to what the robot saw, 1.7-1.9x "
-                        "the translator's time; docs/DOMAIN.md); [lifted] settings apply on top")
+                        "rarer structures, pooled, and picks at a stick's end: closer to what the robot saw, 2.6x "
+                        "Fast Downward's time; docs/DOMAIN.md); [lifted] settings apply on top")
     x.add_argument("--threads", type=thread_count, help=THREADS_HELP)
     x.set_defaults(func=cmd_export_pddl)
 

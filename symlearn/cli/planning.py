@@ -59,9 +59,9 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
     modes = f", {cfg.modes} outcome modes" if cfg.modes > 1 else ""
     print(f"train-transition: preset {cfg.preset}, {cfg.attention_rounds} attention round(s){located}{modes}, "
           f"{cfg.epochs} epochs, seed {args.seed}, run {args.run}, "
-          f"data {args.data}" + "".join(f" + {d}" for d in args.extra_data), file=sys.stderr)
-    m = train_transition(Path(args.run), Path(args.data), cfg, seed=args.seed, show_progress=not args.quiet,
-                         extra_data=tuple(Path(d) for d in args.extra_data))
+          f"data {' + '.join(args.data)}", file=sys.stderr)
+    m = train_transition(Path(args.run), Path(args.data[0]), cfg, seed=args.seed, show_progress=not args.quiet,
+                         extra_data=tuple(Path(d) for d in args.data[1:]))
     test = m["test"]
     out = {"run": args.run, "best_val_loss": m["best_val_loss"],
            "test": {k: test[k] for k in ("bit_accuracy", "object_accuracy", "scene_accuracy")},
@@ -263,9 +263,9 @@ def add_train_transition_command(sub) -> None:
     """Add `train-transition` to the CLI's sub-parsers."""
     t = sub.add_parser("train-transition", help="train the symbolic transition model m(z) on a run's codes")
     t.add_argument("--run", required=True, help="run directory with the trained effect model (best.pt)")
-    t.add_argument("--data", required=True, help="the data set to encode")
-    t.add_argument("--extra-data", nargs="+", default=[], metavar="DIR",
-                   help="more data sets whose train and val splits join m(z)'s (their test splits are reported apart)")
+    t.add_argument("--data", required=True, nargs="+", metavar="DIR",
+                   help="the data sets to encode: the first is the main set, the others' train and val splits join "
+                        "m(z)'s (their test splits are reported apart)")
     t.add_argument("--preset", default="recommended", choices=list(TRAIN_PRESET_NAMES),
                    help="recommended (default): the quick network on codes ending with 9 location bits, which the "
                         "lifted domain reads; quick: learned codes only; paper: the paper's layers")

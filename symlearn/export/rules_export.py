@@ -130,7 +130,7 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     """Enumerate, distil, write and check; returns the report (also written as report.json).
 
     extra_data: more data sets whose training codes join the vocabulary counts and the observed scenes
-    (for instance 1-5-object sets the effect model never saw, as `train-transition --extra-data`).
+    (for instance 1-5-object sets the effect model never saw, as the further `--data` sets of `train-transition`).
     """
     from symlearn.data.dataset import data_fingerprint, data_records, distinct_extra_data
     from symlearn.symbolic.learned_transition import planning_models
