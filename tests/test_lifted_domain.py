@@ -528,6 +528,16 @@ def test_export_lifted_and_plan_with_stock_fast_downward_on_a_tiny_run(tiny_run_
                                              str(tmp_path / "cost_tasks" / "problem.pddl"),
                                              str(tmp_path / "cost_plan.txt"))
     assert verdict.status == "VALID"
+    # one reading of the training moves (bench/preset_sweep.py distils several settings from it), distilled under
+    # the export's setting, gives the exported rules; a setting of another source cannot reuse it
+    from symlearn.export.lifted_export import LiftedConfig, distil_rules, training_moves
+    reader, transition = planning_models(run)
+    seen = training_moves(reader, transition, [tiny_data.path], LiftedConfig(min_count=1))
+    assert len(seen.moves) == len(seen.answers) > 0
+    again = distil_rules(seen, LiftedConfig(min_count=1), lifted.model_hash)
+    assert [(r.key, r.outcome, r.support) for r in again.rules] == [(r.key, r.outcome, r.support) for r in lifted.rules]
+    with pytest.raises(ValueError, match="cannot be distilled under source='network'"):
+        distil_rules(seen, LiftedConfig(min_count=1, source="network"), lifted.model_hash)
 
 
 def test_moves_the_world_model_never_makes_still_write_a_domain_fast_downward_reads(world_rules, tmp_path):

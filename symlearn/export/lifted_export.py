@@ -19,6 +19,7 @@ import time
 from collections import Counter
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import Sequence
 
 import numpy as np
 
@@ -117,7 +118,8 @@ class Split:
     stick: np.ndarray  # (N, K) bool: the recorded type (to name what a learned code is)
 
 
-def _split(reader, data_dir: Path, split: str) -> Split:
+def split_codes(reader, data_dir: Path, split: str) -> Split:
+    """One split of a data set (train, val, test) in the run's codes (reader: planning_models)."""
     from symlearn.data.dataset import load_split
     from symlearn.symbolic.symbols import encode_codes
 
@@ -191,24 +193,27 @@ def check_lifted(rules: LiftedRules, split: Split, net_next: np.ndarray) -> dict
     return {group: {**summary(g[""]), "by_case": {c: summary(t) for c, t in by_size(g)}} for group, g in tally.items()}
 
 
-def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = (), cfg: LiftedConfig = LiftedConfig(),
-                  out_dir: Path | None = None) -> dict:
-    """Distil, write and check the lifted domain of a run; returns its report (also in lifted.json)."""
-    from symlearn.data.dataset import data_fingerprint, data_records, distinct_extra_data
-    from symlearn.symbolic.learned_transition import planning_models
-    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
+@dataclass(frozen=True)
+class TrainingMoves:
+    """What the training splits of a run's data sets show, read once: the code layout, the type reader, every
+    move with its outcome (LiftedConfig.source), m(z)'s answers on the same moves, the picks at a stick's end, and
+    why the other steps are no move. distil_rules makes rules of it under any LiftedConfig of the same source and
+    min_info (bench/preset_sweep.py compares settings on one reading)."""
 
-    run_dir = Path(run_dir)
-    out = Path(out_dir) if out_dir else run_dir / PDDL_DIR
-    reader, transition = planning_models(run_dir)
-    if reader.location_bits != FIELD_BITS:
-        raise ValueError(f"{run_dir / TRANSITION_FILE}: a lifted domain needs m(z) on {FIELD_BITS} location bits "
-                         f"(train-transition --location-bits {FIELD_BITS}); this one has {reader.location_bits}")
-    model_hash = sha256_file(run_dir / TRANSITION_FILE)[:16]
-    extra_data = distinct_extra_data(data_dir, extra_data)
-    t0 = time.perf_counter()
-    sets = [Path(d) for d in (data_dir, *extra_data)]
-    train = [_split(reader, d, "train") for d in sets]
+    layout: CodeLayout
+    stick_of: object
+    train: tuple  # Split per data set
+    moves: tuple
+    answers: tuple  # m(z)'s outcome of each move ("observed" source; else empty)
+    ends: tuple
+    why: Counter
+    source: str
+    min_info: float
+
+
+def training_moves(reader, transition, sets: Sequence[Path], cfg: LiftedConfig) -> TrainingMoves:
+    """The moves of the training splits of sets, in the run's codes (reader, transition: planning_models)."""
+    train = [split_codes(reader, d, "train") for d in sets]
     code_bits = reader.bits - FIELD_BITS
     objects = np.concatenate([s.before[s.mask] for s in train])
     learned = bits_from_codes(objects >> FIELD_BITS, code_bits)
@@ -228,20 +233,53 @@ def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = 
         why.update(w)
         if cfg.source == "observed":
             answers += observed_moves(probe, s.before, net, s.action, s.mask)[0]
-    rules = distil_lifted(layout, stick_of, moves, cfg.min_count, model_hash,
+    return TrainingMoves(layout, stick_of, tuple(train), tuple(moves), tuple(answers), tuple(ends), why,
+                         cfg.source, cfg.min_info)
+
+
+def distil_rules(seen: TrainingMoves, cfg: LiftedConfig, model_hash: str) -> LiftedRules:
+    """The lifted rules (with their end rules) of the moves seen, under cfg's counts and pooling."""
+    if (cfg.source, cfg.min_info) != (seen.source, seen.min_info):
+        raise ValueError(f"moves read with source={seen.source!r}, min_info={seen.min_info} cannot be distilled "
+                         f"under source={cfg.source!r}, min_info={cfg.min_info}")
+    rules = distil_lifted(seen.layout, seen.stick_of, list(seen.moves), cfg.min_count, model_hash,
                           rider_min_count=min(cfg.rider_min_count, cfg.min_count),
                           pair_min_count=cfg.pair_min_count, min_gain=cfg.min_gain,
                           pool_min_count=cfg.pool_min_count or None, pool_structure_min=cfg.pool_structure_min,
                           pool_classes=cfg.pool_classes)
-    if answers:  # each rule's share and alternatives are m(z)'s answers on the moves it covers
-        rules = with_network_answers(rules, answers)
-    found = distil_end_rules(ends, cfg.end_min_count, cfg.end_case_min) if cfg.end_min_count else ()
-    rules = dataclasses.replace(rules, end_rules=found,
-                                stats={**rules.stats, "end_moves": len(ends)})
+    if seen.answers:  # each rule's share and alternatives are m(z)'s answers on the moves it covers
+        rules = with_network_answers(rules, list(seen.answers))
+    found = distil_end_rules(list(seen.ends), cfg.end_min_count, cfg.end_case_min) if cfg.end_min_count else ()
+    return dataclasses.replace(rules, end_rules=found, stats={**rules.stats, "end_moves": len(seen.ends)})
+
+
+def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = (), cfg: LiftedConfig = LiftedConfig(),
+                  out_dir: Path | None = None) -> dict:
+    """Distil, write and check the lifted domain of a run; returns its report (also in lifted.json)."""
+    from symlearn.data.dataset import data_fingerprint, data_records, distinct_extra_data
+    from symlearn.symbolic.learned_transition import planning_models
+    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
+
+    run_dir = Path(run_dir)
+    out = Path(out_dir) if out_dir else run_dir / PDDL_DIR
+    reader, transition = planning_models(run_dir)
+    if reader.location_bits != FIELD_BITS:
+        raise ValueError(f"{run_dir / TRANSITION_FILE}: a lifted domain needs m(z) on {FIELD_BITS} location bits "
+                         f"(train-transition --location-bits {FIELD_BITS}); this one has {reader.location_bits}")
+    model_hash = sha256_file(run_dir / TRANSITION_FILE)[:16]
+    extra_data = distinct_extra_data(data_dir, extra_data)
+    t0 = time.perf_counter()
+    sets = [Path(d) for d in (data_dir, *extra_data)]
+    seen = training_moves(reader, transition, sets, cfg)
+    rules = distil_rules(seen, cfg, model_hash)
+    layout, stick_of, train, why = seen.layout, seen.stick_of, seen.train, seen.why
+    code_bits = reader.bits - FIELD_BITS
+    probe = LiftedRules(layout, stick_of)
+    width = max(s.mask.shape[1] for s in train)
     t_distil = time.perf_counter() - t0
     checks = {}
     for d in sets:
-        test = _split(reader, d, "test")
+        test = split_codes(reader, d, "test")
         checks[str(d)] = check_lifted(rules, test, network_steps(transition, test.before, test.action, test.mask))
     domain = domain_pddl(rules)
     report = {"run": str(run_dir), "model_hash": model_hash, "config": asdict(cfg), "data": str(data_dir),
