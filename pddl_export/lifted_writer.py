@@ -38,7 +38,8 @@ as `rules-outcomes` does on the rules over whole codes.
 A cube's move is lifted over both locations (pick-cube's `?from`, the release's `?to`), and so is a stick's moved
 within the near row (`?from`, `?to`); a stick
 moved in or out of the far row covers its row neighbours with its ends, and which of those overlap depends on
-the pair, so its rules name the two locations (`pick-release-stick-l1-l2-...`).
+the pair, so its rules name the two locations (`pick-release-stick-l1-l2-...`); rules that say the same at other
+pairs are written as one schema lifted over the locations, with a static relation listing them (merged_pairs).
 
     >>> text = domain_pddl(rules)                                        # doctest: +SKIP
     >>> problem_pddl(rules, start_codes, goal, "p01")                    # doctest: +SKIP
@@ -47,6 +48,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from dataclasses import dataclass
 from typing import Iterable, Sequence
 
@@ -480,7 +482,8 @@ def liftable(found: Iterable[Schema]) -> list[tuple[str, str]]:
 def static_facts(found: Sequence[Schema]) -> list[str]:
     """The facts of the rules' static relations, which every problem states: the liftable pairs and the pooled
     schemas' structures."""
-    return [f"(liftable {h} {t})" for h, t in liftable(found)] + list(dict.fromkeys(x for s in found for x in s.statics))
+    return [f"(liftable {h} {t})" for h, t in liftable(found)] + \
+        list(dict.fromkeys(x for s in merged_pairs(found) for x in s.statics))
 
 
 def moves(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
@@ -597,6 +600,65 @@ def pool_schema(rules: LiftedRules, number: int, members: Sequence[Rule], cost: 
                   predicate=f"({predicate} ?h - layer ?t - layer ?top - layer ?new - layer)")
 
 
+_LOCATION = re.compile(r"\bl[0-5]\b")  # a location constant in a literal (l0 ... l5; not ?top_l2)
+PAIR_MOVE = "pick-release-stick-far"  # the name of a merged far-row move (merged_pairs)
+
+
+def _pair_template(s: Schema) -> tuple[tuple, tuple, tuple, tuple[str, ...]]:
+    """A far-row move's literals with its locations as parameters: its pick location ?from, its release location
+    ?to, the others (the neighbours its ends cover, where riders land) ?n1, ?n2, ... in the order they first
+    appear; and the locations, in the order of those parameters."""
+    roles = {loc_name(s.pick): "?from", loc_name(s.release): "?to"}
+    for lit in s.pre + s.eff:
+        for c in _LOCATION.findall(lit):
+            roles.setdefault(c, f"?n{len(roles) - 1}")
+    sub = lambda lit: _LOCATION.sub(lambda m: roles[m.group(0)], lit)  # noqa: E731
+    return tuple(roles.values()), tuple(sub(x) for x in s.pre), tuple(sub(x) for x in s.eff), tuple(roles)
+
+
+def merged_pairs(found: Sequence[Schema]) -> tuple[Schema, ...]:
+    """Far-row moves that differ only in their locations as one schema: `pick-release-stick-far-N ?o ?from ?to
+    ?n1 ...`, whose static relation `(pair-move-N ?from ?to ?n1 ...)`, stated in every problem, lists the locations
+    of each move it stands for. The same ground actions, in fewer schemas: Fast Downward's translator pays for
+    every schema it parses, normalises and synthesises invariants over, whether or not it grounds (a far-row move
+    names its locations, one schema per pair and level case: 97 of the shipped domain's 120 schemas; docs/DOMAIN.md).
+    Moves of one pair, and any move alone in its template, stay as they are; the first of a group gives the
+    merged schema its place."""
+    groups: dict[tuple, list[tuple[Schema, tuple[str, ...]]]] = {}
+    for s in found:
+        if s.step == "move" and s.pick is not None:
+            roles, pre, eff, where = _pair_template(s)
+            key = (s.params, roles, pre, eff, s.alternative, s.cost)
+            groups.setdefault(key, []).append((s, where))
+    numbers = {key: n for n, key in enumerate(k for k, v in groups.items() if len({w[:2] for _, w in v}) > 1)}
+    out, done = [], set()
+    for s in found:
+        key = None
+        if s.step == "move" and s.pick is not None:
+            roles, pre, eff, _ = _pair_template(s)
+            key = (s.params, roles, pre, eff, s.alternative, s.cost)
+        if key not in numbers:
+            out.append(s)
+            continue
+        if key in done:
+            continue
+        done.add(key)
+        members = groups[key]
+        n = numbers[key]
+        predicate = f"pair-move-{n}"
+        name = f"{PAIR_MOVE}-{n}" + (f"-alt{s.alternative}" if s.alternative else "")
+        params = (s.params[0],) + tuple((r, "location") for r in roles[:2]) + s.params[1:] + \
+            tuple((r, "location") for r in roles[2:])
+        head = (f"({predicate} {' '.join(roles)})",)
+        comment = (f"; one move at {len(members)} pairs of locations ({predicate} lists them): "
+                   + "; ".join(f"{m.name}, {m.text.split(chr(10), 1)[0].strip().lstrip('; ')}" for m, _ in members))
+        statics = tuple(f"({predicate} {' '.join(w)})" for _, w in members)
+        out.append(Schema(name, None, None, _schema_text(name, params, head + pre, eff, comment), params,
+                          head + pre, eff, s.alternative, s.cost, statics=statics,
+                          predicate=f"({predicate} {' '.join(f'{r} - location' for r in roles)})"))
+    return tuple(out)
+
+
 def schemas(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
     """The domain's action schemas: pick-cube, the release half of every cube's plain move, and every other move
     whole.
@@ -607,7 +669,7 @@ def schemas(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
     rests) pair: a third of the operators, the same robot actions. A release at the location the cube was
     picked from puts it back on what it rested on; `plan_decoder` drops such a pair from the robot's plan.
     """
-    found = moves(rules, costs)
+    found = merged_pairs(moves(rules, costs))
     halves = tuple(_halves(s) for s in found)
     if not any(s.step == "release" for s in halves):
         return halves

@@ -39,7 +39,11 @@ def test_generate_domain_writes_the_runs_lifted_domain_and_problems_a_parser_loa
     costed = parse_domain(folder / index["cost_form"])  # the all-outcomes cost form: one action per outcome
     alternatives = sum(len(r["alternatives"]) for r in json.loads((RECOMMENDED / "pddl" / "lifted.json").read_text())[
         "rules"])
-    assert n < len(costed.actions) <= n + alternatives and f"{len(costed.actions)} schemas, one per outcome" in out
+    from pddl_export.lifted_writer import moves
+    rules = load_lifted(RECOMMENDED / "pddl" / "lifted.json")  # each outcome one action at most; merged far-row
+    assert len(costed.actions) == len(schemas(rules, costs=True))  # moves of one cost are one schema in either form
+    assert n < len(costed.actions) <= 1 + len(moves(rules)) + alternatives
+    assert f"{len(costed.actions)} schemas, one per outcome" in out
     assert len(parse_problem(folder / "costs" / "p01.pddl").objects) == index["problems"]["p01"]["objects"]
     (tmp_path / "lifted_domain" / "notes.txt").write_text("mine")  # a folder holding other files is refused
     r = subprocess.run([sys.executable, str(ROOT / "examples" / "generate_domain.py")], cwd=tmp_path,

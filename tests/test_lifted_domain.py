@@ -175,6 +175,31 @@ def test_the_domain_is_small_plain_strips(world_rules):
         assert word not in text
 
 
+@pytest.mark.parametrize("costs", [False, True])
+def test_far_row_moves_that_differ_only_in_their_locations_are_one_schema(world_rules, costs):
+    """merged_pairs: each pair move stands in exactly one schema (its own, or a merged one whose static facts name
+    its pick and release locations), and the plan decoder reads a merged step's locations back."""
+    from pddl_export.lifted_writer import PAIR_MOVE, merged_pairs, moves, plan_decoder, static_facts
+    whole = moves(world_rules, costs)
+    merged = merged_pairs(whole)
+    joined = [s for s in merged if s.name.startswith(PAIR_MOVE)]
+    pairs = [s for s in whole if s.step == "move" and s.pick is not None]
+    alone = [s for s in merged if s.step == "move" and s.pick is not None]
+    assert joined and len(merged) == len(whole) - sum(len(s.statics) - 1 for s in joined)
+    facts = [f.strip("()").split() for s in joined for f in s.statics]
+    covered = [(int(f[1][1]), int(f[2][1])) for f in facts] + [(s.pick, s.release) for s in alone]
+    assert sorted(covered) == sorted((s.pick, s.release) for s in pairs)
+    assert all(len(set(f[1:])) == len(f) - 1 for f in facts)  # a move's locations are distinct
+    assert set(x for s in joined for x in s.statics) <= set(static_facts(whole))
+    decode = plan_decoder(world_rules, costs)
+    for s in joined:
+        assert [p for p, _ in s.params[:3]] == ["?o", "?from", "?to"] and s.pre[0].startswith(f"(pair-move-")
+        for f in s.statics:
+            words = f.strip("()").split()
+            step = f"({' '.join([s.name, 'o1', words[1], words[2]] + ['x'] * (len(s.params) - 3))})"
+            assert decode([step]) == [(int(words[1][1]) * 6 + int(words[2][1]), s.alternative)]
+
+
 def test_rules_that_write_the_same_action_write_it_once(world_rules):
     """Rules whose keys differ only in what the PDDL leaves unsaid give one schema, which names the others."""
     from pddl_export.lifted_writer import moves, rule_schema

@@ -13,7 +13,8 @@
                (beneath ?l - location ?h - layer) (place ?b - block ?p - position)
                (near ?l - location) (differ ?a - location ?b - location) (is ?a - location ?b - location)
                (hand-empty) (holding ?b - block) (liftable ?h - layer ?t - layer)
-               (bit-0 ?b - block) (no-bit-0 ?b - block) (bit-5 ?b - block) (no-bit-5 ?b - block))
+               (bit-0 ?b - block) (no-bit-0 ?b - block) (bit-5 ?b - block) (no-bit-5 ?b - block)
+               (pair-move-0 ?from - location ?to - location ?n1 - location) (pair-move-1 ?from - location ?to - location ?n1 - location) (pair-move-2 ?from - location ?to - location ?n1 - location) (pair-move-3 ?from - location ?to - location ?n1 - location ?n2 - location) (pair-move-4 ?from - location ?to - location ?n1 - location) (pair-move-5 ?from - location ?to - location ?n1 - location ?n2 - location) (pair-move-6 ?from - location ?to - location ?n1 - location ?n2 - location) (pair-move-7 ?from - location ?to - location ?n1 - location) (pair-move-8 ?from - location ?to - location ?n1 - location ?n2 - location) (pair-move-9 ?from - location ?to - location) (pair-move-10 ?from - location ?to - location ?n1 - location) (pair-move-11 ?from - location ?to - location ?n1 - location) (pair-move-12 ?from - location ?to - location ?n1 - location) (pair-move-13 ?from - location ?to - location ?n1 - location) (pair-move-14 ?from - location ?to - location ?n1 - location) (pair-move-15 ?from - location ?to - location ?n1 - location ?n2 - location) (pair-move-16 ?from - location ?to - location ?n1 - location ?n2 - location) (pair-move-17 ?from - location ?to - location ?n1 - location ?n2 - location) (pair-move-18 ?from - location ?to - location ?n1 - location ?n2 - location) (pair-move-19 ?from - location ?to - location ?n1 - location ?n2 - location) (pair-move-20 ?from - location ?to - location ?n1 - location ?n2 - location) (pair-move-21 ?from - location ?to - location ?n1 - location))
   ; a cube is lifted off the top of its location, which drops to what it rested on; its level and what
   ; it rested on stay with it until a release-cube action puts it down (liftable: the pairs some does)
   (:action pick-cube
@@ -237,14 +238,14 @@
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l0 h1)) (height l0 h3-end) (not (height l1 h1-end)) (height l1 h3)
       (not (height l2 ?top_l2)) (height l2 h3-end) (not (stands ?o l0 h1)) (stands ?o l1 h3)))
-  ; 31 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l2-28
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l2 h0))
-    :effect (and (not (at ?o l0)) (at ?o l2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
-      (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0) (not (height l2 h0)) (height l2 h1)
-      (not (stands ?o l0 h1)) (stands ?o l2 h1)))
+  ; one move at 2 pairs of locations (pair-move-0 lists them): pick-release-stick-l0-l2-28, 31 moves: a stick lands on its release location at level 1; pick-release-stick-l2-l0-51, 23 moves: a stick lands on its release location at level 1
+  (:action pick-release-stick-far-0
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location)
+    :precondition (and (hand-empty) (pair-move-0 ?from ?to ?n1) (at ?o ?from) (level ?o h1) (rests ?o h0)
+      (place ?o on-spot) (beneath ?n1 h0) (height ?from h1) (height ?n1 h1-end) (height ?to h0))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
+      (not (no-bit-5 ?o)) (not (height ?from h1)) (height ?from h0) (not (height ?to h0)) (height ?to h1)
+      (not (stands ?o ?from h1)) (stands ?o ?to h1)))
   ; 5 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l2-29
     :parameters (?o - stick ?r0 - block)
@@ -256,44 +257,45 @@
       (place ?r0 plus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
       (not (height l0 h1)) (height l0 h0) (not (height l2 h0)) (height l2 h1) (not (stands ?o l0 h1))
       (stands ?o l2 h1)))
-  ; 7 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l2-30
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l0) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (beneath l1 h0) (height l0 h3) (height l1 h3-end) (height l2 h0))
-    :effect (and (not (at ?o l0)) (at ?o l2) (not (rests ?o h2)) (rests ?o h0) (not (level ?o h3))
-      (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h3))
-      (height l0 h2) (not (height l1 h3-end)) (height l1 h1-end) (not (height l2 h0)) (height l2 h1)
-      (not (stands ?o l0 h3)) (stands ?o l2 h1)))
-  ; 11 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l3-31
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l3 h0))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l3) (no-bit-0 ?o) (not (bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end))
-      (height l1 h0) (not (height l3 h0)) (height l3 h1) (not (stands ?o l0 h1)) (stands ?o l3 h1)))
-  ; 3 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l3-32
-    :parameters (?o - stick ?r0 - block)
-    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
-      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l0 h1) (height l1 h3)
-      (height l3 h0))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l3) (no-bit-0 ?o) (not (bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (at ?r0 l1)) (at ?r0 l4)
-      (not (place ?r0 on-spot)) (place ?r0 minus-y-mid) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0)
-      (not (bit-5 ?r0)) (not (height l0 h1)) (height l0 h0) (not (height l1 h3)) (height l1 h0)
-      (not (height l3 h0)) (height l3 h1) (not (stands ?o l0 h1)) (stands ?o l3 h1) (not (stands ?r0 l1 h3))
-      (stands ?r0 l4 h3)))
-  ; 8 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l0-l3-33
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l3 h2))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l3) (not (rests ?o h0)) (rests ?o h2)
-      (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l3 h2))
-      (height l3 h3) (not (stands ?o l0 h1)) (stands ?o l3 h3)))
+  ; one move at 2 pairs of locations (pair-move-1 lists them): pick-release-stick-l0-l2-30, 7 moves: a stick lands on its release location at level 1; pick-release-stick-l2-l0-53, 6 moves: a stick lands on its release location at level 1
+  (:action pick-release-stick-far-1
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location)
+    :precondition (and (hand-empty) (pair-move-1 ?from ?to ?n1) (at ?o ?from) (level ?o h3) (rests ?o h2)
+      (place ?o on-spot) (beneath ?n1 h0) (height ?from h3) (height ?n1 h3-end) (height ?to h0))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h2)) (rests ?o h0)
+      (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
+      (not (height ?from h3)) (height ?from h2) (not (height ?n1 h3-end)) (height ?n1 h1-end)
+      (not (height ?to h0)) (height ?to h1) (not (stands ?o ?from h3)) (stands ?o ?to h1)))
+  ; one move at 6 pairs of locations (pair-move-2 lists them): pick-release-stick-l0-l3-31, 11 moves: a stick lands on its release location at level 1; pick-release-stick-l0-l4-35, 14 moves: a stick lands on its release location at level 1; pick-release-stick-l0-l5-38, 14 moves: a stick lands on its release location at level 1; pick-release-stick-l2-l3-56, 13 moves: a stick lands on its release location at level 1; pick-release-stick-l2-l4-61, 13 moves: a stick lands on its release location at level 1; pick-release-stick-l2-l5-65, 25 moves: a stick lands on its release location at level 1
+  (:action pick-release-stick-far-2
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location)
+    :precondition (and (hand-empty) (pair-move-2 ?from ?to ?n1) (at ?o ?from) (level ?o h1) (rests ?o h0)
+      (place ?o on-spot) (beneath ?n1 h0) (height ?from h1) (height ?n1 h1-end) (height ?to h0))
+    :effect (and (not (beneath ?n1 h0)) (not (at ?o ?from)) (at ?o ?to) (no-bit-0 ?o)
+      (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?from h1)) (height ?from h0)
+      (not (height ?n1 h1-end)) (height ?n1 h0) (not (height ?to h0)) (height ?to h1)
+      (not (stands ?o ?from h1)) (stands ?o ?to h1)))
+  ; one move at 2 pairs of locations (pair-move-3 lists them): pick-release-stick-l0-l3-32, 3 moves: a stick lands on its release location at level 1; pick-release-stick-l0-l4-36, 4 moves: a stick lands on its release location at level 1
+  (:action pick-release-stick-far-3
+    :parameters (?o - stick ?from - location ?to - location ?r0 - block ?n1 - location ?n2 - location)
+    :precondition (and (hand-empty) (pair-move-3 ?from ?to ?n1 ?n2) (at ?o ?from) (level ?o h1)
+      (rests ?o h0) (place ?o on-spot) (at ?r0 ?n1) (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot)
+      (beneath ?n1 h0) (height ?from h1) (height ?n1 h3) (height ?to h0))
+    :effect (and (not (beneath ?n1 h0)) (not (at ?o ?from)) (at ?o ?to) (no-bit-0 ?o)
+      (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0)
+      (not (at ?r0 ?n1)) (at ?r0 ?n2) (not (place ?r0 on-spot)) (place ?r0 minus-y-mid) (no-bit-0 ?r0)
+      (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0)) (not (height ?from h1)) (height ?from h0)
+      (not (height ?n1 h3)) (height ?n1 h0) (not (height ?to h0)) (height ?to h1) (not (stands ?o ?from h1))
+      (stands ?o ?to h1) (not (stands ?r0 ?n1 h3)) (stands ?r0 ?n2 h3)))
+  ; one move at 5 pairs of locations (pair-move-4 lists them): pick-release-stick-l0-l3-33, 8 moves: a stick lands on its release location at level 3; pick-release-stick-l0-l4-37, 10 moves: a stick lands on its release location at level 3; pick-release-stick-l0-l5-40, 6 moves: a stick lands on its release location at level 3; pick-release-stick-l2-l3-58, 10 moves: a stick lands on its release location at level 3; pick-release-stick-l2-l4-63, 14 moves: a stick lands on its release location at level 3
+  (:action pick-release-stick-far-4
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location)
+    :precondition (and (hand-empty) (pair-move-4 ?from ?to ?n1) (at ?o ?from) (level ?o h1) (rests ?o h0)
+      (place ?o on-spot) (beneath ?n1 h0) (height ?from h1) (height ?n1 h1-end) (height ?to h2))
+    :effect (and (not (beneath ?n1 h0)) (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0))
+      (rests ?o h2) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o)
+      (not (bit-5 ?o)) (not (height ?from h1)) (height ?from h0) (not (height ?n1 h1-end)) (height ?n1 h0)
+      (not (height ?to h2)) (height ?to h3) (not (stands ?o ?from h1)) (stands ?o ?to h3)))
   ; 8 moves: a stick ends off its release location at level 1
   (:action pick-release-stick-l0-l3-34
     :parameters (?o - stick)
@@ -302,43 +304,6 @@
     :effect (and (not (at ?o l0)) (at ?o l3) (not (place ?o minus-y-far)) (place ?o minus-y-mid)
       (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0)
       (not (height l3 h0)) (height l3 h1) (not (stands ?o l0 h1)) (stands ?o l3 h1)))
-  ; 14 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l4-35
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l4 h0))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l4) (no-bit-0 ?o) (not (bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end))
-      (height l1 h0) (not (height l4 h0)) (height l4 h1) (not (stands ?o l0 h1)) (stands ?o l4 h1)))
-  ; 4 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l4-36
-    :parameters (?o - stick ?r0 - block)
-    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
-      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l0 h1) (height l1 h3)
-      (height l4 h0))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l4) (no-bit-0 ?o) (not (bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (at ?r0 l1)) (at ?r0 l5)
-      (not (place ?r0 on-spot)) (place ?r0 minus-y-mid) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0)
-      (not (bit-5 ?r0)) (not (height l0 h1)) (height l0 h0) (not (height l1 h3)) (height l1 h0)
-      (not (height l4 h0)) (height l4 h1) (not (stands ?o l0 h1)) (stands ?o l4 h1) (not (stands ?r0 l1 h3))
-      (stands ?r0 l5 h3)))
-  ; 10 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l0-l4-37
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l4 h2))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l4) (not (rests ?o h0)) (rests ?o h2)
-      (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l4 h2))
-      (height l4 h3) (not (stands ?o l0 h1)) (stands ?o l4 h3)))
-  ; 14 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l0-l5-38
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l5 h0))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l5) (no-bit-0 ?o) (not (bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end))
-      (height l1 h0) (not (height l5 h0)) (height l5 h1) (not (stands ?o l0 h1)) (stands ?o l5 h1)))
   ; 3 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l0-l5-39
     :parameters (?o - stick ?r0 - block)
@@ -350,15 +315,6 @@
       (place ?r0 plus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
       (not (height l0 h1)) (height l0 h0) (not (height l5 h0)) (height l5 h1) (not (stands ?o l0 h1))
       (stands ?o l5 h1)))
-  ; 6 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l0-l5-40
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l0) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l0 h1) (height l1 h1-end) (height l5 h2))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l0)) (at ?o l5) (not (rests ?o h0)) (rests ?o h2)
-      (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height l0 h1)) (height l0 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l5 h2))
-      (height l5 h3) (not (stands ?o l0 h1)) (stands ?o l5 h3)))
   ; 21 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l0-41
     :parameters (?o - stick)
@@ -397,53 +353,27 @@
       (rests ?r0 h0) (not (place ?r0 on-spot)) (place ?r0 plus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0))
       (no-bit-5 ?r0) (not (bit-5 ?r0)) (not (height l1 h1)) (height l1 h1-end) (not (height l0 h1-end))
       (height l0 h0) (not (stands ?o l1 h1)) (stands ?o l2 h1)))
-  ; 11 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l1-l3-45
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l3 h0))
-    :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l3)
-      (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l1 h1)) (height l1 h0)
-      (not (height l0 h1-end)) (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l3 h0))
-      (height l3 h1) (not (stands ?o l1 h1)) (stands ?o l3 h1)))
-  ; 8 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l1-l3-46
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l3 h2))
-    :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l3)
+  ; one move at 3 pairs of locations (pair-move-5 lists them): pick-release-stick-l1-l3-45, 11 moves: a stick lands on its release location at level 1; pick-release-stick-l1-l4-47, 10 moves: a stick lands on its release location at level 1; pick-release-stick-l1-l5-48, 10 moves: a stick lands on its release location at level 1
+  (:action pick-release-stick-far-5
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location ?n2 - location)
+    :precondition (and (hand-empty) (pair-move-5 ?from ?to ?n1 ?n2) (at ?o ?from) (level ?o h1)
+      (rests ?o h0) (place ?o on-spot) (beneath ?n1 h0) (beneath ?n2 h0) (height ?from h1) (height ?n1 h1-end)
+      (height ?n2 h1-end) (height ?to h0))
+    :effect (and (not (beneath ?n1 h0)) (not (beneath ?n2 h0)) (not (at ?o ?from)) (at ?o ?to)
+      (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?from h1)) (height ?from h0)
+      (not (height ?n1 h1-end)) (height ?n1 h0) (not (height ?n2 h1-end)) (height ?n2 h0)
+      (not (height ?to h0)) (height ?to h1) (not (stands ?o ?from h1)) (stands ?o ?to h1)))
+  ; one move at 2 pairs of locations (pair-move-6 lists them): pick-release-stick-l1-l3-46, 8 moves: a stick lands on its release location at level 3; pick-release-stick-l1-l5-49, 9 moves: a stick lands on its release location at level 3
+  (:action pick-release-stick-far-6
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location ?n2 - location)
+    :precondition (and (hand-empty) (pair-move-6 ?from ?to ?n1 ?n2) (at ?o ?from) (level ?o h1)
+      (rests ?o h0) (place ?o on-spot) (beneath ?n1 h0) (beneath ?n2 h0) (height ?from h1) (height ?n1 h1-end)
+      (height ?n2 h1-end) (height ?to h2))
+    :effect (and (not (beneath ?n1 h0)) (not (beneath ?n2 h0)) (not (at ?o ?from)) (at ?o ?to)
       (not (rests ?o h0)) (rests ?o h2) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o))
-      (no-bit-5 ?o) (not (bit-5 ?o)) (not (height l1 h1)) (height l1 h0) (not (height l0 h1-end))
-      (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l3 h2)) (height l3 h3)
-      (not (stands ?o l1 h1)) (stands ?o l3 h3)))
-  ; 10 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l1-l4-47
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l4 h0))
-    :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l4)
-      (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l1 h1)) (height l1 h0)
-      (not (height l0 h1-end)) (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l4 h0))
-      (height l4 h1) (not (stands ?o l1 h1)) (stands ?o l4 h1)))
-  ; 10 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l1-l5-48
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l5 h0))
-    :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l5)
-      (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l1 h1)) (height l1 h0)
-      (not (height l0 h1-end)) (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l5 h0))
-      (height l5 h1) (not (stands ?o l1 h1)) (stands ?o l5 h1)))
-  ; 9 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l1-l5-49
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l1) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l0 h0) (beneath l2 h0) (height l1 h1) (height l0 h1-end) (height l2 h1-end) (height l5 h2))
-    :effect (and (not (beneath l0 h0)) (not (beneath l2 h0)) (not (at ?o l1)) (at ?o l5)
-      (not (rests ?o h0)) (rests ?o h2) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o))
-      (no-bit-5 ?o) (not (bit-5 ?o)) (not (height l1 h1)) (height l1 h0) (not (height l0 h1-end))
-      (height l0 h0) (not (height l2 h1-end)) (height l2 h0) (not (height l5 h2)) (height l5 h3)
-      (not (stands ?o l1 h1)) (stands ?o l5 h3)))
+      (no-bit-5 ?o) (not (bit-5 ?o)) (not (height ?from h1)) (height ?from h0) (not (height ?n1 h1-end))
+      (height ?n1 h0) (not (height ?n2 h1-end)) (height ?n2 h0) (not (height ?to h2)) (height ?to h3)
+      (not (stands ?o ?from h1)) (stands ?o ?to h3)))
   ; 7 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l1-l5-50
     :parameters (?o - stick)
@@ -453,14 +383,6 @@
       (not (level ?o h3)) (level ?o h1) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
       (not (height l1 h3)) (height l1 h0) (not (height l0 h3-end)) (height l0 h0) (not (height l2 h3-end))
       (height l2 h2) (not (height l5 h0)) (height l5 h1) (not (stands ?o l1 h3)) (stands ?o l5 h1)))
-  ; 23 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l0-51
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l0 h0))
-    :effect (and (not (at ?o l2)) (at ?o l0) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
-      (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l0 h0)) (height l0 h1)
-      (not (stands ?o l2 h1)) (stands ?o l0 h1)))
   ; 3 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l0-52
     :parameters (?o - stick ?r0 - block)
@@ -472,15 +394,6 @@
       (place ?r0 minus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
       (not (height l2 h1)) (height l2 h0) (not (height l0 h0)) (height l0 h1) (not (stands ?o l2 h1))
       (stands ?o l0 h1)))
-  ; 6 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l0-53
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l2) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (beneath l1 h0) (height l2 h3) (height l1 h3-end) (height l0 h0))
-    :effect (and (not (at ?o l2)) (at ?o l0) (not (rests ?o h2)) (rests ?o h0) (not (level ?o h3))
-      (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h3))
-      (height l2 h2) (not (height l1 h3-end)) (height l1 h1-end) (not (height l0 h0)) (height l0 h1)
-      (not (stands ?o l2 h3)) (stands ?o l0 h1)))
   ; 22 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l1-54
     :parameters (?o - stick)
@@ -501,14 +414,6 @@
       (not (no-bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0)) (not (height l2 h1)) (height l2 h1-end)
       (not (height l1 h3)) (height l1 h1) (not (height l0 h0)) (height l0 h3) (not (stands ?o l2 h1))
       (stands ?o l1 h1) (not (stands ?r0 l1 h3)) (stands ?r0 l0 h3)))
-  ; 13 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l3-56
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l3 h0))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l3) (no-bit-0 ?o) (not (bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end))
-      (height l1 h0) (not (height l3 h0)) (height l3 h1) (not (stands ?o l2 h1)) (stands ?o l3 h1)))
   ; 4 moves: a stick lands on its release location at level 1
   (:action pick-release-stick-l2-l3-57
     :parameters (?o - stick ?r0 - block)
@@ -520,15 +425,6 @@
       (place ?r0 minus-y-far) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
       (not (height l2 h1)) (height l2 h0) (not (height l3 h0)) (height l3 h1) (not (stands ?o l2 h1))
       (stands ?o l3 h1)))
-  ; 10 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l2-l3-58
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l3 h2))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l3) (not (rests ?o h0)) (rests ?o h2)
-      (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l3 h2))
-      (height l3 h3) (not (stands ?o l2 h1)) (stands ?o l3 h3)))
   ; 3 moves: a stick lands on its release location at level 4
   (:action pick-release-stick-l2-l3-59
     :parameters (?o - stick ?r0 - block)
@@ -541,205 +437,129 @@
       (not (level ?r0 h3)) (level ?r0 h1) (bit-0 ?r0) (not (no-bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0))
       (not (height l2 h1)) (height l2 h0) (not (height l1 h3)) (height l1 h1) (not (height l3 h2))
       (height l3 h4) (not (stands ?o l2 h1)) (stands ?o l3 h4) (not (stands ?r0 l1 h3)) (stands ?r0 l1 h1)))
-  ; 8 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l3-60
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l2) (level ?o h3) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h2) (height l2 h3) (height l1 h3-end) (height l3 h0))
-    :effect (and (not (beneath l1 h2)) (not (at ?o l2)) (at ?o l3) (not (level ?o h3)) (level ?o h1)
-      (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h3)) (height l2 h0)
-      (not (height l1 h3-end)) (height l1 h2) (not (height l3 h0)) (height l3 h1) (not (stands ?o l2 h3))
-      (stands ?o l3 h1)))
-  ; 13 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l4-61
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l4 h0))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l4) (no-bit-0 ?o) (not (bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end))
-      (height l1 h0) (not (height l4 h0)) (height l4 h1) (not (stands ?o l2 h1)) (stands ?o l4 h1)))
-  ; 7 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l4-62
-    :parameters (?o - stick ?r0 - block)
-    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
-      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3)
-      (height l4 h0))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l4) (no-bit-0 ?o) (not (bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (at ?r0 l1)) (at ?r0 l3)
-      (not (place ?r0 on-spot)) (place ?r0 plus-y-mid) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0)
-      (not (bit-5 ?r0)) (not (height l2 h1)) (height l2 h0) (not (height l1 h3)) (height l1 h0)
-      (not (height l4 h0)) (height l4 h1) (not (stands ?o l2 h1)) (stands ?o l4 h1) (not (stands ?r0 l1 h3))
-      (stands ?r0 l3 h3)))
-  ; 14 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l2-l4-63
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l4 h2))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l4) (not (rests ?o h0)) (rests ?o h2)
+  ; one move at 2 pairs of locations (pair-move-7 lists them): pick-release-stick-l2-l3-60, 8 moves: a stick lands on its release location at level 1; pick-release-stick-l2-l5-67, 6 moves: a stick lands on its release location at level 1
+  (:action pick-release-stick-far-7
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location)
+    :precondition (and (hand-empty) (pair-move-7 ?from ?to ?n1) (at ?o ?from) (level ?o h3) (rests ?o h0)
+      (place ?o on-spot) (beneath ?n1 h2) (height ?from h3) (height ?n1 h3-end) (height ?to h0))
+    :effect (and (not (beneath ?n1 h2)) (not (at ?o ?from)) (at ?o ?to) (not (level ?o h3))
+      (level ?o h1) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?from h3))
+      (height ?from h0) (not (height ?n1 h3-end)) (height ?n1 h2) (not (height ?to h0)) (height ?to h1)
+      (not (stands ?o ?from h3)) (stands ?o ?to h1)))
+  ; one move at 2 pairs of locations (pair-move-8 lists them): pick-release-stick-l2-l4-62, 7 moves: a stick lands on its release location at level 1; pick-release-stick-l2-l5-66, 5 moves: a stick lands on its release location at level 1
+  (:action pick-release-stick-far-8
+    :parameters (?o - stick ?from - location ?to - location ?r0 - block ?n1 - location ?n2 - location)
+    :precondition (and (hand-empty) (pair-move-8 ?from ?to ?n1 ?n2) (at ?o ?from) (level ?o h1)
+      (rests ?o h0) (place ?o on-spot) (at ?r0 ?n1) (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot)
+      (beneath ?n1 h0) (height ?from h1) (height ?n1 h3) (height ?to h0))
+    :effect (and (not (beneath ?n1 h0)) (not (at ?o ?from)) (at ?o ?to) (no-bit-0 ?o)
+      (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0)
+      (not (at ?r0 ?n1)) (at ?r0 ?n2) (not (place ?r0 on-spot)) (place ?r0 plus-y-mid) (no-bit-0 ?r0)
+      (not (bit-0 ?r0)) (no-bit-5 ?r0) (not (bit-5 ?r0)) (not (height ?from h1)) (height ?from h0)
+      (not (height ?n1 h3)) (height ?n1 h0) (not (height ?to h0)) (height ?to h1) (not (stands ?o ?from h1))
+      (stands ?o ?to h1) (not (stands ?r0 ?n1 h3)) (stands ?r0 ?n2 h3)))
+  ; one move at 2 pairs of locations (pair-move-9 lists them): pick-release-stick-l2-l4-64, 14 moves: a stick ends off its release location at level 1; pick-release-stick-l2-l5-68, 6 moves: a stick ends off its release location at level 1
+  (:action pick-release-stick-far-9
+    :parameters (?o - stick ?from - location ?to - location)
+    :precondition (and (hand-empty) (pair-move-9 ?from ?to) (at ?o ?from) (level ?o h1) (rests ?o h0)
+      (place ?o plus-y-mid) (height ?from h1) (height ?to h0))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o)
+      (not (no-bit-5 ?o)) (not (height ?from h1)) (height ?from h0) (not (height ?to h0)) (height ?to h1)
+      (not (stands ?o ?from h1)) (stands ?o ?to h1)))
+  ; one move at 6 pairs of locations (pair-move-10 lists them): pick-release-stick-l3-l0-69, 80 moves: a stick lands on its release location at level 1; pick-release-stick-l3-l2-79, 69 moves: a stick lands on its release location at level 1; pick-release-stick-l4-l0-84, 65 moves: a stick lands on its release location at level 1; pick-release-stick-l4-l2-97, 53 moves: a stick lands on its release location at level 1; pick-release-stick-l5-l0-102, 58 moves: a stick lands on its release location at level 1; pick-release-stick-l5-l2-113, 63 moves: a stick lands on its release location at level 1
+  (:action pick-release-stick-far-10
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location)
+    :precondition (and (hand-empty) (pair-move-10 ?from ?to ?n1) (at ?o ?from) (level ?o h1) (rests ?o h0)
+      (place ?o on-spot) (height ?from h1) (height ?to h0) (height ?n1 h0))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (beneath ?n1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
+      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?from h1)) (height ?from h0) (not (height ?to h0))
+      (height ?to h1) (not (height ?n1 h0)) (height ?n1 h1-end) (not (stands ?o ?from h1)) (stands ?o ?to h1)))
+  ; one move at 6 pairs of locations (pair-move-11 lists them): pick-release-stick-l3-l0-70, 13 moves: a stick lands on its release location at level 3; pick-release-stick-l3-l2-80, 15 moves: a stick lands on its release location at level 3; pick-release-stick-l4-l0-85, 10 moves: a stick lands on its release location at level 3; pick-release-stick-l4-l2-98, 10 moves: a stick lands on its release location at level 3; pick-release-stick-l5-l0-103, 12 moves: a stick lands on its release location at level 3; pick-release-stick-l5-l2-114, 11 moves: a stick lands on its release location at level 3
+  (:action pick-release-stick-far-11
+    :parameters (?o - stick ?from - location ?to - location ?top_l1 - layer ?n1 - location)
+    :precondition (and (hand-empty) (pair-move-11 ?from ?to ?n1) (at ?o ?from) (level ?o h1) (rests ?o h0)
+      (place ?o on-spot) (height ?from h1) (height ?to h0) (same-level ?top_l1 h2) (height ?n1 ?top_l1))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (beneath ?n1 h2) (not (level ?o h1)) (level ?o h3)
+      (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?from h1)) (height ?from h0)
+      (not (height ?to h0)) (height ?to h3) (not (height ?n1 ?top_l1)) (height ?n1 h3-end)
+      (not (stands ?o ?from h1)) (stands ?o ?to h3)))
+  ; one move at 6 pairs of locations (pair-move-12 lists them): pick-release-stick-l3-l0-71, 17 moves: a stick lands on its release location at level 3; pick-release-stick-l3-l2-81, 12 moves: a stick lands on its release location at level 3; pick-release-stick-l4-l0-86, 18 moves: a stick lands on its release location at level 3; pick-release-stick-l4-l2-99, 19 moves: a stick lands on its release location at level 3; pick-release-stick-l5-l0-104, 17 moves: a stick lands on its release location at level 3; pick-release-stick-l5-l2-115, 14 moves: a stick lands on its release location at level 3
+  (:action pick-release-stick-far-12
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location)
+    :precondition (and (hand-empty) (pair-move-12 ?from ?to ?n1) (at ?o ?from) (level ?o h1) (rests ?o h0)
+      (place ?o on-spot) (height ?from h1) (height ?to h2) (height ?n1 h0))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h2) (beneath ?n1 h0)
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end)) (height l1 h0) (not (height l4 h2))
-      (height l4 h3) (not (stands ?o l2 h1)) (stands ?o l4 h3)))
-  ; 14 moves: a stick ends off its release location at level 1
-  (:action pick-release-stick-l2-l4-64
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o plus-y-mid)
-      (height l2 h1) (height l4 h0))
-    :effect (and (not (at ?o l2)) (at ?o l4) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o)
-      (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l4 h0)) (height l4 h1)
-      (not (stands ?o l2 h1)) (stands ?o l4 h1)))
-  ; 25 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l5-65
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h0) (height l2 h1) (height l1 h1-end) (height l5 h0))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l5) (no-bit-0 ?o) (not (bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l1 h1-end))
-      (height l1 h0) (not (height l5 h0)) (height l5 h1) (not (stands ?o l2 h1)) (stands ?o l5 h1)))
-  ; 5 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l5-66
-    :parameters (?o - stick ?r0 - block)
-    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o on-spot) (at ?r0 l1)
-      (level ?r0 h3) (rests ?r0 h1-end) (place ?r0 on-spot) (beneath l1 h0) (height l2 h1) (height l1 h3)
-      (height l5 h0))
-    :effect (and (not (beneath l1 h0)) (not (at ?o l2)) (at ?o l5) (no-bit-0 ?o) (not (bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (rests ?r0 h1-end)) (rests ?r0 h0) (not (at ?r0 l1)) (at ?r0 l4)
-      (not (place ?r0 on-spot)) (place ?r0 plus-y-mid) (no-bit-0 ?r0) (not (bit-0 ?r0)) (no-bit-5 ?r0)
-      (not (bit-5 ?r0)) (not (height l2 h1)) (height l2 h0) (not (height l1 h3)) (height l1 h0)
-      (not (height l5 h0)) (height l5 h1) (not (stands ?o l2 h1)) (stands ?o l5 h1) (not (stands ?r0 l1 h3))
-      (stands ?r0 l4 h3)))
-  ; 6 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l2-l5-67
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l2) (level ?o h3) (rests ?o h0) (place ?o on-spot)
-      (beneath l1 h2) (height l2 h3) (height l1 h3-end) (height l5 h0))
-    :effect (and (not (beneath l1 h2)) (not (at ?o l2)) (at ?o l5) (not (level ?o h3)) (level ?o h1)
-      (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l2 h3)) (height l2 h0)
-      (not (height l1 h3-end)) (height l1 h2) (not (height l5 h0)) (height l5 h1) (not (stands ?o l2 h3))
-      (stands ?o l5 h1)))
-  ; 6 moves: a stick ends off its release location at level 1
-  (:action pick-release-stick-l2-l5-68
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l2) (level ?o h1) (rests ?o h0) (place ?o plus-y-mid)
-      (height l2 h1) (height l5 h0))
-    :effect (and (not (at ?o l2)) (at ?o l5) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o)
-      (not (no-bit-5 ?o)) (not (height l2 h1)) (height l2 h0) (not (height l5 h0)) (height l5 h1)
-      (not (stands ?o l2 h1)) (stands ?o l5 h1)))
-  ; 80 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l3-l0-69
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l0 h0) (height l1 h0))
-    :effect (and (not (at ?o l3)) (at ?o l0) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0) (not (height l0 h0)) (height l0 h1)
-      (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l3 h1)) (stands ?o l0 h1)))
-  ; 13 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l0-70
-    :parameters (?o - stick ?top_l1 - layer)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l0 h0) (same-level ?top_l1 h2) (height l1 ?top_l1))
-    :effect (and (not (at ?o l3)) (at ?o l0) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
-      (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0)
-      (not (height l0 h0)) (height l0 h3) (not (height l1 ?top_l1)) (height l1 h3-end) (not (stands ?o l3 h1))
-      (stands ?o l0 h3)))
-  ; 17 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l0-71
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l0 h2) (height l1 h0))
-    :effect (and (not (at ?o l3)) (at ?o l0) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
-      (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height l3 h1)) (height l3 h0) (not (height l0 h2)) (height l0 h3) (not (height l1 h0))
-      (height l1 h3-end) (not (stands ?o l3 h1)) (stands ?o l0 h3)))
-  ; 21 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l3-l0-72
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l3 h3) (height l0 h0) (height l1 h0))
-    :effect (and (not (at ?o l3)) (at ?o l0) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
+      (not (height ?from h1)) (height ?from h0) (not (height ?to h2)) (height ?to h3) (not (height ?n1 h0))
+      (height ?n1 h3-end) (not (stands ?o ?from h1)) (stands ?o ?to h3)))
+  ; one move at 6 pairs of locations (pair-move-13 lists them): pick-release-stick-l3-l0-72, 21 moves: a stick lands on its release location at level 1; pick-release-stick-l3-l2-83, 17 moves: a stick lands on its release location at level 1; pick-release-stick-l4-l0-87, 21 moves: a stick lands on its release location at level 1; pick-release-stick-l4-l2-101, 19 moves: a stick lands on its release location at level 1; pick-release-stick-l5-l0-106, 25 moves: a stick lands on its release location at level 1; pick-release-stick-l5-l2-118, 19 moves: a stick lands on its release location at level 1
+  (:action pick-release-stick-far-13
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location)
+    :precondition (and (hand-empty) (pair-move-13 ?from ?to ?n1) (at ?o ?from) (level ?o h3) (rests ?o h2)
+      (place ?o on-spot) (height ?from h3) (height ?to h0) (height ?n1 h0))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h2)) (rests ?o h0) (beneath ?n1 h0)
       (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height l3 h3)) (height l3 h2) (not (height l0 h0)) (height l0 h1) (not (height l1 h0))
-      (height l1 h1-end) (not (stands ?o l3 h3)) (stands ?o l0 h1)))
-  ; 9 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l0-73
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l3 h3) (height l0 h2) (height l1 h0))
-    :effect (and (not (at ?o l3)) (at ?o l0) (beneath l1 h0) (no-bit-0 ?o) (not (bit-0 ?o))
-      (no-bit-5 ?o) (not (bit-5 ?o)) (not (height l3 h3)) (height l3 h2) (not (height l0 h2)) (height l0 h3)
-      (not (height l1 h0)) (height l1 h3-end) (not (stands ?o l3 h3)) (stands ?o l0 h3)))
-  ; 51 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l3-l1-74
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l1 h0) (height l0 h0) (height l2 h0))
-    :effect (and (not (at ?o l3)) (at ?o l1) (beneath l0 h0) (beneath l2 h0) (bit-0 ?o)
-      (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0)
-      (not (height l1 h0)) (height l1 h1) (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0))
-      (height l2 h1-end) (not (stands ?o l3 h1)) (stands ?o l1 h1)))
-  ; 15 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l1-75
-    :parameters (?o - stick ?top_l2 - layer)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l1 h0) (height l0 h0) (same-level ?top_l2 h2) (height l2 ?top_l2))
-    :effect (and (not (at ?o l3)) (at ?o l1) (beneath l0 h0) (beneath l2 h2) (not (level ?o h1))
-      (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1))
-      (height l3 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?top_l2)) (height l2 h3-end) (not (stands ?o l3 h1)) (stands ?o l1 h3)))
-  ; 11 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l1-76
-    :parameters (?o - stick ?top_l0 - layer)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l1 h0) (same-level ?top_l0 h2) (height l0 ?top_l0) (height l2 h0))
-    :effect (and (not (at ?o l3)) (at ?o l1) (beneath l0 h2) (beneath l2 h0) (not (level ?o h1))
-      (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1))
-      (height l3 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?top_l0)) (height l0 h3-end)
-      (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l3 h1)) (stands ?o l1 h3)))
-  ; 13 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l1-77
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l1 h2) (height l0 h0) (height l2 h0))
-    :effect (and (not (at ?o l3)) (at ?o l1) (not (rests ?o h0)) (rests ?o h2) (beneath l0 h0)
-      (beneath l2 h0) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o)
-      (not (bit-5 ?o)) (not (height l3 h1)) (height l3 h0) (not (height l1 h2)) (height l1 h3)
-      (not (height l0 h0)) (height l0 h3-end) (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l3 h1))
-      (stands ?o l1 h3)))
-  ; 12 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l3-l1-78
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l3 h3) (height l1 h0) (height l0 h0) (height l2 h0))
-    :effect (and (not (at ?o l3)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
-      (beneath l2 h0) (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
-      (not (no-bit-5 ?o)) (not (height l3 h3)) (height l3 h2) (not (height l1 h0)) (height l1 h1)
-      (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0)) (height l2 h1-end) (not (stands ?o l3 h3))
-      (stands ?o l1 h1)))
-  ; 69 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l3-l2-79
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l2 h0) (height l1 h0))
-    :effect (and (not (at ?o l3)) (at ?o l2) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0) (not (height l2 h0)) (height l2 h1)
-      (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l3 h1)) (stands ?o l2 h1)))
-  ; 15 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l2-80
-    :parameters (?o - stick ?top_l1 - layer)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l2 h0) (same-level ?top_l1 h2) (height l1 ?top_l1))
-    :effect (and (not (at ?o l3)) (at ?o l2) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
-      (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l3 h1)) (height l3 h0)
-      (not (height l2 h0)) (height l2 h3) (not (height l1 ?top_l1)) (height l1 h3-end) (not (stands ?o l3 h1))
-      (stands ?o l2 h3)))
-  ; 12 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l3-l2-81
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l3 h1) (height l2 h2) (height l1 h0))
-    :effect (and (not (at ?o l3)) (at ?o l2) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
-      (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height l3 h1)) (height l3 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 h0))
-      (height l1 h3-end) (not (stands ?o l3 h1)) (stands ?o l2 h3)))
+      (not (height ?from h3)) (height ?from h2) (not (height ?to h0)) (height ?to h1) (not (height ?n1 h0))
+      (height ?n1 h1-end) (not (stands ?o ?from h3)) (stands ?o ?to h1)))
+  ; one move at 2 pairs of locations (pair-move-14 lists them): pick-release-stick-l3-l0-73, 9 moves: a stick lands on its release location at level 3; pick-release-stick-l4-l0-88, 7 moves: a stick lands on its release location at level 3
+  (:action pick-release-stick-far-14
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location)
+    :precondition (and (hand-empty) (pair-move-14 ?from ?to ?n1) (at ?o ?from) (level ?o h3) (rests ?o h2)
+      (place ?o on-spot) (height ?from h3) (height ?to h2) (height ?n1 h0))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (beneath ?n1 h0) (no-bit-0 ?o) (not (bit-0 ?o))
+      (no-bit-5 ?o) (not (bit-5 ?o)) (not (height ?from h3)) (height ?from h2) (not (height ?to h2))
+      (height ?to h3) (not (height ?n1 h0)) (height ?n1 h3-end) (not (stands ?o ?from h3)) (stands ?o ?to h3)))
+  ; one move at 3 pairs of locations (pair-move-15 lists them): pick-release-stick-l3-l1-74, 51 moves: a stick lands on its release location at level 1; pick-release-stick-l4-l1-89, 56 moves: a stick lands on its release location at level 1; pick-release-stick-l5-l1-107, 51 moves: a stick lands on its release location at level 1
+  (:action pick-release-stick-far-15
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location ?n2 - location)
+    :precondition (and (hand-empty) (pair-move-15 ?from ?to ?n1 ?n2) (at ?o ?from) (level ?o h1)
+      (rests ?o h0) (place ?o on-spot) (height ?from h1) (height ?to h0) (height ?n1 h0) (height ?n2 h0))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (beneath ?n1 h0) (beneath ?n2 h0) (bit-0 ?o)
+      (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?from h1)) (height ?from h0)
+      (not (height ?to h0)) (height ?to h1) (not (height ?n1 h0)) (height ?n1 h1-end) (not (height ?n2 h0))
+      (height ?n2 h1-end) (not (stands ?o ?from h1)) (stands ?o ?to h1)))
+  ; one move at 3 pairs of locations (pair-move-16 lists them): pick-release-stick-l3-l1-75, 15 moves: a stick lands on its release location at level 3; pick-release-stick-l4-l1-90, 17 moves: a stick lands on its release location at level 3; pick-release-stick-l5-l1-108, 10 moves: a stick lands on its release location at level 3
+  (:action pick-release-stick-far-16
+    :parameters (?o - stick ?from - location ?to - location ?top_l2 - layer ?n1 - location ?n2 - location)
+    :precondition (and (hand-empty) (pair-move-16 ?from ?to ?n1 ?n2) (at ?o ?from) (level ?o h1)
+      (rests ?o h0) (place ?o on-spot) (height ?from h1) (height ?to h0) (height ?n1 h0)
+      (same-level ?top_l2 h2) (height ?n2 ?top_l2))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (beneath ?n1 h0) (beneath ?n2 h2)
+      (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
+      (not (height ?from h1)) (height ?from h0) (not (height ?to h0)) (height ?to h3) (not (height ?n1 h0))
+      (height ?n1 h3-end) (not (height ?n2 ?top_l2)) (height ?n2 h3-end) (not (stands ?o ?from h1))
+      (stands ?o ?to h3)))
+  ; one move at 3 pairs of locations (pair-move-17 lists them): pick-release-stick-l3-l1-76, 11 moves: a stick lands on its release location at level 3; pick-release-stick-l4-l1-91, 8 moves: a stick lands on its release location at level 3; pick-release-stick-l5-l1-109, 9 moves: a stick lands on its release location at level 3
+  (:action pick-release-stick-far-17
+    :parameters (?o - stick ?from - location ?to - location ?top_l0 - layer ?n1 - location ?n2 - location)
+    :precondition (and (hand-empty) (pair-move-17 ?from ?to ?n1 ?n2) (at ?o ?from) (level ?o h1)
+      (rests ?o h0) (place ?o on-spot) (height ?from h1) (height ?to h0) (same-level ?top_l0 h2)
+      (height ?n1 ?top_l0) (height ?n2 h0))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (beneath ?n1 h2) (beneath ?n2 h0)
+      (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
+      (not (height ?from h1)) (height ?from h0) (not (height ?to h0)) (height ?to h3)
+      (not (height ?n1 ?top_l0)) (height ?n1 h3-end) (not (height ?n2 h0)) (height ?n2 h3-end)
+      (not (stands ?o ?from h1)) (stands ?o ?to h3)))
+  ; one move at 3 pairs of locations (pair-move-18 lists them): pick-release-stick-l3-l1-77, 13 moves: a stick lands on its release location at level 3; pick-release-stick-l4-l1-92, 9 moves: a stick lands on its release location at level 3; pick-release-stick-l5-l1-110, 17 moves: a stick lands on its release location at level 3
+  (:action pick-release-stick-far-18
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location ?n2 - location)
+    :precondition (and (hand-empty) (pair-move-18 ?from ?to ?n1 ?n2) (at ?o ?from) (level ?o h1)
+      (rests ?o h0) (place ?o on-spot) (height ?from h1) (height ?to h2) (height ?n1 h0) (height ?n2 h0))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h0)) (rests ?o h2) (beneath ?n1 h0)
+      (beneath ?n2 h0) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o)
+      (not (bit-5 ?o)) (not (height ?from h1)) (height ?from h0) (not (height ?to h2)) (height ?to h3)
+      (not (height ?n1 h0)) (height ?n1 h3-end) (not (height ?n2 h0)) (height ?n2 h3-end)
+      (not (stands ?o ?from h1)) (stands ?o ?to h3)))
+  ; one move at 3 pairs of locations (pair-move-19 lists them): pick-release-stick-l3-l1-78, 12 moves: a stick lands on its release location at level 1; pick-release-stick-l4-l1-94, 14 moves: a stick lands on its release location at level 1; pick-release-stick-l5-l1-111, 10 moves: a stick lands on its release location at level 1
+  (:action pick-release-stick-far-19
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location ?n2 - location)
+    :precondition (and (hand-empty) (pair-move-19 ?from ?to ?n1 ?n2) (at ?o ?from) (level ?o h3)
+      (rests ?o h2) (place ?o on-spot) (height ?from h3) (height ?to h0) (height ?n1 h0) (height ?n2 h0))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h2)) (rests ?o h0) (beneath ?n1 h0)
+      (beneath ?n2 h0) (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
+      (not (no-bit-5 ?o)) (not (height ?from h3)) (height ?from h2) (not (height ?to h0)) (height ?to h1)
+      (not (height ?n1 h0)) (height ?n1 h1-end) (not (height ?n2 h0)) (height ?n2 h1-end)
+      (not (stands ?o ?from h3)) (stands ?o ?to h1)))
   ; 7 moves: a stick lands on its release location at level 5
   (:action pick-release-stick-l3-l2-82
     :parameters (?o - stick ?v - block)
@@ -750,95 +570,6 @@
       (bit-0 ?v) (not (no-bit-0 ?v)) (bit-5 ?v) (not (no-bit-5 ?v)) (not (height l3 h1)) (height l3 h0)
       (not (height l2 h4)) (height l2 h5) (not (height l1 h0)) (height l1 h5-end) (not (stands ?o l3 h1))
       (stands ?o l2 h5)))
-  ; 17 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l3-l2-83
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l3) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l3 h3) (height l2 h0) (height l1 h0))
-    :effect (and (not (at ?o l3)) (at ?o l2) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
-      (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height l3 h3)) (height l3 h2) (not (height l2 h0)) (height l2 h1) (not (height l1 h0))
-      (height l1 h1-end) (not (stands ?o l3 h3)) (stands ?o l2 h1)))
-  ; 65 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l4-l0-84
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l0 h0) (height l1 h0))
-    :effect (and (not (at ?o l4)) (at ?o l0) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0) (not (height l0 h0)) (height l0 h1)
-      (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l4 h1)) (stands ?o l0 h1)))
-  ; 10 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l4-l0-85
-    :parameters (?o - stick ?top_l1 - layer)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l0 h0) (same-level ?top_l1 h2) (height l1 ?top_l1))
-    :effect (and (not (at ?o l4)) (at ?o l0) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
-      (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0)
-      (not (height l0 h0)) (height l0 h3) (not (height l1 ?top_l1)) (height l1 h3-end) (not (stands ?o l4 h1))
-      (stands ?o l0 h3)))
-  ; 18 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l4-l0-86
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l0 h2) (height l1 h0))
-    :effect (and (not (at ?o l4)) (at ?o l0) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
-      (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height l4 h1)) (height l4 h0) (not (height l0 h2)) (height l0 h3) (not (height l1 h0))
-      (height l1 h3-end) (not (stands ?o l4 h1)) (stands ?o l0 h3)))
-  ; 21 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l4-l0-87
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l4 h3) (height l0 h0) (height l1 h0))
-    :effect (and (not (at ?o l4)) (at ?o l0) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
-      (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height l4 h3)) (height l4 h2) (not (height l0 h0)) (height l0 h1) (not (height l1 h0))
-      (height l1 h1-end) (not (stands ?o l4 h3)) (stands ?o l0 h1)))
-  ; 7 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l4-l0-88
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l4 h3) (height l0 h2) (height l1 h0))
-    :effect (and (not (at ?o l4)) (at ?o l0) (beneath l1 h0) (no-bit-0 ?o) (not (bit-0 ?o))
-      (no-bit-5 ?o) (not (bit-5 ?o)) (not (height l4 h3)) (height l4 h2) (not (height l0 h2)) (height l0 h3)
-      (not (height l1 h0)) (height l1 h3-end) (not (stands ?o l4 h3)) (stands ?o l0 h3)))
-  ; 56 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l4-l1-89
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l1 h0) (height l0 h0) (height l2 h0))
-    :effect (and (not (at ?o l4)) (at ?o l1) (beneath l0 h0) (beneath l2 h0) (bit-0 ?o)
-      (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0)
-      (not (height l1 h0)) (height l1 h1) (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0))
-      (height l2 h1-end) (not (stands ?o l4 h1)) (stands ?o l1 h1)))
-  ; 17 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l4-l1-90
-    :parameters (?o - stick ?top_l2 - layer)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l1 h0) (height l0 h0) (same-level ?top_l2 h2) (height l2 ?top_l2))
-    :effect (and (not (at ?o l4)) (at ?o l1) (beneath l0 h0) (beneath l2 h2) (not (level ?o h1))
-      (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1))
-      (height l4 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?top_l2)) (height l2 h3-end) (not (stands ?o l4 h1)) (stands ?o l1 h3)))
-  ; 8 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l4-l1-91
-    :parameters (?o - stick ?top_l0 - layer)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l1 h0) (same-level ?top_l0 h2) (height l0 ?top_l0) (height l2 h0))
-    :effect (and (not (at ?o l4)) (at ?o l1) (beneath l0 h2) (beneath l2 h0) (not (level ?o h1))
-      (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1))
-      (height l4 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?top_l0)) (height l0 h3-end)
-      (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l4 h1)) (stands ?o l1 h3)))
-  ; 9 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l4-l1-92
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l1 h2) (height l0 h0) (height l2 h0))
-    :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h0)) (rests ?o h2) (beneath l0 h0)
-      (beneath l2 h0) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o)
-      (not (bit-5 ?o)) (not (height l4 h1)) (height l4 h0) (not (height l1 h2)) (height l1 h3)
-      (not (height l0 h0)) (height l0 h3-end) (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l4 h1))
-      (stands ?o l1 h3)))
   ; 8 moves: a stick lands on its release location at level 2
   (:action pick-release-stick-l4-l1-93
     :parameters (?o - stick)
@@ -849,25 +580,16 @@
       (not (bit-5 ?o)) (not (height l4 h3)) (height l4 h1) (not (height l1 h0)) (height l1 h2)
       (not (height l0 h0)) (height l0 h2-end) (not (height l2 h0)) (height l2 h2-end) (not (stands ?o l4 h3))
       (stands ?o l1 h2)))
-  ; 14 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l4-l1-94
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l4 h3) (height l1 h0) (height l0 h0) (height l2 h0))
-    :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
-      (beneath l2 h0) (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
-      (not (no-bit-5 ?o)) (not (height l4 h3)) (height l4 h2) (not (height l1 h0)) (height l1 h1)
-      (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0)) (height l2 h1-end) (not (stands ?o l4 h3))
-      (stands ?o l1 h1)))
-  ; 8 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l4-l1-95
-    :parameters (?o - stick ?top_l2 - layer)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l4 h3) (height l1 h0) (height l0 h0) (same-level ?top_l2 h2) (height l2 ?top_l2))
-    :effect (and (not (at ?o l4)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
-      (beneath l2 h2) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h3))
-      (height l4 h2) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?top_l2)) (height l2 h3-end) (not (stands ?o l4 h3)) (stands ?o l1 h3)))
+  ; one move at 2 pairs of locations (pair-move-20 lists them): pick-release-stick-l4-l1-95, 8 moves: a stick lands on its release location at level 3; pick-release-stick-l5-l1-112, 6 moves: a stick lands on its release location at level 3
+  (:action pick-release-stick-far-20
+    :parameters (?o - stick ?from - location ?to - location ?top_l2 - layer ?n1 - location ?n2 - location)
+    :precondition (and (hand-empty) (pair-move-20 ?from ?to ?n1 ?n2) (at ?o ?from) (level ?o h3)
+      (rests ?o h2) (place ?o on-spot) (height ?from h3) (height ?to h0) (height ?n1 h0)
+      (same-level ?top_l2 h2) (height ?n2 ?top_l2))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h2)) (rests ?o h0) (beneath ?n1 h0)
+      (beneath ?n2 h2) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height ?from h3))
+      (height ?from h2) (not (height ?to h0)) (height ?to h3) (not (height ?n1 h0)) (height ?n1 h3-end)
+      (not (height ?n2 ?top_l2)) (height ?n2 h3-end) (not (stands ?o ?from h3)) (stands ?o ?to h3)))
   ; 7 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l4-l1-96
     :parameters (?o - stick ?top_l0 - layer)
@@ -877,76 +599,15 @@
       (beneath l2 h0) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h3))
       (height l4 h2) (not (height l1 h0)) (height l1 h3) (not (height l0 ?top_l0)) (height l0 h3-end)
       (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l4 h3)) (stands ?o l1 h3)))
-  ; 53 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l4-l2-97
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l2 h0) (height l1 h0))
-    :effect (and (not (at ?o l4)) (at ?o l2) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0) (not (height l2 h0)) (height l2 h1)
-      (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l4 h1)) (stands ?o l2 h1)))
-  ; 10 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l4-l2-98
-    :parameters (?o - stick ?top_l1 - layer)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l2 h0) (same-level ?top_l1 h2) (height l1 ?top_l1))
-    :effect (and (not (at ?o l4)) (at ?o l2) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
-      (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l4 h1)) (height l4 h0)
-      (not (height l2 h0)) (height l2 h3) (not (height l1 ?top_l1)) (height l1 h3-end) (not (stands ?o l4 h1))
-      (stands ?o l2 h3)))
-  ; 19 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l4-l2-99
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l4 h1) (height l2 h2) (height l1 h0))
-    :effect (and (not (at ?o l4)) (at ?o l2) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
-      (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height l4 h1)) (height l4 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 h0))
-      (height l1 h3-end) (not (stands ?o l4 h1)) (stands ?o l2 h3)))
-  ; 10 moves: a stick lands on its release location at level 2
-  (:action pick-release-stick-l4-l2-100
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h1) (place ?o on-spot)
-      (height l4 h3) (height l2 h0) (height l1 h0))
-    :effect (and (not (at ?o l4)) (at ?o l2) (not (rests ?o h1)) (rests ?o h0) (beneath l1 h0)
+  ; one move at 2 pairs of locations (pair-move-21 lists them): pick-release-stick-l4-l2-100, 10 moves: a stick lands on its release location at level 2; pick-release-stick-l5-l2-117, 11 moves: a stick lands on its release location at level 2
+  (:action pick-release-stick-far-21
+    :parameters (?o - stick ?from - location ?to - location ?n1 - location)
+    :precondition (and (hand-empty) (pair-move-21 ?from ?to ?n1) (at ?o ?from) (level ?o h3) (rests ?o h1)
+      (place ?o on-spot) (height ?from h3) (height ?to h0) (height ?n1 h0))
+    :effect (and (not (at ?o ?from)) (at ?o ?to) (not (rests ?o h1)) (rests ?o h0) (beneath ?n1 h0)
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height l4 h3)) (height l4 h1) (not (height l2 h0)) (height l2 h2) (not (height l1 h0))
-      (height l1 h2-end) (not (stands ?o l4 h3)) (stands ?o l2 h2)))
-  ; 19 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l4-l2-101
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l4) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l4 h3) (height l2 h0) (height l1 h0))
-    :effect (and (not (at ?o l4)) (at ?o l2) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
-      (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height l4 h3)) (height l4 h2) (not (height l2 h0)) (height l2 h1) (not (height l1 h0))
-      (height l1 h1-end) (not (stands ?o l4 h3)) (stands ?o l2 h1)))
-  ; 58 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l5-l0-102
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l0 h0) (height l1 h0))
-    :effect (and (not (at ?o l5)) (at ?o l0) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0) (not (height l0 h0)) (height l0 h1)
-      (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l5 h1)) (stands ?o l0 h1)))
-  ; 12 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l5-l0-103
-    :parameters (?o - stick ?top_l1 - layer)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l0 h0) (same-level ?top_l1 h2) (height l1 ?top_l1))
-    :effect (and (not (at ?o l5)) (at ?o l0) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
-      (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0)
-      (not (height l0 h0)) (height l0 h3) (not (height l1 ?top_l1)) (height l1 h3-end) (not (stands ?o l5 h1))
-      (stands ?o l0 h3)))
-  ; 17 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l5-l0-104
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l0 h2) (height l1 h0))
-    :effect (and (not (at ?o l5)) (at ?o l0) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
-      (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height l5 h1)) (height l5 h0) (not (height l0 h2)) (height l0 h3) (not (height l1 h0))
-      (height l1 h3-end) (not (stands ?o l5 h1)) (stands ?o l0 h3)))
+      (not (height ?from h3)) (height ?from h1) (not (height ?to h0)) (height ?to h2) (not (height ?n1 h0))
+      (height ?n1 h2-end) (not (stands ?o ?from h3)) (stands ?o ?to h2)))
   ; 6 moves: a stick lands on its release location at level 2
   (:action pick-release-stick-l5-l0-105
     :parameters (?o - stick)
@@ -956,97 +617,6 @@
       (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l5 h3)) (height l5 h1) (not (height l0 h0)) (height l0 h2) (not (height l1 h0))
       (height l1 h2-end) (not (stands ?o l5 h3)) (stands ?o l0 h2)))
-  ; 25 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l5-l0-106
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l5 h3) (height l0 h0) (height l1 h0))
-    :effect (and (not (at ?o l5)) (at ?o l0) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
-      (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height l5 h3)) (height l5 h2) (not (height l0 h0)) (height l0 h1) (not (height l1 h0))
-      (height l1 h1-end) (not (stands ?o l5 h3)) (stands ?o l0 h1)))
-  ; 51 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l5-l1-107
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l1 h0) (height l0 h0) (height l2 h0))
-    :effect (and (not (at ?o l5)) (at ?o l1) (beneath l0 h0) (beneath l2 h0) (bit-0 ?o)
-      (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0)
-      (not (height l1 h0)) (height l1 h1) (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0))
-      (height l2 h1-end) (not (stands ?o l5 h1)) (stands ?o l1 h1)))
-  ; 10 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l5-l1-108
-    :parameters (?o - stick ?top_l2 - layer)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l1 h0) (height l0 h0) (same-level ?top_l2 h2) (height l2 ?top_l2))
-    :effect (and (not (at ?o l5)) (at ?o l1) (beneath l0 h0) (beneath l2 h2) (not (level ?o h1))
-      (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1))
-      (height l5 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?top_l2)) (height l2 h3-end) (not (stands ?o l5 h1)) (stands ?o l1 h3)))
-  ; 9 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l5-l1-109
-    :parameters (?o - stick ?top_l0 - layer)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l1 h0) (same-level ?top_l0 h2) (height l0 ?top_l0) (height l2 h0))
-    :effect (and (not (at ?o l5)) (at ?o l1) (beneath l0 h2) (beneath l2 h0) (not (level ?o h1))
-      (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1))
-      (height l5 h0) (not (height l1 h0)) (height l1 h3) (not (height l0 ?top_l0)) (height l0 h3-end)
-      (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l5 h1)) (stands ?o l1 h3)))
-  ; 17 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l5-l1-110
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l1 h2) (height l0 h0) (height l2 h0))
-    :effect (and (not (at ?o l5)) (at ?o l1) (not (rests ?o h0)) (rests ?o h2) (beneath l0 h0)
-      (beneath l2 h0) (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o)
-      (not (bit-5 ?o)) (not (height l5 h1)) (height l5 h0) (not (height l1 h2)) (height l1 h3)
-      (not (height l0 h0)) (height l0 h3-end) (not (height l2 h0)) (height l2 h3-end) (not (stands ?o l5 h1))
-      (stands ?o l1 h3)))
-  ; 10 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l5-l1-111
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l5 h3) (height l1 h0) (height l0 h0) (height l2 h0))
-    :effect (and (not (at ?o l5)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
-      (beneath l2 h0) (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o)
-      (not (no-bit-5 ?o)) (not (height l5 h3)) (height l5 h2) (not (height l1 h0)) (height l1 h1)
-      (not (height l0 h0)) (height l0 h1-end) (not (height l2 h0)) (height l2 h1-end) (not (stands ?o l5 h3))
-      (stands ?o l1 h1)))
-  ; 6 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l5-l1-112
-    :parameters (?o - stick ?top_l2 - layer)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l5 h3) (height l1 h0) (height l0 h0) (same-level ?top_l2 h2) (height l2 ?top_l2))
-    :effect (and (not (at ?o l5)) (at ?o l1) (not (rests ?o h2)) (rests ?o h0) (beneath l0 h0)
-      (beneath l2 h2) (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h3))
-      (height l5 h2) (not (height l1 h0)) (height l1 h3) (not (height l0 h0)) (height l0 h3-end)
-      (not (height l2 ?top_l2)) (height l2 h3-end) (not (stands ?o l5 h3)) (stands ?o l1 h3)))
-  ; 63 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l5-l2-113
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l2 h0) (height l1 h0))
-    :effect (and (not (at ?o l5)) (at ?o l2) (beneath l1 h0) (bit-0 ?o) (not (no-bit-0 ?o))
-      (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0) (not (height l2 h0)) (height l2 h1)
-      (not (height l1 h0)) (height l1 h1-end) (not (stands ?o l5 h1)) (stands ?o l2 h1)))
-  ; 11 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l5-l2-114
-    :parameters (?o - stick ?top_l1 - layer)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l2 h0) (same-level ?top_l1 h2) (height l1 ?top_l1))
-    :effect (and (not (at ?o l5)) (at ?o l2) (beneath l1 h2) (not (level ?o h1)) (level ?o h3)
-      (no-bit-0 ?o) (not (bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o)) (not (height l5 h1)) (height l5 h0)
-      (not (height l2 h0)) (height l2 h3) (not (height l1 ?top_l1)) (height l1 h3-end) (not (stands ?o l5 h1))
-      (stands ?o l2 h3)))
-  ; 14 moves: a stick lands on its release location at level 3
-  (:action pick-release-stick-l5-l2-115
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h1) (rests ?o h0) (place ?o on-spot)
-      (height l5 h1) (height l2 h2) (height l1 h0))
-    :effect (and (not (at ?o l5)) (at ?o l2) (not (rests ?o h0)) (rests ?o h2) (beneath l1 h0)
-      (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
-      (not (height l5 h1)) (height l5 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 h0))
-      (height l1 h3-end) (not (stands ?o l5 h1)) (stands ?o l2 h3)))
   ; 10 moves: a stick lands on its release location at level 3
   (:action pick-release-stick-l5-l2-116
     :parameters (?o - stick ?top_l1 - layer)
@@ -1056,22 +626,4 @@
       (not (level ?o h1)) (level ?o h3) (no-bit-0 ?o) (not (bit-0 ?o)) (no-bit-5 ?o) (not (bit-5 ?o))
       (not (height l5 h1)) (height l5 h0) (not (height l2 h2)) (height l2 h3) (not (height l1 ?top_l1))
       (height l1 h3-end) (not (stands ?o l5 h1)) (stands ?o l2 h3)))
-  ; 11 moves: a stick lands on its release location at level 2
-  (:action pick-release-stick-l5-l2-117
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h3) (rests ?o h1) (place ?o on-spot)
-      (height l5 h3) (height l2 h0) (height l1 h0))
-    :effect (and (not (at ?o l5)) (at ?o l2) (not (rests ?o h1)) (rests ?o h0) (beneath l1 h0)
-      (not (level ?o h3)) (level ?o h2) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height l5 h3)) (height l5 h1) (not (height l2 h0)) (height l2 h2) (not (height l1 h0))
-      (height l1 h2-end) (not (stands ?o l5 h3)) (stands ?o l2 h2)))
-  ; 19 moves: a stick lands on its release location at level 1
-  (:action pick-release-stick-l5-l2-118
-    :parameters (?o - stick)
-    :precondition (and (hand-empty) (at ?o l5) (level ?o h3) (rests ?o h2) (place ?o on-spot)
-      (height l5 h3) (height l2 h0) (height l1 h0))
-    :effect (and (not (at ?o l5)) (at ?o l2) (not (rests ?o h2)) (rests ?o h0) (beneath l1 h0)
-      (not (level ?o h3)) (level ?o h1) (bit-0 ?o) (not (no-bit-0 ?o)) (bit-5 ?o) (not (no-bit-5 ?o))
-      (not (height l5 h3)) (height l5 h2) (not (height l2 h0)) (height l2 h1) (not (height l1 h0))
-      (height l1 h1-end) (not (stands ?o l5 h3)) (stands ?o l2 h1)))
 )
