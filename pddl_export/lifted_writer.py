@@ -624,25 +624,25 @@ def merged_pairs(found: Sequence[Schema]) -> tuple[Schema, ...]:
     names its locations, one schema per pair and level case: 97 of the shipped domain's 120 schemas; docs/DOMAIN.md).
     Moves of one pair, and any move alone in its template, stay as they are; the first of a group gives the
     merged schema its place."""
+    keys: list[tuple | None] = []  # per schema: its template, with what else must match; None: no pair move
     groups: dict[tuple, list[tuple[Schema, tuple[str, ...]]]] = {}
     for s in found:
+        key = None
         if s.step == "move" and s.pick is not None:
             roles, pre, eff, where = _pair_template(s)
             key = (s.params, roles, pre, eff, s.alternative, s.cost)
             groups.setdefault(key, []).append((s, where))
+        keys.append(key)
     numbers = {key: n for n, key in enumerate(k for k, v in groups.items() if len({w[:2] for _, w in v}) > 1)}
     out, done = [], set()
-    for s in found:
-        key = None
-        if s.step == "move" and s.pick is not None:
-            roles, pre, eff, _ = _pair_template(s)
-            key = (s.params, roles, pre, eff, s.alternative, s.cost)
+    for s, key in zip(found, keys):
         if key not in numbers:
             out.append(s)
             continue
         if key in done:
             continue
         done.add(key)
+        _, roles, pre, eff, _, _ = key
         members = groups[key]
         n = numbers[key]
         predicate = f"pair-move-{n}"

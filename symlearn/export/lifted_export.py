@@ -273,7 +273,6 @@ def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = 
     seen = training_moves(reader, transition, sets, cfg)
     rules = distil_rules(seen, cfg, model_hash)
     layout, stick_of, train, why = seen.layout, seen.stick_of, seen.train, seen.why
-    code_bits = reader.bits - FIELD_BITS
     probe = LiftedRules(layout, stick_of)
     width = max(s.mask.shape[1] for s in train)
     t_distil = time.perf_counter() - t0
@@ -284,7 +283,7 @@ def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = 
     domain = domain_pddl(rules)
     report = {"run": str(run_dir), "model_hash": model_hash, "config": asdict(cfg), "data": str(data_dir),
               "data_fingerprint": data_fingerprint(data_dir), "extra_data": data_records(extra_data),
-              "kept_bits": list(layout.kept), "position_bits": [b for b in range(code_bits) if b not in layout.kept],
+              "kept_bits": list(layout.kept), "position_bits": [b for b in range(layout.code_bits) if b not in layout.kept],
               "moves_not_described": dict(why), "checks_test_split": checks, "domain_bytes": len(domain.encode()),
               "n_schemas": len(schemas(rules)), "seconds": round(time.perf_counter() - t0, 1),
               "distil_seconds": round(t_distil, 1), "versions": versions()}
