@@ -19,12 +19,13 @@ of that trade. This script puts any settings beside them, on one reading of the 
         --out bench/results/preset_sweep_dev.json
 
 A setting is NAME=FIELD:VALUE,... over LiftedConfig's fields (pool_classes joined with +); empty: the defaults.
-An interrupted run resumes from --out (the calls of the same run, problems and settings are kept).
+An interrupted run resumes from --out (the calls of the same run, problems, settings and domain texts are kept).
 """
 from __future__ import annotations
 
 import argparse
 import dataclasses
+import hashlib
 import json
 import statistics
 import sys
@@ -72,90 +73,11 @@ def cubes_only(rules):
     return dataclasses.replace(rules, rules=keep, end_rules=())
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--run", required=True, type=Path, help="a run with m(z) on 9 location bits")
-    ap.add_argument("--data", required=True, type=Path, nargs="+", help="the data sets export-pddl reads")
-    ap.add_argument("--problems", required=True, type=Path, help="a problem folder (symlearn problems)")
-    ap.add_argument("--setting", action="append", required=True, help="NAME=FIELD:VALUE,... (repeat; the first "
-                    "is the baseline of the ratios)")
-    ap.add_argument("--probe-sticks", action="store_true", help="also each domain without its stick moves")
-    ap.add_argument("--planner", default="fd-lama-first", help="a search.stock_planners name")
-    ap.add_argument("--timeout", type=float, default=10.0, help="seconds per call")
-    ap.add_argument("--out", required=True, type=Path)
-    args = ap.parse_args(argv)
-    settings = dict(parse_setting(s) for s in args.setting)
-    if len(settings) != len(args.setting):
-        raise SystemExit("preset_sweep: two --setting share a name")
-    first = next(iter(settings.values()))
-    if any((c.source, c.min_info) != (first.source, first.min_info) for c in settings.values()):
-        raise SystemExit("preset_sweep: every setting needs the same source and min_info (one reading of the moves)")
-    for d in args.data:
-        if not d.is_dir():
-            raise SystemExit(f"preset_sweep: no data set at {d}")
-
-    from pddl_export.bounded_json import read_json_file
-    from pddl_export.files import sha256_file
-    from pddl_export.lifted_writer import domain_pddl, moves, problem_pddl, schemas, static_facts
-    from search.stock_planners import solve_texts
-    from symlearn.export.lifted_export import check_lifted, distil_rules, network_steps, split_codes, \
-        training_moves
-    from symlearn.problems.problem import load_problems
-    from symlearn.provenance import atomic_write_json, bench_context
-    from symlearn.sim.simulator import TabletopSimulator
-    from symlearn.symbolic.learned_transition import planning_models
-    from symlearn.symbolic.scenes import scene_codes, symbolic_goal
-    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
-
-    problems = load_problems(args.problems)  # refuses a missing or empty folder before any work
-    reader, transition = planning_models(args.run)
-    model_hash = sha256_file(args.run / TRANSITION_FILE)[:16]
-    key = {"run_model_hash": model_hash, "problems": str(args.problems), "planner": args.planner,
-           "timeout_s": args.timeout, "settings": {n: dataclasses.asdict(c) for n, c in settings.items()},
-           "data": [str(d) for d in args.data], "probe_sticks": args.probe_sticks}
-    old = read_json_file(args.out, what="sweep", max_bytes=64 << 20) if args.out.is_file() else {}
-    key = json.loads(json.dumps(key))  # as the file holds it (tuples as lists), so that a resumed run matches
-    calls = old.get("calls", []) if all(old.get(k) == v for k, v in key.items()) else []
-    done = {(c["problem"], c["form"]) for c in calls}
-
-    seen = training_moves(reader, transition, list(args.data), first)
-    val = [(d, split_codes(reader, d, "val")) for d in args.data]
-    val_net = [network_steps(transition, s.before, s.action, s.mask) for _, s in val]
-    forms, report = {}, {}
-    for name, cfg in settings.items():
-        rules = distil_rules(seen, cfg, model_hash)
-        checks = {d.name: check_lifted(rules, s, n) for (d, s), n in zip(val, val_net)}
-        text = domain_pddl(rules)
-        report[name] = {"domain_bytes": len(text.encode()), "schemas": len(schemas(rules)),
-                        "rules": len(rules.rules), "pooled_rules": sum(r.pool is not None for r in rules.rules),
-                        "end_rules": len(rules.end_rules),
-                        "val_accuracy": {d: {g: {"rules": c[g]["accuracy_rules"], "m(z)": c[g]["accuracy_net"],
-                                                 "cases": c[g]["cases"]} for g in c} for d, c in checks.items()}}
-        forms[name] = rules
-        if args.probe_sticks:
-            forms[STICK_PROBE.format(name)] = cubes_only(rules)
-    texts = {f: (domain_pddl(r), static_facts(moves(r))) for f, r in forms.items()}
-    names = list(forms)
-    sim = TabletopSimulator()
-    try:
-        for n, (path, problem) in enumerate(problems):
-            todo = [f for f in names if (path.name, f) not in done]
-            if not todo:
-                continue
-            goal = symbolic_goal(sim, reader, problem)
-            start = [int(c) for c in scene_codes(sim, reader, problem.initial)]
-            shift = n % len(todo)
-            for form in todo[shift:] + todo[:shift]:  # the order rotates from problem to problem
-                domain, statics = texts[form]
-                text = problem_pddl(forms[form], start, goal, f"p{n + 1:02d}", statics=statics)
-                rec = row(solve_texts(domain, text, args.planner, args.timeout))
-                calls.append({"problem": path.name, "objects": problem.k, "form": form,
-                              **{k: rec.get(k) for k in ("status", "translate_plus_search_s", "fd_translate_time_s",
-                                                         "translator_operators", "call_time_s")}})
-            atomic_write_json(args.out, {**key, "calls": calls, **bench_context()})  # resumable per problem
-    finally:
-        sim.close()
-
+def fast_downward_summary(calls: list[dict], names: list[str], settings) -> dict:
+    """Per form: its calls' statuses, translate + search median and max, translator median, median operators at
+    the most objects, the ratio of its median to the first form's on the problems both timed, and for a stick
+    probe its translator time beside its setting's on the same ground tasks."""
+    report: dict = {}
     base = names[0]
     by_problem: dict = {}
     for c in calls:
@@ -188,8 +110,12 @@ def main(argv: list[str] | None = None) -> int:
                 "translate_s_median": round(statistics.median(a["fd_translate_time_s"] for a, _ in same), 4),
                 f"translate_s_median_of_{owner}": round(statistics.median(b["fd_translate_time_s"] for _, b in same), 4),
             } if same else None
-        report.setdefault(form, {}).update({"fast_downward": entry})
-    atomic_write_json(args.out, {**key, "summary": report, "calls": calls, **bench_context()})
+        report[form] = entry
+    return report
+
+
+def print_report(report: dict, base: str) -> None:
+    """One line per form: validation accuracy beside m(z)'s, lama-first's median and max, its ratio to base."""
     for form, r in report.items():
         fd = r["fast_downward"]
         acc = "; ".join(f"{d} {v['all']['rules']:.3f} (m(z) {v['all']['m(z)']:.3f})"
@@ -201,6 +127,110 @@ def main(argv: list[str] | None = None) -> int:
                                      f"{next(v for k, v in both.items() if k.startswith('translate_s_median_of_'))} s")
         print(f"{form}: {acc or 'probe'}; lama-first median {t.get('median')} s, max {t.get('max')} s, "
               f"x{fd[f'median_over_{base}']} of {base}, {fd['status']}{probe}")
+
+
+def solve_all(problems, forms: dict, texts: dict, reader, planner: str, timeout: float, calls: list[dict],
+              checkpoint) -> None:
+    """Every form (forms: name -> rules; texts: name -> (domain, static facts)) on every problem the calls do not
+    hold yet, the order rotated from problem to problem; each call appended to calls, checkpoint() after each
+    problem."""
+    from pddl_export.lifted_writer import problem_pddl
+    from search.stock_planners import solve_texts
+    from symlearn.sim.simulator import TabletopSimulator
+    from symlearn.symbolic.scenes import scene_codes, symbolic_goal
+
+    done = {(c["problem"], c["form"]) for c in calls}
+    sim = TabletopSimulator()
+    try:
+        for n, (path, problem) in enumerate(problems):
+            todo = [f for f in forms if (path.name, f) not in done]
+            if not todo:
+                continue
+            goal = symbolic_goal(sim, reader, problem)
+            start = [int(c) for c in scene_codes(sim, reader, problem.initial)]
+            shift = n % len(todo)
+            for form in todo[shift:] + todo[:shift]:  # the order rotates from problem to problem
+                domain, statics = texts[form]
+                text = problem_pddl(forms[form], start, goal, f"p{n + 1:02d}", statics=statics)
+                rec = row(solve_texts(domain, text, planner, timeout))
+                calls.append({"problem": path.name, "objects": problem.k, "form": form,
+                              **{k: rec.get(k) for k in ("status", "translate_plus_search_s", "fd_translate_time_s",
+                                                         "translator_operators", "call_time_s")}})
+            checkpoint()  # resumable per problem
+    finally:
+        sim.close()
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--run", required=True, type=Path, help="a run with m(z) on 9 location bits")
+    ap.add_argument("--data", required=True, type=Path, nargs="+", help="the data sets export-pddl reads")
+    ap.add_argument("--problems", required=True, type=Path, help="a problem folder (symlearn problems)")
+    ap.add_argument("--setting", action="append", required=True, help="NAME=FIELD:VALUE,... (repeat; the first "
+                    "is the baseline of the ratios)")
+    ap.add_argument("--probe-sticks", action="store_true", help="also each domain without its stick moves")
+    ap.add_argument("--planner", default="fd-lama-first", help="a search.stock_planners name")
+    ap.add_argument("--timeout", type=float, default=10.0, help="seconds per call")
+    ap.add_argument("--out", required=True, type=Path)
+    args = ap.parse_args(argv)
+    settings = dict(parse_setting(s) for s in args.setting)
+    if len(settings) != len(args.setting):
+        raise SystemExit("preset_sweep: two --setting share a name")
+    first = next(iter(settings.values()))
+    if any((c.source, c.min_info) != (first.source, first.min_info) for c in settings.values()):
+        raise SystemExit("preset_sweep: every setting needs the same source and min_info (one reading of the moves)")
+    for d in args.data:
+        if not d.is_dir():
+            raise SystemExit(f"preset_sweep: no data set at {d}")
+
+    from pddl_export.bounded_json import read_json_file
+    from pddl_export.files import sha256_file
+    from pddl_export.lifted_writer import domain_pddl, moves, schemas, static_facts
+    from symlearn.export.lifted_export import check_lifted, distil_rules, network_steps, split_codes, \
+        training_moves
+    from symlearn.problems.problem import load_problems
+    from symlearn.provenance import atomic_write_json, bench_context
+    from symlearn.symbolic.learned_transition import planning_models
+    from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
+
+    problems = load_problems(args.problems)  # refuses a missing or empty folder before any work
+    reader, transition = planning_models(args.run)
+    model_hash = sha256_file(args.run / TRANSITION_FILE)[:16]
+    key = {"run_model_hash": model_hash, "problems": str(args.problems), "planner": args.planner,
+           "timeout_s": args.timeout, "settings": {n: dataclasses.asdict(c) for n, c in settings.items()},
+           "data": [str(d) for d in args.data], "probe_sticks": args.probe_sticks}
+
+    seen = training_moves(reader, transition, list(args.data), first)
+    val = [(d, split_codes(reader, d, "val")) for d in args.data]
+    val_net = [network_steps(transition, s.before, s.action, s.mask) for _, s in val]
+    forms, texts, report = {}, {}, {}  # texts: each form's domain and static facts, written once
+    for name, cfg in settings.items():
+        rules = distil_rules(seen, cfg, model_hash)
+        checks = {d.name: check_lifted(rules, s, n) for (d, s), n in zip(val, val_net)}
+        forms[name] = rules
+        if args.probe_sticks:
+            forms[STICK_PROBE.format(name)] = cubes_only(rules)
+        texts[name] = (domain_pddl(rules), static_facts(moves(rules)))
+        report[name] = {"domain_bytes": len(texts[name][0].encode()), "schemas": len(schemas(rules)),
+                        "rules": len(rules.rules),
+                        "pooled_rules": sum(r.pool is not None for r in rules.rules),
+                        "end_rules": len(rules.end_rules),
+                        "val_accuracy": {d: {g: {"rules": c[g]["accuracy_rules"], "m(z)": c[g]["accuracy_net"],
+                                                 "cases": c[g]["cases"]} for g in c} for d, c in checks.items()}}
+    texts.update({f: (domain_pddl(r), static_facts(moves(r))) for f, r in forms.items() if f not in texts})
+    names = list(forms)
+    # a resumed run keeps the calls of the same forms as written now (another writer's domain is another form)
+    key["domains_sha256"] = {f: hashlib.sha256(texts[f][0].encode()).hexdigest()[:16] for f in names}
+    old = read_json_file(args.out, what="sweep", max_bytes=64 << 20) if args.out.is_file() else {}
+    key = json.loads(json.dumps(key))  # as the file holds it (tuples as lists), so that a resumed run matches
+    calls = old.get("calls", []) if all(old.get(k) == v for k, v in key.items()) else []
+    solve_all(problems, forms, texts, reader, args.planner, args.timeout, calls,
+              lambda: atomic_write_json(args.out, {**key, "calls": calls, **bench_context()}))
+
+    for form, entry in fast_downward_summary(calls, names, settings).items():
+        report.setdefault(form, {})["fast_downward"] = entry
+    atomic_write_json(args.out, {**key, "summary": report, "calls": calls, **bench_context()})
+    print_report(report, names[0])
     print(f"wrote {args.out}")
     return 0
 
