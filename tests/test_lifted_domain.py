@@ -898,10 +898,13 @@ def test_stock_planners_drag_a_stick_by_its_end_in_a_domain_with_pools(pooled_pa
 
 
 def test_the_presets_of_export_pddl():
-    """fast (the default): no pools, no end rules; accurate: both; --preset with --rules is refused in one line."""
+    """fast (the default): no pools, no end rules; accurate: rarer structures of its own, far-row pairs only where
+    seen more often, pooled cubes and end rules; --preset with --rules is refused in one line."""
     from symlearn.export.lifted_export import LIFTED_PRESETS, LiftedConfig
-    assert LIFTED_PRESETS["fast"] == LiftedConfig() and LiftedConfig().pool_min_count == 0 == LiftedConfig().end_min_count
+    fast = LIFTED_PRESETS["fast"]
+    assert fast == LiftedConfig() and fast.pool_min_count == 0 == fast.end_min_count
     acc = LIFTED_PRESETS["accurate"]
-    assert acc.pool_min_count > 0 and acc.end_min_count > 0 and set(acc.pool_classes) == {"cube", "near"}
+    assert acc.min_count < fast.min_count and acc.pair_min_count > fast.pair_min_count
+    assert acc.pool_min_count > 0 and acc.end_min_count > 0 and set(acc.pool_classes) == {"cube"}
     with pytest.raises(ValueError, match="pool_classes=.* must name some of cube, near"):
         LiftedConfig(pool_classes=("pair",))

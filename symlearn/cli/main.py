@@ -282,8 +282,9 @@ def add_export_pddl_command(sub) -> None:
                        "(ExportConfig: max_objects, min_count, scenes, larger_scenes, pddl_fidelity_cases, ...)")
     x.add_argument("--preset", default="fast", choices=("fast", "accurate"),
                    help="lifted domain: fast (default: the rules Fast Downward translates fastest) or accurate (also "
-                        "rarer structures, pooled, and picks at a stick's end: closer to what the robot saw, 2.6x "
-                        "Fast Downward's time; docs/DOMAIN.md); [lifted] settings apply on top")
+                        "rarer structures, rarer cube structures pooled, and picks at a stick's end: closer to what "
+                        "the robot saw than m(z) on 1-5-object scenes, about 2x Fast Downward's time; "
+                        "docs/DOMAIN.md); [lifted] settings apply on top")
     x.add_argument("--threads", type=thread_count, help=THREADS_HELP)
     x.set_defaults(func=cmd_export_pddl)
 
