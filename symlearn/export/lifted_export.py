@@ -62,8 +62,9 @@ class LiftedConfig:
     pair_min_count: int = 6
     # a structure of pool_classes rarer than min_count takes the majority of its pool (lifted_rules: the class,
     # place and what it lands on) once the pool has this many moves; 0 (the "fast" preset): no pooling. Each pooled
-    # structure grounds once per cube and location, and the schemas' layer parameters weigh on Fast Downward's
-    # translator: the "accurate" preset (LIFTED_PRESETS) pools cubes, at about 2x Fast Downward's time
+    # structure grounds once per cube and release location (a near-row stick's: per stick and pair of locations),
+    # and the schemas' layer parameters weigh on Fast Downward's translator: the "accurate" preset
+    # (LIFTED_PRESETS) pools cubes only, at about 2x Fast Downward's time
     pool_min_count: int = 0
     pool_classes: tuple = POOLED_CLASSES
     # a structure joins its pool once seen this often: each is a static fact of every problem and, per cube and
