@@ -425,6 +425,37 @@ def _written(key: tuple, change: tuple) -> tuple:
     return (key[0], key[1], change)
 
 
+def _best_split(node: list, used: tuple[str, ...], least: int, best: Outcome, n_best: int) -> tuple[str | None, int]:
+    """The refinement field (REFINEMENTS, none of used) whose values' own majorities explain the most moves of node
+    beyond its majority outcome best (n_best moves), and how many more; (None, 0) where none explains more."""
+    split, gain = None, 0
+    for (name,) in REFINEMENTS:
+        if name in used:
+            continue
+        parts: dict = defaultdict(Counter)
+        for sig, out in node:
+            parts[sig[name]][out] += 1
+        # a value with too few moves keeps the node's answer (distil_lifted), so it explains no more than that
+        g = sum(c.most_common(1)[0][1] if sum(c.values()) >= least else c[best] for c in parts.values()) - n_best
+        if g > gain:
+            split, gain = name, g
+    return split, gain
+
+
+def _distil_stats(lookup: LiftedRules, moves: Sequence[tuple[dict, Outcome]], n_structures: int, n_own: int,
+                  unwritable: int) -> dict:
+    """What distil_lifted reports: counts of its rules (the first n_own its own, the rest pooled), and how many of
+    the moves a rule of lookup covers and how often its outcome is theirs."""
+    rules = lookup.rules
+    hits = [lookup.rule_for(sig) for sig, _ in moves]
+    agree = sum(h is not None and h.outcome == out for h, (_, out) in zip(hits, moves))
+    n_covered = sum(h is not None for h in hits)
+    return {"moves": len(moves), "structures": n_structures, "rules": len(rules), "pooled_rules": len(rules) - n_own,
+            "pools": len({r.pool for r in rules if r.pool is not None}),
+            "structures_without_move": unwritable, "covered_moves": n_covered,
+            "agreement": round(agree / n_covered, 4) if n_covered else 0.0}
+
+
 def distil_lifted(layout: CodeLayout, stick_of: dict, moves: Sequence[tuple[dict, Outcome]], min_count: int = 3,
                   model_hash: str = "", rider_min_count: int | None = None,
                   pair_min_count: int | None = None, min_gain: float = MIN_GAIN,
@@ -470,17 +501,7 @@ def distil_lifted(layout: CodeLayout, stick_of: dict, moves: Sequence[tuple[dict
         tally = Counter(out for _, out in node)
         best, n_best = tally.most_common(1)[0]
         least = needed(key, best)
-        split, gain = None, 0
-        for (name,) in REFINEMENTS:
-            if name in used:
-                continue
-            parts: dict = defaultdict(Counter)
-            for sig, out in node:
-                parts[sig[name]][out] += 1
-            # a value with too few moves keeps the node's answer (below), so it explains no more than that
-            g = sum(c.most_common(1)[0][1] if sum(c.values()) >= least else c[best] for c in parts.values()) - n_best
-            if g > gain:
-                split, gain = name, g
+        split, gain = _best_split(node, used, least, best, n_best)
         if split is None or gain < max(2, min_gain * len(node)):
             leaf(key, tally, best)
             return
@@ -506,14 +527,7 @@ def distil_lifted(layout: CodeLayout, stick_of: dict, moves: Sequence[tuple[dict
     n_own = len(rules)
     if pool_min_count is not None:
         rules += _pool_rules(moves, handled, pool_min_count, pool_structure_min, pool_classes)
-    lookup = LiftedRules(layout, stick_of, tuple(rules))
-    hits = [lookup.rule_for(sig) for sig, _ in moves]
-    agree = sum(h is not None and h.outcome == out for h, (_, out) in zip(hits, moves))
-    n_covered = sum(h is not None for h in hits)
-    stats = {"moves": len(moves), "structures": len(groups), "rules": len(rules), "pooled_rules": len(rules) - n_own,
-             "pools": len({r.pool for r in rules if r.pool is not None}),
-             "structures_without_move": unwritable, "covered_moves": n_covered,
-             "agreement": round(agree / n_covered, 4) if n_covered else 0.0}
+    stats = _distil_stats(LiftedRules(layout, stick_of, tuple(rules)), moves, len(groups), n_own, unwritable)
     return LiftedRules(layout, stick_of, tuple(sorted(rules, key=lambda r: (repr(r.key), r.depth))),
                        model_hash, stats)
 
