@@ -9,8 +9,9 @@ the end of a far-row stick lying over the location from a neighbour (`h1-end`); 
 left under a stick's end); and `(stands ?b ?l ?h)`, `at` and `level` together, which lets Fast Downward's relaxed
 exploration refuse a goal no move builds in one place (_stands_effects). The ends keep a move onto a stick's end
 and one onto a tower of the same height apart (the rules' `v.at`, `u.at`: without them both actions would apply to
-either). The learned bits a rule tests are unary
-predicates in both polarities (`bit-I`, `no-bit-I`; docs/DOMAIN.md says what they mean in a real run), and
+either). The learned bits are unary
+predicates, `(bit-I ?b)` true where bit I is 1 (docs/DOMAIN.md says what they mean in a real run), with a negative
+form `no-bit-I` only for a bit some rule tests as 0 (negated_bits), so that no precondition is negative; and
 `(differ ?a ?b)`, `(is ?a ?b)` (the same location), `(near ?l)` and `(same-level ?t ?h)` are static facts of every
 problem. Each rule of `pddl_export.lifted_rules` is one robot action in plain STRIPS with typing: no negative
 preconditions, no equality, no conditional effects, no quantifiers, no axioms, so that Fast Downward (LM-cut
@@ -119,19 +120,41 @@ class Schema:
     predicate: str = ""  # the static relation a pooled schema declares, with its typed parameters
 
 
-def _bit_literals(rules: LiftedRules, term: str, kind: int, present: bool = True) -> list[str]:
-    """Literals fixing a piece's kept learned bits to `kind` (packed in layout.kept order)."""
+def negated_bits(rules: LiftedRules) -> frozenset[int]:
+    """The kept learned bits some rule's condition reads as 0: only these get a negative form `no-bit-I`, so that
+    no precondition is negative; every other bit is one predicate, true where the bit is 1 (as a person would
+    write it), which spares the translator two atoms per changed bit of every action."""
     kept = rules.layout.kept
+    out: set[int] = set()
+    for r in rules.rules:
+        f = r.fields()
+        kinds = [f.get("o.kind"), f.get("u.kind"), f.get("v.kind"), *(f.get("riders.kind") or ())]
+        for kind in kinds:
+            if kind is not None:
+                out.update(bit for pos, bit in enumerate(kept) if not (kind >> (len(kept) - 1 - pos)) & 1)
+    return frozenset(out)
+
+
+def _bit_literals(rules: LiftedRules, term: str, kind: int, negated: frozenset[int] | None = None) -> list[str]:
+    """Literals fixing a piece's kept learned bits to `kind` (packed in layout.kept order): `bit-I` for a 1, and
+    for a 0 `no-bit-I` where the domain has it (negated: negated_bits, worked out from the rules if not given)."""
+    kept = rules.layout.kept
+    negated = negated_bits(rules) if negated is None else negated
     out = []
     for pos, bit in enumerate(kept):
         value = (kind >> (len(kept) - 1 - pos)) & 1
-        out.append(f"(bit-{bit} {term})" if value else f"(no-bit-{bit} {term})")
-    return out if present else []
+        if value:
+            out.append(f"(bit-{bit} {term})")
+        elif bit in negated:
+            out.append(f"(no-bit-{bit} {term})")
+    return out
 
 
 def _bit_effects(rules: LiftedRules, term: str, new_kind: int, old_kind: int | None) -> list[str]:
-    """Effects setting the kept bits to new_kind (only those that differ where the old value is known)."""
+    """Effects setting the kept bits to new_kind (only those that differ where the old value is known); the
+    negative form follows where the domain has it (negated_bits)."""
     kept = rules.layout.kept
+    negated = negated_bits(rules)
     out = []
     for pos, bit in enumerate(kept):
         shift = len(kept) - 1 - pos
@@ -139,7 +162,10 @@ def _bit_effects(rules: LiftedRules, term: str, new_kind: int, old_kind: int | N
         if old_kind is not None and ((old_kind >> shift) & 1) == value:
             continue
         on, off = f"(bit-{bit} {term})", f"(no-bit-{bit} {term})"
-        out += [on, f"(not {off})"] if value else [off, f"(not {on})"]
+        if bit in negated:
+            out += [on, f"(not {off})"] if value else [off, f"(not {on})"]
+        else:
+            out.append(on if value else f"(not {on})")
     return out
 
 
@@ -749,7 +775,9 @@ def plan_decoder(rules: LiftedRules, costs: bool = False):
 
 def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
     """The lifted domain's text; with costs, its all-outcomes cost form (the module docstring)."""
-    bits = " ".join(f"(bit-{b} ?b - block) (no-bit-{b} ?b - block)" for b in rules.layout.kept)
+    negated = negated_bits(rules)
+    bits = " ".join(f"(bit-{b} ?b - block)" + (f" (no-bit-{b} ?b - block)" if b in negated else "")
+                    for b in rules.layout.kept)
     locs = " ".join(loc_name(i) for i in range(N_LOCATIONS))
     lvls = " ".join(layer_names())
     found = schemas(rules, costs)
@@ -798,12 +826,13 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
     init += [f"(differ {loc_name(a)} {loc_name(b)})" for a in range(N_LOCATIONS) for b in range(N_LOCATIONS) if a != b]
     init += [f"(is {loc_name(a)} {loc_name(a)})" for a in range(N_LOCATIONS)]
     init += ["(hand-empty)"] + list(static_facts(moves(rules, costs)) if statics is None else statics)
+    negated = negated_bits(rules)
     for i, p in enumerate(pieces):
         o = object_name(i)
         if p.loc < N_LOCATIONS:
             init += [f"(at {o} {loc_name(p.loc)})", f"(stands {o} {loc_name(p.loc)} {level_name(p.level)})"]
         init.append(f"(level {o} {level_name(p.level)})")
-        init += _bit_literals(rules, o, p.kind)
+        init += _bit_literals(rules, o, p.kind, negated)
         init.append(f"(place {o} {place_name(p.place)})")
         if p.loc < N_LOCATIONS:  # the level under it at its own location, and whether that stands there
             below = top_of(pieces, p.loc, frozenset(j for j, q in enumerate(pieces) if q.level >= p.level))

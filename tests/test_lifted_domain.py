@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import re
 from collections import Counter
 
 import numpy as np
@@ -17,8 +18,8 @@ import pytest
 from pddl_export.lifted_rules import REFINEMENTS, LiftedRules, distil_lifted, key_of, load_lifted, observed_moves, \
     participants, stick_reader
 from pddl_export.lifted_scene import CodeLayout, Piece, kept_bits, read_scene
-from pddl_export.lifted_writer import PICK_CUBE, domain_pddl, layer_names, object_name, plan_actions, problem_pddl, \
-    schemas
+from pddl_export.lifted_writer import PICK_CUBE, domain_pddl, layer_names, negated_bits, object_name, plan_actions, \
+    problem_pddl, schemas
 from pddl_export.symbolic import SymbolicGoal
 from symlearn.problems.stacking import act, drop_all
 from symlearn.world import ObjectType
@@ -671,9 +672,6 @@ def test_a_kind_that_follows_the_release_location_splits_the_rule_there_and_the_
     """The kept bits of a moved object can follow where it lands (as the trained encoders' do). Moves whose cube
     takes another kind when released at l2: the tree refines on the release location, the other locations keep
     one lifted rule (`?to` with `(differ ?to l2)`), and every ground action of the PDDL sets the bits the rules set."""
-    from unified_planning.io import PDDLReader
-    from unified_planning.shortcuts import SequentialSimulator, get_environment
-    get_environment().credits_stream = None
     before, actions, after, mask, stick = _arrays(world_moves(400, seed=3, objects=(2, 2)))
     objs = before[mask]
     layout = CodeLayout(8, kept_bits((objs[:, None] >> (9 + np.arange(7, -1, -1))) & 1, (objs >> 6) & 7))
@@ -691,6 +689,16 @@ def test_a_kind_that_follows_the_release_location_splits_the_rule_there_and_the_
     assert (2,) in cube_to and any(len(t) > 1 and 2 not in t for t in cube_to), cube_to
     domain = domain_pddl(rules)
     assert "(differ ?to l2)" in domain and "(:action release-cube-to-l2-" in domain
+    assert negated_bits(rules) == frozenset() and "no-bit-" not in domain  # no rule tests a bit
+    assert _bits_as_the_rules_set_them(rules, domain) >= 6
+
+
+def _bits_as_the_rules_set_them(rules, domain: str) -> int:
+    """How many robot actions of the PDDL (from a few 2-object scenes, up's simulator) leave every object's kept
+    bits as the rule of the same action does; fails on the first that does not, or on an action no rule has."""
+    from unified_planning.io import PDDLReader
+    from unified_planning.shortcuts import SequentialSimulator, get_environment
+    get_environment().credits_stream = None
     checked = 0
     for start in [m[0] for m in world_moves(6, seed=5, objects=(2, 2))]:
         problem = PDDLReader().parse_problem_string(domain, problem_pddl(rules, start, SymbolicGoal(tuple(start)), "p"))
@@ -703,11 +711,49 @@ def test_a_kind_that_follows_the_release_location_splits_the_rule_there_and_the_
                 for i, p in enumerate(want):
                     o = problem.object(object_name(i))
                     kind = 0
-                    for b in layout.kept:
+                    for b in rules.layout.kept:
                         kind = (kind << 1) | int(nxt.get_value(problem.fluent(f"bit-{b}")(o)).bool_constant_value())
                     assert kind == p.kind, f"object {i}'s kept bits after action {a} from {start}"
                 checked += 1
-    assert checked >= 6
+    return checked
+
+
+def test_a_bit_a_rule_tests_as_zero_gets_its_negative_form_and_no_other_does():
+    """Bits are plain predicates (`bit-I` true where the bit is 1). Where a rule's condition reads a bit as 0 (here
+    each cube move is seen again with o's last kept bit flipped and another outcome kind, so the tree refines on o's
+    kind), that bit also
+    gets `no-bit-I`, maintained by every action and stated in every problem, so that no precondition is negative;
+    a bit no rule tests as 0 does not; and the PDDL's actions still set the bits the rules set."""
+    before, actions, after, mask, stick = _arrays(world_moves(400, seed=3, objects=(2, 2)))
+    objs = before[mask]
+    layout = CodeLayout(8, kept_bits((objs[:, None] >> (9 + np.arange(7, -1, -1))) & 1, (objs >> 6) & 7))
+    assert len(layout.kept) >= 2
+    stick_of = stick_reader(before, mask, stick, layout)
+    moves, _ = observed_moves(LiftedRules(layout, stick_of), before, after, actions, mask)
+    first, last = 1 << (len(layout.kept) - 1), 1
+
+    def twin(sig, out):  # the same cube move with the last kept bit flipped, its cube taking another kind
+        o = out[0]
+        return {**sig, "o.kind": sig["o.kind"] ^ last}, ((o[0], o[1], o[2], o[3] ^ first), *out[1:])
+    twins = [twin(*m) for m in moves if m[0]["cls"] == "cube"]
+    rules = distil_lifted(layout, stick_of, moves + twins, min_count=1, model_hash="cd" * 8)
+    tested = {dict(r.key)["o.kind"] for r in rules.rules if "o.kind" in dict(r.key)}
+    assert tested, "the tree should refine on o's kind"
+    zero = {b for pos, b in enumerate(layout.kept) for k in tested if not (k >> (len(layout.kept) - 1 - pos)) & 1}
+    assert negated_bits(rules) == zero and layout.kept[-1] in zero and layout.kept[0] not in zero  # bit 0 is 1 here
+    domain = domain_pddl(rules)
+    declared = {int(b) for b in re.findall(r"\(no-bit-(\d+) \?b - block\)", domain)}
+    assert declared == zero and set(layout.kept) - zero <= {int(b) for b in re.findall(r"\(bit-(\d+) \?b", domain)}
+    preconditions = [a.split(":effect")[0] for a in domain.split("(:action")[1:]]
+    assert any(f"(no-bit-{layout.kept[-1]} ?o)" in pre for pre in preconditions)
+    start = next(m[0] for m in world_moves(6, seed=5, objects=(2, 2)))
+    init = problem_pddl(rules, start, SymbolicGoal(tuple(start)), "p").split("(:goal")[0]
+    for i, p in enumerate(rules.pieces(start)):
+        for pos, b in enumerate(layout.kept):
+            one = (p.kind >> (len(layout.kept) - 1 - pos)) & 1
+            assert (f"(bit-{b} o{i})" in init) == bool(one)
+            assert (f"(no-bit-{b} o{i})" in init) == (not one and b in zero)
+    assert _bits_as_the_rules_set_them(rules, domain) >= 6
 
 
 def test_rarer_structures_take_their_pools_change_and_reproduce_the_world(tmp_path):
