@@ -693,14 +693,15 @@ def test_a_kind_that_follows_the_release_location_splits_the_rule_there_and_the_
     assert _bits_as_the_rules_set_them(rules, domain) >= 6
 
 
-def _bits_as_the_rules_set_them(rules, domain: str) -> int:
-    """How many robot actions of the PDDL (from a few 2-object scenes, up's simulator) leave every object's kept
-    bits as the rule of the same action does; fails on the first that does not, or on an action no rule has."""
+def _bits_as_the_rules_set_them(rules, domain: str, starts=None) -> int:
+    """How many robot actions of the PDDL (from the start codes given, else six 2-object scenes; up's simulator)
+    leave every object's kept bits as the rule of the same action does; fails on the first that does not, or on an
+    action no rule has."""
     from unified_planning.io import PDDLReader
     from unified_planning.shortcuts import SequentialSimulator, get_environment
     get_environment().credits_stream = None
     checked = 0
-    for start in [m[0] for m in world_moves(6, seed=5, objects=(2, 2))]:
+    for start in starts if starts is not None else [m[0] for m in world_moves(6, seed=5, objects=(2, 2))]:
         problem = PDDLReader().parse_problem_string(domain, problem_pddl(rules, start, SymbolicGoal(tuple(start)), "p"))
         pieces = rules.pieces(start)
         with SequentialSimulator(problem) as sim:
@@ -721,9 +722,9 @@ def _bits_as_the_rules_set_them(rules, domain: str) -> int:
 def test_a_bit_a_rule_tests_as_zero_gets_its_negative_form_and_no_other_does():
     """Bits are plain predicates (`bit-I` true where the bit is 1). Where a rule's condition reads a bit as 0 (here
     each cube move is seen again with o's last kept bit flipped and another outcome kind, so the tree refines on o's
-    kind), that bit also
-    gets `no-bit-I`, maintained by every action and stated in every problem, so that no precondition is negative;
-    a bit no rule tests as 0 does not; and the PDDL's actions still set the bits the rules set."""
+    kind), that bit also gets `no-bit-I`, maintained by every action and stated in every problem, so that no
+    precondition is negative; a bit no rule tests as 0 does not; and the PDDL's actions still set the bits the rules
+    set, from scenes whose cubes have the bit at 0 as well."""
     before, actions, after, mask, stick = _arrays(world_moves(400, seed=3, objects=(2, 2)))
     objs = before[mask]
     layout = CodeLayout(8, kept_bits((objs[:, None] >> (9 + np.arange(7, -1, -1))) & 1, (objs >> 6) & 7))
@@ -736,7 +737,7 @@ def test_a_bit_a_rule_tests_as_zero_gets_its_negative_form_and_no_other_does():
         o = out[0]
         return {**sig, "o.kind": sig["o.kind"] ^ last}, ((o[0], o[1], o[2], o[3] ^ first), *out[1:])
     twins = [twin(*m) for m in moves if m[0]["cls"] == "cube"]
-    rules = distil_lifted(layout, stick_of, moves + twins, min_count=1, model_hash="cd" * 8)
+    rules = distil_lifted(layout, stick_of, moves + twins, min_count=20, model_hash="cd" * 8)
     tested = {dict(r.key)["o.kind"] for r in rules.rules if "o.kind" in dict(r.key)}
     assert tested, "the tree should refine on o's kind"
     zero = {b for pos, b in enumerate(layout.kept) for k in tested if not (k >> (len(layout.kept) - 1 - pos)) & 1}
@@ -746,14 +747,23 @@ def test_a_bit_a_rule_tests_as_zero_gets_its_negative_form_and_no_other_does():
     assert declared == zero and set(layout.kept) - zero <= {int(b) for b in re.findall(r"\(bit-(\d+) \?b", domain)}
     preconditions = [a.split(":effect")[0] for a in domain.split("(:action")[1:]]
     assert any(f"(no-bit-{layout.kept[-1]} ?o)" in pre for pre in preconditions)
-    start = next(m[0] for m in world_moves(6, seed=5, objects=(2, 2)))
-    init = problem_pddl(rules, start, SymbolicGoal(tuple(start)), "p").split("(:goal")[0]
-    for i, p in enumerate(rules.pieces(start)):
-        for pos, b in enumerate(layout.kept):
-            one = (p.kind >> (len(layout.kept) - 1 - pos)) & 1
-            assert (f"(bit-{b} o{i})" in init) == bool(one)
-            assert (f"(no-bit-{b} o{i})" in init) == (not one and b in zero)
-    assert _bits_as_the_rules_set_them(rules, domain) >= 6
+    # a scene as the world has it and the same with each cube's last kept bit flipped (a kind no start of
+    # the world has here), so that the init states no-bit-I and actions whose precondition reads it run too
+    scenes = [m[0] for m in world_moves(1, seed=5, objects=(2, 2))]
+    flipped = [tuple(c if rules.is_stick(c) else (layout.with_kind(layout.learned(c), layout.kind(c) ^ last) << 9)
+                     | (c & 511) for c in scene) for scene in scenes]
+    assert [[p.stick for p in rules.pieces(f)] for f in flipped] == [[p.stick for p in rules.pieces(s)] for s in scenes]
+    for start in scenes + flipped:
+        init = problem_pddl(rules, start, SymbolicGoal(tuple(start)), "p").split("(:goal")[0]
+        for i, p in enumerate(rules.pieces(start)):
+            for pos, b in enumerate(layout.kept):
+                one = (p.kind >> (len(layout.kept) - 1 - pos)) & 1
+                assert (f"(bit-{b} o{i})" in init) == bool(one)
+                assert (f"(no-bit-{b} o{i})" in init) == (not one and b in zero)
+    assert any("(no-bit-" in problem_pddl(rules, f, SymbolicGoal(tuple(f)), "p") for f in flipped)
+    fired = [r for f in flipped for a in range(36) if (r := rules.step_pieces(rules.pieces(f), a)[1]) is not None]
+    assert any(not r.fields().get("o.kind", last) & last for r in fired)  # a rule that reads the bit as 0 fires
+    assert _bits_as_the_rules_set_them(rules, domain, scenes + flipped) >= 2
 
 
 def test_rarer_structures_take_their_pools_change_and_reproduce_the_world(tmp_path):
