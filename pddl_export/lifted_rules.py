@@ -41,6 +41,7 @@ import dataclasses
 from pathlib import Path
 from collections import Counter, defaultdict
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Iterable, Sequence
 
 import numpy as np
@@ -233,6 +234,17 @@ class LiftedRules:
                     splits[key[:n]] = key[n][0]
         object.__setattr__(self, "_index", index)
         object.__setattr__(self, "_splits", splits)
+
+    @cached_property
+    def tested_kinds(self) -> frozenset[int]:
+        """Every kind (packed kept bits) some rule's condition tests: of o, of what it leaves on top or lands on, or
+        of a rider (the writer states a bit's negative form only where one of these has it at 0)."""
+        out = set()
+        for r in self.rules:
+            f = r.fields()
+            out.update(k for k in (f.get("o.kind"), f.get("u.kind"), f.get("v.kind"), *(f.get("riders.kind") or ()))
+                       if k is not None)
+        return frozenset(out)
 
     def is_stick(self, code: int) -> bool:
         """The type a located code reads as: the data's majority for its learned code and level (else level 1)."""

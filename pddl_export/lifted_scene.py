@@ -69,11 +69,15 @@ class CodeLayout:
             out = (out << 1) | ((learned >> (self.code_bits - 1 - b)) & 1)
         return out
 
+    def kind_bits(self, kind: int) -> tuple[tuple[int, int], ...]:
+        """((kept bit, its value 0 or 1), ...) of a packed kind, in `kept` order (as `kind` packs them)."""
+        return tuple((bit, (kind >> (len(self.kept) - 1 - pos)) & 1) for pos, bit in enumerate(self.kept))
+
     def with_kind(self, learned: int, kind: int) -> int:
         """A learned code with its kept bits set to `kind` (as `kind` packs them), the other bits as they were."""
-        for pos, bit in enumerate(self.kept):
+        for bit, value in self.kind_bits(kind):
             mask = 1 << (self.code_bits - 1 - bit)
-            learned = (learned | mask) if (kind >> (len(self.kept) - 1 - pos)) & 1 else (learned & ~mask)
+            learned = (learned | mask) if value else (learned & ~mask)
         return learned
 
     def piece(self, code: int, stick: bool) -> "Piece":

@@ -121,45 +121,28 @@ class Schema:
 
 
 def negated_bits(rules: LiftedRules) -> frozenset[int]:
-    """The kept learned bits some rule's condition reads as 0: only these get a negative form `no-bit-I`, so that
-    no precondition is negative; every other bit is one predicate, true where the bit is 1 (as a person would
-    write it), which spares the translator two atoms per changed bit of every action."""
-    kept = rules.layout.kept
-    out: set[int] = set()
-    for r in rules.rules:
-        f = r.fields()
-        kinds = [f.get("o.kind"), f.get("u.kind"), f.get("v.kind"), *(f.get("riders.kind") or ())]
-        for kind in kinds:
-            if kind is not None:
-                out.update(bit for pos, bit in enumerate(kept) if not (kind >> (len(kept) - 1 - pos)) & 1)
-    return frozenset(out)
+    """The kept learned bits some rule's condition reads as 0 (LiftedRules.tested_kinds): only these get a negative
+    form `no-bit-I`, so that no precondition is negative; every other bit is one predicate, true where the bit is 1
+    (as a person would write it), which spares the translator two atoms per changed bit of every action."""
+    return frozenset(bit for kind in rules.tested_kinds for bit, value in rules.layout.kind_bits(kind) if not value)
 
 
-def _bit_literals(rules: LiftedRules, term: str, kind: int, negated: frozenset[int] | None = None) -> list[str]:
+def _bit_literals(rules: LiftedRules, term: str, kind: int) -> list[str]:
     """Literals fixing a piece's kept learned bits to `kind` (packed in layout.kept order): `bit-I` for a 1, and
-    for a 0 `no-bit-I` where the domain has it (negated: negated_bits, worked out from the rules if not given)."""
-    kept = rules.layout.kept
-    negated = negated_bits(rules) if negated is None else negated
-    out = []
-    for pos, bit in enumerate(kept):
-        value = (kind >> (len(kept) - 1 - pos)) & 1
-        if value:
-            out.append(f"(bit-{bit} {term})")
-        elif bit in negated:
-            out.append(f"(no-bit-{bit} {term})")
-    return out
+    for a 0 `no-bit-I` where the domain has it (negated_bits)."""
+    negated = negated_bits(rules)
+    return [f"(bit-{bit} {term})" if value else f"(no-bit-{bit} {term})"
+            for bit, value in rules.layout.kind_bits(kind) if value or bit in negated]
 
 
 def _bit_effects(rules: LiftedRules, term: str, new_kind: int, old_kind: int | None) -> list[str]:
     """Effects setting the kept bits to new_kind (only those that differ where the old value is known); the
     negative form follows where the domain has it (negated_bits)."""
-    kept = rules.layout.kept
     negated = negated_bits(rules)
+    old = dict(rules.layout.kind_bits(old_kind)) if old_kind is not None else {}
     out = []
-    for pos, bit in enumerate(kept):
-        shift = len(kept) - 1 - pos
-        value = (new_kind >> shift) & 1
-        if old_kind is not None and ((old_kind >> shift) & 1) == value:
+    for bit, value in rules.layout.kind_bits(new_kind):
+        if old.get(bit) == value:
             continue
         on, off = f"(bit-{bit} {term})", f"(no-bit-{bit} {term})"
         if bit in negated:
@@ -826,13 +809,12 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
     init += [f"(differ {loc_name(a)} {loc_name(b)})" for a in range(N_LOCATIONS) for b in range(N_LOCATIONS) if a != b]
     init += [f"(is {loc_name(a)} {loc_name(a)})" for a in range(N_LOCATIONS)]
     init += ["(hand-empty)"] + list(static_facts(moves(rules, costs)) if statics is None else statics)
-    negated = negated_bits(rules)
     for i, p in enumerate(pieces):
         o = object_name(i)
         if p.loc < N_LOCATIONS:
             init += [f"(at {o} {loc_name(p.loc)})", f"(stands {o} {loc_name(p.loc)} {level_name(p.level)})"]
         init.append(f"(level {o} {level_name(p.level)})")
-        init += _bit_literals(rules, o, p.kind, negated)
+        init += _bit_literals(rules, o, p.kind)
         init.append(f"(place {o} {place_name(p.place)})")
         if p.loc < N_LOCATIONS:  # the level under it at its own location, and whether that stands there
             below = top_of(pieces, p.loc, frozenset(j for j, q in enumerate(pieces) if q.level >= p.level))
