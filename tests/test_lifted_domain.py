@@ -19,7 +19,7 @@ from pddl_export.lifted_rules import REFINEMENTS, LiftedRules, distil_lifted, ke
     participants, stick_reader
 from pddl_export.lifted_scene import CodeLayout, Piece, kept_bits, read_scene
 from pddl_export.lifted_writer import PICK_CUBE, domain_pddl, layer_names, negated_bits, object_name, plan_actions, \
-    problem_pddl, schemas
+    plan_decoder, problem_pddl, schemas
 from pddl_export.symbolic import SymbolicGoal
 from symlearn.problems.stacking import act, drop_all
 from symlearn.world import ObjectType
@@ -180,7 +180,7 @@ def test_the_domain_is_small_plain_strips(world_rules):
 def test_far_row_moves_that_differ_only_in_their_locations_are_one_schema(world_rules, costs):
     """merged_pairs: each pair move stands in exactly one schema (its own, or a merged one whose static facts name
     its pick and release locations), and the plan decoder reads a merged step's locations back."""
-    from pddl_export.lifted_writer import PAIR_MOVE, merged_pairs, moves, plan_decoder, static_facts
+    from pddl_export.lifted_writer import PAIR_MOVE, merged_pairs, moves, static_facts
     whole = moves(world_rules, costs)
     merged = merged_pairs(whole)
     joined = [s for s in merged if s.name.startswith(PAIR_MOVE)]
@@ -220,6 +220,18 @@ def _step(action, params) -> str:
     return f"({action.name} {' '.join(str(p) for p in params)})"
 
 
+_DECODERS: dict[int, tuple] = {}
+
+
+def _robot_ids(rules: LiftedRules, steps) -> list[int]:
+    """plan_actions with one plan_decoder per rule set: plan_actions writes every schema anew on each call, and
+    these tests read back thousands of single ground actions."""
+    kept = _DECODERS.get(id(rules))
+    if kept is None or kept[0] is not rules:
+        kept = _DECODERS[id(rules)] = (rules, plan_decoder(rules))
+    return [a for a, _ in kept[1](steps)]
+
+
 def _robot_moves(sim, state, rules: LiftedRules) -> list[tuple[int, object]]:
     """(robot action, next state) of every whole move applicable in a unified-planning state and of every
     pick-cube followed by a release-cube (a cube put back where it was picked is no robot action)."""
@@ -227,11 +239,11 @@ def _robot_moves(sim, state, rules: LiftedRules) -> list[tuple[int, object]]:
     for action, params in sim.get_applicable_actions(state):
         nxt = sim.apply(state, action, params)
         if action.name != PICK_CUBE:
-            out.append((plan_actions(rules, [_step(action, params)])[0], nxt))
+            out.append((_robot_ids(rules, [_step(action, params)])[0], nxt))
             continue
         assert not any(a.name == PICK_CUBE for a, _ in sim.get_applicable_actions(nxt)), "two cubes in the hand"
         for release, args in sim.get_applicable_actions(nxt):
-            ids = plan_actions(rules, [_step(action, params), _step(release, args)])
+            ids = _robot_ids(rules, [_step(action, params), _step(release, args)])
             if ids:
                 out.append((ids[0], sim.apply(nxt, release, args)))
     return out
@@ -322,12 +334,12 @@ def _robot_actions(schema_list, problem_text: str, rules: LiftedRules) -> dict[i
     step = lambda s, b: f"({s.name} {' '.join(b[p] for p, _ in s.params)})"  # noqa: E731
     for s, b in _applicable(schema_list, init, typed):
         if s.name != PICK_CUBE:
-            out.setdefault(plan_actions(rules, [step(s, b)])[0], []).append(s.name)
+            out.setdefault(_robot_ids(rules, [step(s, b)])[0], []).append(s.name)
             continue
         held = (init - {_ground(e[5:-1], b) for e in s.eff if e.startswith("(not ")}) | \
             {_ground(e, b) for e in s.eff if not e.startswith("(not ")}
         for r, rb in _applicable(schema_list, held, typed):
-            for a in plan_actions(rules, [step(s, b), step(r, rb)]):
+            for a in _robot_ids(rules, [step(s, b), step(r, rb)]):
                 out.setdefault(a, []).append(r.name)
     return out
 
@@ -336,7 +348,6 @@ def test_a_plan_reads_back_as_robot_actions_a_pick_and_its_release_as_one(world_
     """plan_decoder: a pick-cube and the release-cube after it are one robot action (pick * 6 + release), a stick's
     move is one on its own, a cube put back where it was picked is none; a plan that releases what is not held,
     moves while holding, or ends holding is refused in one line."""
-    from pddl_export.lifted_writer import plan_decoder
     written = schemas(world_rules)
     release = next(s for s in written if s.step == "release" and s.release is None)
     stick = next(s for s in written if s.step == "move" and s.pick is not None)
@@ -472,11 +483,11 @@ def test_pddlgym_loads_the_domain_and_steps_to_the_goal_as_the_rules_do(world_ru
     offered = set()  # the robot actions of pddlgym's ground actions: a whole move, or a pick and a release
     for lit in env.action_space.all_ground_literals(obs):
         if lit.predicate.name != PICK_CUBE:
-            offered.add(plan_actions(world_rules, [step(lit)])[0])
+            offered.add(_robot_ids(world_rules, [step(lit)])[0])
             continue
         held, *_ = env.step(lit)
         offered |= {a for rel in env.action_space.all_ground_literals(held)
-                    for a in plan_actions(world_rules, [step(lit), step(rel)])}
+                    for a in _robot_ids(world_rules, [step(lit), step(rel)])}
         env.set_state(obs)
     allowed = {a for a in range(36) if world_rules.step_pieces(world_rules.pieces(start), a)[1] is not None}
     assert offered == allowed
@@ -612,7 +623,7 @@ def test_a_rule_keeps_its_outcome_share_and_the_cost_form_plans_on_its_alternati
     goal and the alternative where only it does; the planner's predictions follow the outcome each step chose."""
     import pyval
 
-    from pddl_export.lifted_writer import outcome_cost, plan_decoder
+    from pddl_export.lifted_writer import outcome_cost
     from search.stock_planners import solve_texts
     from symlearn.planning.lifted_planner import LiftedPlanner
     before, actions, after, mask, stick = _arrays(world_moves(300, seed=0))
