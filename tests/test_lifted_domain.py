@@ -220,30 +220,25 @@ def _step(action, params) -> str:
     return f"({action.name} {' '.join(str(p) for p in params)})"
 
 
-_DECODERS: dict[int, tuple] = {}
+def _robot_ids(decode, steps) -> list[int]:
+    """plan_actions through a decoder the test built once for its rules (plan_decoder): plan_actions writes every
+    schema anew on each call, and these tests read back thousands of single ground actions."""
+    return [a for a, _ in decode(steps)]
 
 
-def _robot_ids(rules: LiftedRules, steps) -> list[int]:
-    """plan_actions with one plan_decoder per rule set: plan_actions writes every schema anew on each call, and
-    these tests read back thousands of single ground actions."""
-    kept = _DECODERS.get(id(rules))
-    if kept is None or kept[0] is not rules:
-        kept = _DECODERS[id(rules)] = (rules, plan_decoder(rules))
-    return [a for a, _ in kept[1](steps)]
-
-
-def _robot_moves(sim, state, rules: LiftedRules) -> list[tuple[int, object]]:
+def _robot_moves(sim, state, decode) -> list[tuple[int, object]]:
     """(robot action, next state) of every whole move applicable in a unified-planning state and of every
-    pick-cube followed by a release-cube (a cube put back where it was picked is no robot action)."""
+    pick-cube followed by a release-cube (a cube put back where it was picked is no robot action); decode: the
+    rules' plan_decoder."""
     out = []
     for action, params in sim.get_applicable_actions(state):
         nxt = sim.apply(state, action, params)
         if action.name != PICK_CUBE:
-            out.append((_robot_ids(rules, [_step(action, params)])[0], nxt))
+            out.append((_robot_ids(decode, [_step(action, params)])[0], nxt))
             continue
         assert not any(a.name == PICK_CUBE for a, _ in sim.get_applicable_actions(nxt)), "two cubes in the hand"
         for release, args in sim.get_applicable_actions(nxt):
-            ids = _robot_ids(rules, [_step(action, params), _step(release, args)])
+            ids = _robot_ids(decode, [_step(action, params), _step(release, args)])
             if ids:
                 out.append((ids[0], sim.apply(nxt, release, args)))
     return out
@@ -260,6 +255,7 @@ def test_pddl_successors_are_the_rules(fixture, request):
     domain = domain_pddl(pair_rules)
     states = [m[0] for m in world_moves(3 if fixture == "pair_rules" else 12, seed=2, objects=(2, 2))]
     checked = pooled = 0
+    decode = plan_decoder(pair_rules)
     for start in states:
         goal = SymbolicGoal(tuple(start))
         problem = PDDLReader().parse_problem_string(domain, problem_pddl(pair_rules, start, goal, "p"))
@@ -267,7 +263,7 @@ def test_pddl_successors_are_the_rules(fixture, request):
         with SequentialSimulator(problem) as sim:
             state = sim.get_initial_state()
             by_action = {}
-            for a, nxt in _robot_moves(sim, state, pair_rules):
+            for a, nxt in _robot_moves(sim, state, decode):
                 by_action.setdefault(a, []).append(nxt)
         for a in range(36):
             want, rule = pair_rules.step_pieces(pieces, a)
@@ -326,20 +322,20 @@ def _applicable(schema_list, init: set[str], typed: dict) -> list[tuple]:
     return found
 
 
-def _robot_actions(schema_list, problem_text: str, rules: LiftedRules) -> dict[int, list[str]]:
+def _robot_actions(schema_list, problem_text: str, decode) -> dict[int, list[str]]:
     """Robot action -> the names of the ground actions (a whole move, or a pick-cube and a release-cube) that
-    stand for it in the problem's initial state."""
+    stand for it in the problem's initial state; decode: the rules' plan_decoder."""
     init, typed = _facts(problem_text)
     out: dict[int, list[str]] = {}
     step = lambda s, b: f"({s.name} {' '.join(b[p] for p, _ in s.params)})"  # noqa: E731
     for s, b in _applicable(schema_list, init, typed):
         if s.name != PICK_CUBE:
-            out.setdefault(_robot_ids(rules, [step(s, b)])[0], []).append(s.name)
+            out.setdefault(_robot_ids(decode, [step(s, b)])[0], []).append(s.name)
             continue
         held = (init - {_ground(e[5:-1], b) for e in s.eff if e.startswith("(not ")}) | \
             {_ground(e, b) for e in s.eff if not e.startswith("(not ")}
         for r, rb in _applicable(schema_list, held, typed):
-            for a in _robot_ids(rules, [step(s, b), step(r, rb)]):
+            for a in _robot_ids(decode, [step(s, b), step(r, rb)]):
                 out.setdefault(a, []).append(r.name)
     return out
 
@@ -379,12 +375,13 @@ def test_one_ground_action_per_pick_and_release_where_stick_ends_and_towers_shar
     assert any(not r.fields()["v.at"] and r.fields()["v.level"] > 0 for r in world_rules.rules)
     assert any(not r.fields()["u.at"] and r.fields()["u.level"] > 0 for r in world_rules.rules)
     written = schemas(world_rules)
+    decode = plan_decoder(world_rules)
     onto_end = checked = 0
     for start, _, _, _ in world_moves(120, seed=5, objects=(3, 4)):
         text = problem_pddl(world_rules, start, SymbolicGoal(tuple(start)), "p")
         pieces = world_rules.pieces(start)
         graph = read_scene(pieces)
-        by_action = _robot_actions(written, text, world_rules)
+        by_action = _robot_actions(written, text, decode)
         for a in range(36):
             _, rule = world_rules.step_pieces(pieces, a)
             assert len(by_action.get(a, [])) == (rule is not None), f"action {a} from {start}: {by_action.get(a)}"
@@ -481,13 +478,14 @@ def test_pddlgym_loads_the_domain_and_steps_to_the_goal_as_the_rules_do(world_ru
     obs, _ = env.reset()
     step = lambda lit: f"({lit.predicate.name} {' '.join(v.name for v in lit.variables)})"  # noqa: E731
     offered = set()  # the robot actions of pddlgym's ground actions: a whole move, or a pick and a release
+    decode = plan_decoder(world_rules)
     for lit in env.action_space.all_ground_literals(obs):
         if lit.predicate.name != PICK_CUBE:
-            offered.add(_robot_ids(world_rules, [step(lit)])[0])
+            offered.add(_robot_ids(decode, [step(lit)])[0])
             continue
         held, *_ = env.step(lit)
         offered |= {a for rel in env.action_space.all_ground_literals(held)
-                    for a in _robot_ids(world_rules, [step(lit), step(rel)])}
+                    for a in _robot_ids(decode, [step(lit), step(rel)])}
         env.set_state(obs)
     allowed = {a for a in range(36) if world_rules.step_pieces(world_rules.pieces(start), a)[1] is not None}
     assert offered == allowed
@@ -712,12 +710,13 @@ def _bits_as_the_rules_set_them(rules, domain: str, starts=None) -> int:
     from unified_planning.shortcuts import SequentialSimulator, get_environment
     get_environment().credits_stream = None
     checked = 0
+    decode = plan_decoder(rules)
     for start in starts if starts is not None else [m[0] for m in world_moves(6, seed=5, objects=(2, 2))]:
         problem = PDDLReader().parse_problem_string(domain, problem_pddl(rules, start, SymbolicGoal(tuple(start)), "p"))
         pieces = rules.pieces(start)
         with SequentialSimulator(problem) as sim:
             state = sim.get_initial_state()
-            for a, nxt in _robot_moves(sim, state, rules):
+            for a, nxt in _robot_moves(sim, state, decode):
                 want, rule = rules.step_pieces(pieces, a)
                 assert rule is not None, f"the PDDL offers action {a} from {start}, no rule does"
                 for i, p in enumerate(want):
@@ -884,12 +883,13 @@ def test_a_pick_at_a_stick_end_drags_the_stick_and_the_pddl_does_the_same(pair_r
     assert rules.step_pieces(unlisted, 1 * 6 + 4) == (unlisted, None)
     domain = domain_pddl(rules)
     fired = set()
+    decode = plan_decoder(rules)
     for pieces in scenes:
         start = [code(p) for p in pieces]
         problem = PDDLReader().parse_problem_string(domain, problem_pddl(rules, start, SymbolicGoal(tuple(start)), "p"))
         with SequentialSimulator(problem) as sim:
             by_action: dict = {}
-            for a, nxt in _robot_moves(sim, sim.get_initial_state(), rules):
+            for a, nxt in _robot_moves(sim, sim.get_initial_state(), decode):
                 by_action.setdefault(a, []).append(nxt)
         for a in range(36):
             want, rule = rules.step_pieces(rules.pieces(start), a)
