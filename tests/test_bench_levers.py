@@ -74,3 +74,29 @@ def test_the_rules_load_baseline_builds_and_checks_groups_as_ruleset_does():
     lo[1:] = lo[0]  # ... and all of them the same one
     assert _first_overlap(lo, hi) == load.baseline_first_overlap(lo, hi) == (0, 1)
 
+
+
+def test_heldout_accuracy_interval_and_refusals(tmp_path):
+    """bench/heldout_accuracy.py: the paired interval brackets the mean difference and narrows with more steps;
+    a held-out set that made the rules (the same folder, or a copy of it) or no data set at all is refused in
+    one line before any model is read."""
+    ho = _load("heldout_accuracy")
+    rng = np.random.default_rng(0)
+    net = rng.random(4000) < 0.7
+    mine = np.where(rng.random(4000) < 0.1, ~net, net)  # flips a tenth of the steps either way
+    d = mine.mean() - net.mean()
+    lo, hi = ho.paired_interval(mine, net, seed=1)
+    assert lo <= d <= hi and 0 < hi - lo < 0.03
+    lo_s, hi_s = ho.paired_interval(mine[:400], net[:400], seed=1)
+    assert hi_s - lo_s > 2 * (hi - lo)  # ten times fewer steps: about three times as wide
+    assert ho.paired_interval(net, net, seed=1) == [0.0, 0.0]
+
+    a, copy = tmp_path / "a", tmp_path / "copy"
+    a.mkdir()
+    (a / "manifest.json").write_text('{"samples": 1}')
+    shutil.copytree(a, copy)
+    base = ["--run", str(tmp_path / "run"), "--data", str(a), "--setting", "fast=", "--out", str(tmp_path / "o.json")]
+    for heldout, message in [(a, "is one of --data"), (copy, "is a copy of"), (tmp_path / "none", "no manifest.json")]:
+        with pytest.raises(SystemExit, match=message):
+            ho.main([*base, "--heldout", str(heldout)])
+    assert not (tmp_path / "o.json").exists()
