@@ -27,7 +27,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from preset_sweep import parse_setting  # noqa: E402  (NAME=FIELD:VALUE,... -> LiftedConfig)
+from preset_sweep import parse_settings  # noqa: E402  (NAME=FIELD:VALUE,... -> LiftedConfig)
 
 SPLITS = ("train", "val", "test")
 GROUPS = (("all", lambda k: k > 0), ("1-3", lambda k: k <= 3), ("4-5", lambda k: k >= 4))
@@ -51,9 +51,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0, help="the bootstrap's seed")
     ap.add_argument("--out", required=True, type=Path)
     args = ap.parse_args(argv)
-    settings = dict(parse_setting(s) for s in args.setting)
-    if len(settings) != len(args.setting):
-        raise SystemExit("heldout_accuracy: two --setting share a name")
+    settings = parse_settings(args.setting, "heldout_accuracy")
     for d in (*args.data, args.heldout):
         if not (d / "manifest.json").is_file():
             raise SystemExit(f"heldout_accuracy: no data set at {d} (no manifest.json)")
@@ -65,8 +63,6 @@ def main(argv: list[str] | None = None) -> int:
         raise SystemExit(f"heldout_accuracy: {args.heldout} is a copy of {same[0]} (the same manifest.json): "
                          "its training split made the rules")
     first = next(iter(settings.values()))
-    if any((c.source, c.min_info) != (first.source, first.min_info) for c in settings.values()):
-        raise SystemExit("heldout_accuracy: every setting needs the same source and min_info (one reading)")
 
     from symlearn.export.lifted_export import _fields, check_lifted, distil_rules, network_steps, split_codes, \
         training_moves

@@ -67,6 +67,18 @@ def parse_setting(spec: str):
         raise SystemExit(f"preset_sweep: --setting {name}: {e}") from None
 
 
+def parse_settings(specs: list[str], script: str) -> dict:
+    """Several --setting values -> {NAME: LiftedConfig}; SystemExit if two share a name, or if they differ in
+    source or min_info (the settings are distilled from one reading of the training moves)."""
+    settings = dict(parse_setting(s) for s in specs)
+    if len(settings) != len(specs):
+        raise SystemExit(f"{script}: two --setting share a name")
+    first = next(iter(settings.values()))
+    if any((c.source, c.min_info) != (first.source, first.min_info) for c in settings.values()):
+        raise SystemExit(f"{script}: every setting needs the same source and min_info (one reading of the moves)")
+    return settings
+
+
 def cubes_only(rules):
     """The same rules without any stick move (the --probe-sticks form)."""
     keep = tuple(r for r in rules.rules if dict(r.key)["cls"] == "cube")
@@ -173,12 +185,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--timeout", type=float, default=10.0, help="seconds per call")
     ap.add_argument("--out", required=True, type=Path)
     args = ap.parse_args(argv)
-    settings = dict(parse_setting(s) for s in args.setting)
-    if len(settings) != len(args.setting):
-        raise SystemExit("preset_sweep: two --setting share a name")
-    first = next(iter(settings.values()))
-    if any((c.source, c.min_info) != (first.source, first.min_info) for c in settings.values()):
-        raise SystemExit("preset_sweep: every setting needs the same source and min_info (one reading of the moves)")
+    settings = parse_settings(args.setting, "preset_sweep")
     for d in args.data:
         if not d.is_dir():
             raise SystemExit(f"preset_sweep: no data set at {d}")
@@ -200,7 +207,7 @@ def main(argv: list[str] | None = None) -> int:
            "timeout_s": args.timeout, "settings": {n: dataclasses.asdict(c) for n, c in settings.items()},
            "data": [str(d) for d in args.data], "probe_sticks": args.probe_sticks}
 
-    seen = training_moves(reader, transition, list(args.data), first)
+    seen = training_moves(reader, transition, list(args.data), next(iter(settings.values())))
     val = [(d, split_codes(reader, d, "val")) for d in args.data]
     val_net = [network_steps(transition, s.before, s.action, s.mask) for _, s in val]
     forms, texts, report = {}, {}, {}  # texts: each form's domain and static facts, written once
