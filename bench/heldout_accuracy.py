@@ -5,7 +5,7 @@ the robot observed next) then has a standard error of about 0.011 (0.0033 on 12,
 differences between the settings of the lifted export. This script reads a whole further data set (`symlearn
 collect` with a seed of its own; all its splits are unseen by the run), checks each setting's rules on every step
 of it beside m(z), and gives the difference with a paired bootstrap 95% interval, by object count and by what the
-rules make of a step (`check_lifted`).
+rules make of a step (`step_checks`, which `check_lifted` tallies).
 
     symlearn collect --out data/k15h2 --n 12000 --objects 1-5 --workers 2 --seed 102
     python bench/heldout_accuracy.py --run RUN --data data/paper_a data/k15 --heldout data/k15h2 \
@@ -58,13 +58,14 @@ def main(argv: list[str] | None = None) -> int:
     if args.heldout.resolve() in {d.resolve() for d in args.data}:
         raise SystemExit(f"heldout_accuracy: {args.heldout} is one of --data: its training split made the rules")
     from pddl_export.files import sha256_file
-    same = [d for d in args.data if sha256_file(d / "manifest.json") == sha256_file(args.heldout / "manifest.json")]
+    heldout_hash = sha256_file(args.heldout / "manifest.json")
+    same = [d for d in args.data if sha256_file(d / "manifest.json") == heldout_hash]
     if same:
         raise SystemExit(f"heldout_accuracy: {args.heldout} is a copy of {same[0]} (the same manifest.json): "
                          "its training split made the rules")
     first = next(iter(settings.values()))
 
-    from symlearn.export.lifted_export import _fields, check_lifted, distil_rules, network_steps, split_codes, \
+    from symlearn.export.lifted_export import distil_rules, network_steps, split_codes, step_checks, \
         training_moves
     from symlearn.provenance import atomic_write_json, bench_context
     from symlearn.symbolic.learned_transition import planning_models
@@ -74,32 +75,26 @@ def main(argv: list[str] | None = None) -> int:
     model_hash = sha256_file(args.run / TRANSITION_FILE)[:16]
     seen = training_moves(reader, transition, list(args.data), first)
     rules = {n: distil_rules(seen, c, model_hash) for n, c in settings.items()}
-    right = {n: [] for n in rules}
-    net_right, counts = [], []
+    right: dict = {n: [] for n in rules}
+    net_right: dict = {n: [] for n in rules}
+    counts: dict = {n: [] for n in rules}
     by_case: dict = {n: {} for n in rules}
     for split in SPLITS:
         s = split_codes(reader, args.heldout, split)
         net = network_steps(transition, s.before, s.action, s.mask)
         for n, r in rules.items():
-            for group, c in check_lifted(r, s, net).items():
-                for case, v in c["by_case"].items():
-                    t = by_case[n].setdefault(group, {}).setdefault(case, Counter())
-                    t["cases"] += v["cases"]
-                    t["rules_right"] += round(v["accuracy_rules"] * v["cases"])
-                    t["m(z)_right"] += round(v["accuracy_net"] * v["cases"])
-        any_rules = next(iter(rules.values()))
-        for i in range(len(s.action)):
-            k = int(s.mask[i].sum())
-            observed = _fields(any_rules, any_rules.pieces(s.after[i, :k].tolist()))
-            counts.append(k)
-            net_right.append(_fields(any_rules, any_rules.pieces(net[i, :k].tolist())) == observed)
-            for n, r in rules.items():
-                after, _ = r.step_pieces(r.pieces(s.before[i, :k].tolist()), int(s.action[i]))
-                right[n].append(_fields(r, after) == observed)
-    counts_a, net_a = np.array(counts), np.array(net_right)
+            for c in step_checks(r, s, net):
+                right[n].append(c.rules_right)
+                net_right[n].append(c.net_right)
+                counts[n].append(c.objects)
+                for group in ("all", "1-3" if c.objects <= 3 else "4-5"):
+                    t = by_case[n].setdefault(group, {}).setdefault(c.case, Counter())
+                    t["cases"] += 1
+                    t["rules_right"] += c.rules_right
+                    t["m(z)_right"] += c.net_right
     report = {}
     for n in rules:
-        mine = np.array(right[n])
+        mine, net_a, counts_a = np.array(right[n]), np.array(net_right[n]), np.array(counts[n])
         report[n] = {"setting": dataclasses.asdict(settings[n]), "rules": len(rules[n].rules),
                      "end_rules": len(rules[n].end_rules)}
         for group, pick in GROUPS:
@@ -108,14 +103,15 @@ def main(argv: list[str] | None = None) -> int:
                                 "m(z)": round(float(net_a[sel].mean()), 4),
                                 "difference": round(float(mine[sel].mean() - net_a[sel].mean()), 4),
                                 "ci95": paired_interval(mine[sel], net_a[sel], args.seed)}
-        report[n]["by_case"] = {g: {c: dict(t) for c, t in d.items()} for g, d in by_case[n].items()}
+        report[n]["by_case"] = {g: {c: dict(t) for c, t in sorted(d.items(), key=lambda x: -x[1]["cases"])}
+                                for g, d in by_case[n].items()}
         a = report[n]["all"]
         print(f"{n}: rules {a['rules']:.4f}, m(z) {a['m(z)']:.4f}, difference {a['difference']:+.4f} "
               f"(95% {a['ci95'][0]:+.4f} to {a['ci95'][1]:+.4f}); 1-3 objects {report[n]['1-3']['difference']:+.4f},"
               f" 4-5 {report[n]['4-5']['difference']:+.4f}")
     atomic_write_json(args.out, {"run": str(args.run), "run_model_hash": model_hash,
                                  "data": [str(d) for d in args.data], "heldout": str(args.heldout),
-                                 "heldout_manifest_sha256": sha256_file(args.heldout / "manifest.json")[:16],
+                                 "heldout_manifest_sha256": heldout_hash[:16],
                                  "seed": args.seed, "summary": report, **bench_context()})
     print(f"wrote {args.out}")
     return 0

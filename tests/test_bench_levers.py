@@ -75,7 +75,6 @@ def test_the_rules_load_baseline_builds_and_checks_groups_as_ruleset_does():
     assert _first_overlap(lo, hi) == load.baseline_first_overlap(lo, hi) == (0, 1)
 
 
-
 def test_heldout_accuracy_interval_and_refusals(tmp_path):
     """bench/heldout_accuracy.py: the paired interval brackets the mean difference and narrows with more steps;
     a held-out set that made the rules (the same folder, or a copy of it) or no data set at all is refused in

@@ -19,7 +19,7 @@ import time
 from collections import Counter
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Sequence
+from typing import Iterator, Sequence
 
 import numpy as np
 
@@ -159,11 +159,20 @@ def case_of(pieces, action: int, fired: bool) -> str:
     return move if isinstance(move, str) else "no rule"
 
 
-def check_lifted(rules: LiftedRules, split: Split, net_next: np.ndarray) -> dict:
-    """Whole-scene agreement on a split, by object count: the rules against m(z), each against the observation;
-    where the two disagree, which one the world sides with; and the same by case (case_of), so the report says
-    where the rules lose to m(z)."""
-    tally: dict = {}
+@dataclass(frozen=True)
+class StepCheck:
+    """One step of a split, compared on what the domain states: the rules' next scene, m(z)'s and the observed."""
+
+    objects: int
+    case: str  # case_of: what the rules make of the step
+    rules_right: bool  # the rules' next scene is the observed one
+    net_right: bool  # m(z)'s likeliest next scene is the observed one
+    agree: bool  # the rules' next scene is m(z)'s
+    fired: bool  # a rule (or end rule) fired
+
+
+def step_checks(rules: LiftedRules, split: Split, net_next: np.ndarray) -> Iterator[StepCheck]:
+    """Each step of a split as the rules, m(z) (net_next: network_steps) and the world saw it, in order."""
     for n in range(len(split.action)):
         k = int(split.mask[n].sum())
         before = rules.pieces(split.before[n, :k].tolist())
@@ -171,19 +180,28 @@ def check_lifted(rules: LiftedRules, split: Split, net_next: np.ndarray) -> dict
         mine = _fields(rules, after)
         net = _fields(rules, rules.pieces(net_next[n, :k].tolist()))
         seen = _fields(rules, rules.pieces(split.after[n, :k].tolist()))
-        case = case_of(before, int(split.action[n]), rule is not None)
-        for group in ("all", "1-3" if k <= 3 else "4-5"):
+        yield StepCheck(k, case_of(before, int(split.action[n]), rule is not None), mine == seen, net == seen,
+                        mine == net, rule is not None)
+
+
+def check_lifted(rules: LiftedRules, split: Split, net_next: np.ndarray) -> dict:
+    """Whole-scene agreement on a split, by object count: the rules against m(z), each against the observation;
+    where the two disagree, which one the world sides with; and the same by case (case_of), so the report says
+    where the rules lose to m(z)."""
+    tally: dict = {}
+    for c in step_checks(rules, split, net_next):
+        for group in ("all", "1-3" if c.objects <= 3 else "4-5"):
             g = tally.setdefault(group, {})
-            for t in (g.setdefault("", Counter()), g.setdefault(case, Counter())):
+            for t in (g.setdefault("", Counter()), g.setdefault(c.case, Counter())):
                 t["cases"] += 1
-                t["rules_vs_net"] += mine == net
-                t["rules_vs_observed"] += mine == seen
-                t["net_vs_observed"] += net == seen
-                t["rule_fired"] += rule is not None
-                if mine != net:
+                t["rules_vs_net"] += c.agree
+                t["rules_vs_observed"] += c.rules_right
+                t["net_vs_observed"] += c.net_right
+                t["rule_fired"] += c.fired
+                if not c.agree:
                     t["disagree"] += 1
-                    t["world_sides_with_rules"] += mine == seen
-                    t["world_sides_with_net"] += net == seen
+                    t["world_sides_with_rules"] += c.rules_right
+                    t["world_sides_with_net"] += c.net_right
 
     def summary(t: Counter) -> dict:
         return {"cases": t["cases"], "fidelity_to_net": round(t["rules_vs_net"] / t["cases"], 4),
