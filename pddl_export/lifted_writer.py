@@ -6,8 +6,11 @@ places as constants, and relations read from the location bits: `(at ?b ?l)` (ne
 (the top at a location: where a released object lands) and `(rests ?b ?t)` (what is left at its location when it
 is lifted), where the top `?t` is a layer (`h0`: the table; `h3`: a block standing there, its top at level 3) or
 the end of a far-row stick lying over the location from a neighbour (`h1-end`); `(beneath ?l ?h)` (what is
-left under a stick's end); and `(stands ?b ?l ?h)`, `at` and `level` together, which lets Fast Downward's relaxed
-exploration refuse a goal no move builds in one place (_stands_effects). The ends keep a move onto a stick's end
+left under a stick's end); `(stands ?b ?l ?h)`, `at` and `level` together, which lets Fast Downward's relaxed
+exploration refuse a goal no move builds in one place (_stands_effects); and `(vacant ?l ?h)`, no block standing
+at ?l with its top at ?h, kept by every move, which lets its invariant synthesis find one block per location and
+level and refuse a goal that puts two there (_occupancy). A goal also says what each block on its spot rests on
+(_rests_fact), so that the relaxed check sees the tops a block can be put on. The ends keep a move onto a stick's end
 and one onto a tower of the same height apart (the rules' `v.at`, `u.at`: without them both actions would apply to
 either). The learned bits are unary
 predicates, `(bit-I ?b)` true where bit I is 1 (docs/DOMAIN.md says what they mean in a real run), with a negative
@@ -349,6 +352,67 @@ def _stands_effects(pre: Sequence[str], eff: Sequence[str]) -> list[str]:
     return out
 
 
+_STANDS = re.compile(r"^\((not \()?stands (\S+) (\S+) ([^\s)]+)\)\)?$")
+
+
+def _occupancy(s: Schema) -> Schema | None:
+    """A schema with `(vacant ?l ?h)` kept: no block stands at location ?l with its top at level ?h. None where the
+    move cannot state it (below).
+
+    Each block a move lifts from a (location, level) must stand there (a precondition) and leaves it vacant; each
+    block it puts at one needs it vacant and fills it. Fast Downward's invariant synthesis then finds, for every
+    location and level, that at most one of `vacant` and the blocks' `stands` there holds (the scene model's own
+    fact: every block covers its nearest location, on its spot or off it, so a second one lands on top of it), and
+    its translator refuses at once a goal that puts two blocks at one location and level, which the height field's
+    last layer (h7: a top at 35 cm or more) can state; otherwise the relaxed task reaches each of those goal facts
+    and the search must exhaust every state the rules reach to prove the goal unreachable.
+
+    None where a block lands at the level of the top it lands on (the height field's last layer on both: the
+    location then holds two blocks at that level), where two blocks fill one place, or where a block may stay at its
+    place (a stick dragged by its end that keeps its location, its levels before and after parameters):
+    `schemas` then states no occupancy in the whole domain, so that every move applies as the rules say."""
+    eff = list(s.eff[:-1] if s.cost is not None else s.eff)
+    tail = list(s.eff[len(eff):])
+    leaves, fills = [], []
+    for lit in eff:
+        m = _STANDS.match(lit)
+        if m:
+            (leaves if m.group(1) else fills).append((m.group(3), m.group(4)))
+    left, filled = set(leaves), set(fills)
+    if len(filled) < len(fills) or any(f"(height {loc} {h})" in s.pre for loc, h in filled) or any(
+            loc == loc2 and h != h2 and "?" in h + h2 for loc, h in filled for loc2, h2 in left):
+        return None
+    pre = _stands_preconditions(list(s.pre) + [f"(stands {m.group(2)} {m.group(3)} {m.group(4)})"
+                                              for m in map(_STANDS.match, eff) if m and m.group(1)])
+    for loc, h in sorted(filled - left):
+        pre.append(f"(vacant {loc} {h})")
+        eff.append(f"(not (vacant {loc} {h}))")
+    eff += [f"(vacant {loc} {h})" for loc, h in sorted(left - filled)]
+    pre, eff = tuple(dict.fromkeys(pre)), tuple(dict.fromkeys(eff)) + tuple(tail)
+    if (pre, eff) == (s.pre, s.eff):
+        return s
+    head = s.text.split("\n  (:action ", 1)[0].strip() if "\n  (:action " in s.text else ""
+    return dataclasses.replace(s, pre=pre, eff=eff, text=_schema_text(s.name, s.params, pre, eff, head))
+
+
+def _stands_preconditions(pre: list[str]) -> list[str]:
+    """Preconditions with each block's `(at T L)` and `(level T H)` read as the one `(stands T L H)` they state
+    together (every action keeps stands equal to at and level): the same ground actions, with one atom fewer to
+    join for each block a move reads, which pays for the occupancy's (`_occupancy`) work in the translator."""
+    def value(predicate: str, term: str) -> str | None:
+        head = f"({predicate} {term} "
+        return next((x[len(head):-1] for x in pre if x.startswith(head) and x.count(" ") == 2), None)
+    out: list[str] = []
+    for lit in pre:
+        words = lit.strip("()").split()
+        if words[0] in ("at", "level") and len(words) == 3 and value("at", words[1]) and value("level", words[1]):
+            if words[0] == "at":
+                out.append(f"(stands {words[1]} {words[2]} {value('level', words[1])})")
+            continue
+        out.append(lit)
+    return list(dict.fromkeys(out))
+
+
 def _replace(predicate: str, term: str, old: str, new: str) -> list[str]:
     """Effects moving a one-value fluent of term from old to new (none where they are equal)."""
     return [] if old == new else [f"(not ({predicate} {term} {old}))", f"({predicate} {term} {new})"]
@@ -680,9 +744,10 @@ def schemas(rules: LiftedRules, costs: bool = False) -> tuple[Schema, ...]:
     """
     found = merged_pairs(moves(rules, costs))
     halves = tuple(_halves(s) for s in found)
-    if not any(s.step == "release" for s in halves):
-        return halves
-    return (_pick_cube(),) + halves
+    if any(s.step == "release" for s in halves):
+        halves = (_pick_cube(),) + halves
+    kept = tuple(_occupancy(s) for s in halves)
+    return halves if None in kept else kept
 
 
 def _distinct(found: Iterable[Schema]) -> tuple[Schema, ...]:
@@ -776,7 +841,7 @@ def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
             "  (:types\n    block location layer position - object\n    cube stick - block)\n"
             f"  (:constants {locs} - location {' '.join(PLACES)} - position\n    {lvls} - layer)\n"
             "  (:predicates (at ?b - block ?l - location) (level ?b - block ?h - layer)\n"
-            "               (stands ?b - block ?l - location ?h - layer)\n"
+            "               (stands ?b - block ?l - location ?h - layer) (vacant ?l - location ?h - layer)\n"
             "               (rests ?b - block ?t - layer) (height ?l - location ?t - layer) (same-level ?t - layer ?h - layer)\n"
             "               (beneath ?l - location ?h - layer) (place ?b - block ?p - position)\n"
             "               (near ?l - location) (differ ?a - location ?b - location) (is ?a - location ?b - location)\n"
@@ -792,6 +857,22 @@ def object_name(i: int) -> str:
 def _surface_of(pieces, t: int | None, loc: int) -> str:
     """What piece t (None: nothing) is as the top at location loc."""
     return surface(0 if t is None else pieces[t].level, t is not None and pieces[t].loc == loc)
+
+
+def _rests_fact(pieces, i: int) -> str:
+    """`(rests oI T)`: the top under piece i at its own location (the level, and whether a block stands there or a
+    far-row stick's end lies over it), which is what lifting it leaves there.
+
+    A goal states it too, of each block on its spot, where every object's goal is known, as a blocks-world goal
+    says what each block is on: the goal's levels already fix it, and Fast Downward's relaxed exploration then also
+    sees which top a block can be put on. A goal that only a move rarer than min_count builds (a fourth cube on a
+    tower, whose top the height field's last layer reads as level 7, as it reads a third cube on a stick) is then
+    refused by the translator, where the search would exhaust every state the rules reach. (A block off its spot
+    may have come down beside the top a rule says it lands on, so what it rests on is not stated.)"""
+    p = pieces[i]
+    below = top_of(pieces, p.loc, frozenset(j for j, q in enumerate(pieces) if q.level >= p.level))
+    return (f"(rests {object_name(i)} "
+            f"{top_name(level_name(0 if below is None else pieces[below].level), _surface_of(pieces, below, p.loc))})")
 
 
 def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicGoal, name: str,
@@ -816,9 +897,11 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
         init.append(f"(level {o} {level_name(p.level)})")
         init += _bit_literals(rules, o, p.kind)
         init.append(f"(place {o} {place_name(p.place)})")
-        if p.loc < N_LOCATIONS:  # the level under it at its own location, and whether that stands there
-            below = top_of(pieces, p.loc, frozenset(j for j, q in enumerate(pieces) if q.level >= p.level))
-            init.append(f"(rests {o} {top_name(level_name(0 if below is None else pieces[below].level), _surface_of(pieces, below, p.loc))})")
+        if p.loc < N_LOCATIONS:
+            init.append(_rests_fact(pieces, i))
+    stood = {(p.loc, p.level) for p in pieces if p.loc < N_LOCATIONS}
+    init += [f"(vacant {loc_name(loc)} {level_name(h)})" for loc in range(N_LOCATIONS) for h in range(LEVELS)
+             if (loc, h) not in stood]
     for loc, t in enumerate(graph.tops):
         init.append(f"(height {loc_name(loc)} {top_name(level_name(0 if t is None else pieces[t].level), _surface_of(pieces, t, loc))})")
         for i, p in enumerate(pieces):  # a far-row stick's end over loc: the level under it
@@ -826,6 +909,8 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
                 below = top_of(pieces, loc, frozenset(j for j, q in enumerate(pieces) if q.level >= p.level))
                 init.append(f"(beneath {loc_name(loc)} {level_name(0 if below is None else pieces[below].level)})")
     goals = ["(hand-empty)"]
+    whole = None not in goal.codes  # every object's goal known: what each rests on is known too
+    goal_pieces = [rules.layout.piece(code, pieces[i].stick) for i, code in enumerate(goal.codes)] if whole else []
     for i, code in enumerate(goal.codes):
         if code is None:
             continue
@@ -835,6 +920,8 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
             goals += [f"(at {o} {loc_name(g.loc)})", f"(stands {o} {loc_name(g.loc)} {level_name(g.level)})"]
         goals.append(f"(level {o} {level_name(g.level)})")
         goals.append(f"(place {o} {place_name(g.place)})")
+        if whole and g.on_location:  # one off its spot may have come down beside what a rule says it lands on
+            goals.append(_rests_fact(goal_pieces, i))
     if costs:
         init.append("(= (total-cost) 0)")
     init_s = "\n    ".join(init)

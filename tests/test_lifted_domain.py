@@ -20,6 +20,7 @@ from pddl_export.lifted_rules import REFINEMENTS, LiftedRules, distil_lifted, ke
 from pddl_export.lifted_scene import CodeLayout, Piece, kept_bits, read_scene
 from pddl_export.lifted_writer import PICK_CUBE, domain_pddl, layer_names, negated_bits, object_name, plan_actions, \
     plan_decoder, problem_pddl, schemas
+from pddl_export.lifted_writer import _rests_fact
 from pddl_export.symbolic import SymbolicGoal
 from symlearn.problems.stacking import act, drop_all
 from symlearn.world import ObjectType
@@ -253,6 +254,7 @@ def test_pddl_successors_are_the_rules(fixture, request):
     get_environment().credits_stream = None
     pair_rules = request.getfixturevalue(fixture)
     domain = domain_pddl(pair_rules)
+    assert "(vacant ?to " in domain  # the world's rules state where a place is free (test_two_blocks_at_one_...)
     states = [m[0] for m in world_moves(3 if fixture == "pair_rules" else 12, seed=2, objects=(2, 2))]
     checked = pooled = 0
     decode = plan_decoder(pair_rules)
@@ -282,6 +284,18 @@ def test_pddl_successors_are_the_rules(fixture, request):
                     stands = [(loc, h) for loc in range(6) for h in range(8) if nxt.get_value(problem.fluent("stands")(
                         o, problem.object(f"l{loc}"), problem.object(f"h{h}"))).bool_constant_value()]
                     assert stands == [(p.loc, p.level)], f"object {i} stands at {stands} after action {a} from {start}"
+                # rests: what the problem writer reads under each block of the scene the rules predict (a goal
+                # states it, _rests_fact, so the two must agree or a goal the rules reach would be refused)
+                rests = {f"(rests {object_name(i)} {t})" for i in range(len(want)) for t in layer_names()
+                         if nxt.get_value(problem.fluent("rests")(problem.object(object_name(i)),
+                                                                  problem.object(t))).bool_constant_value()}
+                assert rests == {_rests_fact(want, i) for i, p in enumerate(want) if p.loc < 6}, \
+                    f"rests after action {a} from {start}"
+                # vacant: exactly the (location, level) places no block stands at
+                vacant = {(loc, h) for loc in range(6) for h in range(8) if nxt.get_value(problem.fluent("vacant")(
+                    problem.object(f"l{loc}"), problem.object(f"h{h}"))).bool_constant_value()}
+                assert vacant == {(loc, h) for loc in range(6) for h in range(8)} - {(p.loc, p.level) for p in want}, \
+                    f"vacant places after action {a} from {start}"
     assert checked >= 3 and (pooled >= 5 if fixture == "pooled_pair_rules" else pooled == 0)
 
 
@@ -452,6 +466,81 @@ def test_a_goal_no_move_builds_in_one_place_is_refused_by_the_translator(world_r
     assert res.status == PlanStatus.UNSOLVABLE, res.message
     # the translator's relaxed exploration found no way to the goal: it wrote the trivially unsolvable task
     assert res.extra["translator_operators"] == 0, f"{res.extra} (the search expanded {res.expansions} states)"
+
+
+def test_two_blocks_at_one_place_are_refused_by_the_translator(world_rules, tmp_path):
+    """`vacant` and `stands` make "one block per location and level" an invariant Fast Downward's translator finds,
+    so a goal with two cubes on the table at l5 (two tops at level 2 there, which the height field's last layer
+    can state of a tall tower) is refused before any search, though each cube alone can be put there."""
+    from search.result import PlanStatus
+    from search.stock_planners import solve_files
+    types = [ObjectType.CUBE] * 3
+    start = [located_code(drop_all([(ObjectType.CUBE, x) for x in (0, 3, 4)]), types, i) for i in range(3)]
+    first = located_code(drop_all([(ObjectType.CUBE, x) for x in (5, 3, 4)]), types, 0)
+    second = located_code(drop_all([(ObjectType.CUBE, x) for x in (0, 5, 4)]), types, 1)
+    assert world_rules.pieces([first])[0].level == world_rules.pieces([second])[0].level == 2
+    (tmp_path / "domain.pddl").write_text(domain_pddl(world_rules))
+    for name, goal, status in (("alone", (first, None, None), PlanStatus.SOLVED),
+                               ("both", (first, second, None), PlanStatus.UNSOLVABLE)):
+        (tmp_path / f"{name}.pddl").write_text(problem_pddl(world_rules, start, SymbolicGoal(goal), name))
+        res = solve_files(tmp_path / "domain.pddl", tmp_path / f"{name}.pddl", "fd-lama-first", timeout_s=60,
+                          action_ids=lambda steps: plan_actions(world_rules, steps))
+        assert res.status == status, (name, res.message)
+    assert res.extra["translator_operators"] == 0, f"{res.extra} (the search expanded {res.expansions} states)"
+
+
+def test_a_whole_goal_says_what_each_block_rests_on_and_a_top_no_move_reaches_is_refused(world_rules, tmp_path):
+    """Where every object's goal is known the goal also states `rests` (what each block is on, as blocks-world
+    goals do). With the moves that put a cube on a far-row stick's end taken out, a cube on the end of a stick at l0
+    is refused by the translator: some move still puts a cube at l1 at level 3 (onto a stick standing there), so
+    without `rests` the goal passes the relaxed check and the search has to look."""
+    from search.result import PlanStatus
+    from search.stock_planners import solve_files
+    types = [ObjectType.STICK, ObjectType.CUBE]
+    start_state = drop_all([(ObjectType.STICK, 0), (ObjectType.CUBE, 4)])
+    start = [located_code(start_state, types, i) for i in range(2)]
+    on_end = act(start_state, types, 4, 1)  # the cube onto the stick's end over l1, in the world
+    goal = [located_code(on_end, types, i) for i in range(2)]
+    text = problem_pddl(world_rules, start, SymbolicGoal(tuple(goal)), "p01")
+    assert {"(rests o0 h0)", "(rests o1 h1-end)"} == set(re.findall(r"\(rests o\d [^\s)]+\)", text.split("(:goal")[1]))
+    partial = problem_pddl(world_rules, start, SymbolicGoal((None, goal[1])), "p").split("(:goal", 1)[1]
+    assert "(rests " not in partial  # what the cube rests on depends on the stick, whose goal is not known
+    rules = dataclasses.replace(world_rules, rules=tuple(r for r in world_rules.rules if r.fields()["o.stick"] or not (
+        r.fields()["v.level"] == 1 and not r.fields()["v.at"])))
+    assert len(rules.rules) < len(world_rules.rules)
+    (tmp_path / "domain.pddl").write_text(domain_pddl(rules))
+    text = problem_pddl(rules, start, SymbolicGoal(tuple(goal)), "p01")
+    (tmp_path / "p01.pddl").write_text(text)
+    (tmp_path / "p02.pddl").write_text(text.replace("(rests o1 h1-end))", ")"))
+    found = {}
+    for name in ("p01", "p02"):
+        found[name] = solve_files(tmp_path / "domain.pddl", tmp_path / f"{name}.pddl", "fd-lama-first",
+                                  timeout_s=60, action_ids=lambda steps: plan_actions(rules, steps))
+        assert found[name].status == PlanStatus.UNSOLVABLE, found[name].message
+    assert found["p01"].extra["translator_operators"] == 0, found["p01"].extra
+    assert found["p02"].extra["translator_operators"] > 0, found["p02"].extra  # without rests: searched
+
+
+@pytest.mark.parametrize("pre, eff", [
+    # a cube landing at the level of the top it lands on (both the height field's last layer)
+    (("(holding ?o)", "(height ?to h7)"), ("(at ?o ?to)", "(stands ?o ?to h7)")),
+    # a stick dragged by its end that may keep its location and level
+    (("(at ?o l0)", "(level ?o ?h)"), ("(not (stands ?o l0 ?h))", "(stands ?o l0 ?new)")),
+    # two blocks put at one place
+    (("(holding ?o)",), ("(stands ?o ?to h3)", "(stands ?r0 ?to h3)")),
+])
+def test_a_move_that_cannot_state_occupancy_leaves_it_out_of_the_whole_domain(pre, eff):
+    """Where a move may leave two blocks at one place, or keep a block where it stood, `vacant` would forbid what
+    the rules allow: that move states none (_occupancy gives None) and `schemas` writes no occupancy at all."""
+    from pddl_export.lifted_writer import Schema, _occupancy
+    params = (("?o", "block"), ("?to", "location"), ("?r0", "block"), ("?h", "layer"), ("?new", "layer"))
+    assert _occupancy(Schema("m", None, None, "  ; m\n  (:action m\n", params, pre, eff)) is None
+    plain = _occupancy(Schema("m", None, None, "  ; m\n  (:action m\n", params,
+                              ("(at ?o l0)", "(level ?o h2)", "(height ?to h0)"),
+                              ("(not (stands ?o l0 h2))", "(stands ?o ?to h2)", "(increase (total-cost) 10)"), cost=10))
+    assert plain.pre == ("(stands ?o l0 h2)", "(height ?to h0)", "(vacant ?to h2)")
+    assert plain.eff == ("(not (stands ?o l0 h2))", "(stands ?o ?to h2)", "(not (vacant ?to h2))", "(vacant l0 h2)",
+                         "(increase (total-cost) 10)")
 
 
 def _pddlgym_env(domain, problems_dir):
@@ -971,7 +1060,8 @@ def test_the_presets_of_export_pddl():
     fast = LIFTED_PRESETS["fast"]
     assert fast == LiftedConfig() and fast.pool_min_count == 0 == fast.end_min_count
     acc = LIFTED_PRESETS["accurate"]
-    assert acc.min_count < fast.min_count and acc.pair_min_count > fast.pair_min_count
+    assert (fast.min_count, fast.rider_min_count) == (20, 6) and (acc.min_count, acc.rider_min_count) == (30, 3)
+    assert acc.pair_min_count > fast.pair_min_count
     assert acc.pool_min_count > 0 and acc.end_min_count > 0 and set(acc.pool_classes) == {"cube"}
     with pytest.raises(ValueError, match="pool_classes=.* must name some of cube, near"):
         LiftedConfig(pool_classes=("pair",))
