@@ -334,19 +334,22 @@ def _stick_ends(rules: LiftedRules, f: dict, pick: int, ho: str, before: dict, u
     return riders
 
 
+def _value(literals: Sequence[str], predicate: str, term: str) -> str | None:
+    """The second argument of the first `(predicate term X)` among literals (`at`, `level`: a block's one value)."""
+    head = f"({predicate} {term} "
+    return next((x[len(head):-1] for x in literals if x.startswith(head)), None)
+
+
 def _stands_effects(pre: Sequence[str], eff: Sequence[str]) -> list[str]:
     """The `stands` effects of a move: each block it moves from one (location, level) to another stops standing at
     the first and stands at the second. `(stands ?b ?l ?h)` repeats `at` and `level` together, so that Fast
     Downward's relaxed reachability sees which location and level a block can reach together: a goal no rule can
     build (a stick on a tower in the far row, where no rule puts one) is refused by the translator at once, where
     at and level alone are each reachable and the search would have to exhaust the task's states to prove it."""
-    def value(literals: Sequence[str], predicate: str, term: str) -> str | None:
-        head = f"({predicate} {term} "
-        return next((x[len(head):-1] for x in literals if x.startswith(head)), None)
     out: list[str] = []
     for term in dict.fromkeys(x.split()[1] for x in pre if x.startswith("(at ")):
-        loc, level = value(pre, "at", term), value(pre, "level", term)
-        new_loc, new_level = value(eff, "at", term) or loc, value(eff, "level", term) or level
+        loc, level = _value(pre, "at", term), _value(pre, "level", term)
+        new_loc, new_level = _value(eff, "at", term) or loc, _value(eff, "level", term) or level
         if level is not None and (loc, level) != (new_loc, new_level):
             out += [f"(not (stands {term} {loc} {level}))", f"(stands {term} {new_loc} {new_level})"]
     return out
@@ -373,17 +376,14 @@ def _occupancy(s: Schema) -> Schema | None:
     `schemas` then states no occupancy in the whole domain, so that every move applies as the rules say."""
     eff = list(s.eff[:-1] if s.cost is not None else s.eff)
     tail = list(s.eff[len(eff):])
-    leaves, fills = [], []
-    for lit in eff:
-        m = _STANDS.match(lit)
-        if m:
-            (leaves if m.group(1) else fills).append((m.group(3), m.group(4)))
-    left, filled = set(leaves), set(fills)
+    found = [m.groups() for m in map(_STANDS.match, eff) if m]  # (deleted, block, location, level)
+    leaves = [(b, loc, h) for deleted, b, loc, h in found if deleted]
+    fills = [(loc, h) for deleted, _, loc, h in found if not deleted]
+    left, filled = {(loc, h) for _, loc, h in leaves}, set(fills)
     if len(filled) < len(fills) or any(f"(height {loc} {h})" in s.pre for loc, h in filled) or any(
             loc == loc2 and h != h2 and "?" in h + h2 for loc, h in filled for loc2, h2 in left):
         return None
-    pre = _stands_preconditions(list(s.pre) + [f"(stands {m.group(2)} {m.group(3)} {m.group(4)})"
-                                              for m in map(_STANDS.match, eff) if m and m.group(1)])
+    pre = _stands_preconditions(list(s.pre) + [f"(stands {b} {loc} {h})" for b, loc, h in leaves])
     for loc, h in sorted(filled - left):
         pre.append(f"(vacant {loc} {h})")
         eff.append(f"(not (vacant {loc} {h}))")
@@ -399,15 +399,13 @@ def _stands_preconditions(pre: list[str]) -> list[str]:
     """Preconditions with each block's `(at T L)` and `(level T H)` read as the one `(stands T L H)` they state
     together (every action keeps stands equal to at and level): the same ground actions, with one atom fewer to
     join for each block a move reads, which pays for the occupancy's (`_occupancy`) work in the translator."""
-    def value(predicate: str, term: str) -> str | None:
-        head = f"({predicate} {term} "
-        return next((x[len(head):-1] for x in pre if x.startswith(head) and x.count(" ") == 2), None)
     out: list[str] = []
     for lit in pre:
         words = lit.strip("()").split()
-        if words[0] in ("at", "level") and len(words) == 3 and value("at", words[1]) and value("level", words[1]):
+        if words[0] in ("at", "level") and len(words) == 3 and _value(pre, "at", words[1]) and \
+                _value(pre, "level", words[1]):
             if words[0] == "at":
-                out.append(f"(stands {words[1]} {words[2]} {value('level', words[1])})")
+                out.append(f"(stands {words[1]} {words[2]} {_value(pre, 'level', words[1])})")
             continue
         out.append(lit)
     return list(dict.fromkeys(out))
