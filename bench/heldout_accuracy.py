@@ -9,11 +9,12 @@ rules make of a step (`step_checks`, which `check_lifted` tallies).
 
     symlearn collect --out data/k15h2 --n 12000 --objects 1-5 --workers 2 --seed 102
     python bench/heldout_accuracy.py --run RUN --data data/paper_a data/k15 --heldout data/k15h2 \
-        --setting fast= --setting m20r6=min_count:20,rider_min_count:6 \
+        --setting fast=min_count:50,rider_min_count:3 --setting m20r6=min_count:20,rider_min_count:6 \
         --setting accurate=min_count:30,pair_min_count:10,pool_min_count:20,pool_classes:cube,pool_structure_min:12,end_min_count:6 \
         --out bench/results/heldout_k15h2.json
 
-A setting is NAME=FIELD:VALUE,... over LiftedConfig's fields, as in bench/preset_sweep.py; empty: the defaults.
+A setting is NAME=FIELD:VALUE,... over LiftedConfig's fields, as in bench/preset_sweep.py; empty: the defaults
+(min count 20, rider moves 6 since 2026-12-06: `m20r6` above; `fast` there is the earlier default).
 """
 from __future__ import annotations
 
@@ -87,7 +88,7 @@ def main(argv: list[str] | None = None) -> int:
                 right[n].append(c.rules_right)
                 net_right[n].append(c.net_right)
                 counts[n].append(c.objects)
-                for group in ("all", "1-3" if c.objects <= 3 else "4-5"):
+                for group in (g for g, pick in GROUPS if pick(c.objects)):
                     t = by_case[n].setdefault(group, {}).setdefault(c.case, Counter())
                     t["cases"] += 1
                     t["rules_right"] += c.rules_right
