@@ -11,13 +11,22 @@ import argparse
 import re
 from pathlib import Path
 
-from pddl_export.lifted_rules import load_lifted
-from symlearn.export.lifted_export import COST_FORM_DIR, LIFTED_FILE, write_problem_folder
+from symlearn.export.lifted_export import COST_FORM_DIR, check_problem_folder, write_problem_folder
+from symlearn.planning.planners import load_run_lifted
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:
+    try:
+        write_and_show()
+    except ValueError as e:  # a refusal (a bad --out, a lifted.json of another transition.pt): one line
+        raise SystemExit(f"generate_domain.py: error: {e}") from None
+
+
+def write_and_show() -> None:
+    """Check --out and the run's lifted rules (those of its transition.pt, as `symlearn plan` checks them), then
+    write the folder and say what it holds."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--run", default=str(ROOT / "pretrained" / "recommended"))
     ap.add_argument("--problems", help="problem folder (default RUN/problems)")
@@ -25,10 +34,9 @@ def main() -> None:
     args = ap.parse_args()
     run, out = Path(args.run), Path(args.out)
     problems = Path(args.problems) if args.problems else run / "problems"
-    if out.exists() and any(p.suffix not in (".pddl", ".json") and p.name != COST_FORM_DIR for p in out.iterdir()):
-        raise SystemExit(f"generate_domain.py: error: {out} holds files other than a domain folder's; give another --out")
-    rules = load_lifted(run / "pddl" / LIFTED_FILE)
-    index = write_problem_folder(run, problems, out)
+    check_problem_folder(out, "--out")  # before any work: a folder of other files is refused
+    rules = load_run_lifted(run)  # refused if exported from another transition.pt than the run's
+    index = write_problem_folder(run, problems, out, rules=rules)
     domain = (out / "domain.pddl").read_text()
     print(f"domain {out / 'domain.pddl'}: {len(domain) / 1000:.0f} KB, {domain.count('(:action ')} typed STRIPS "
           f"schemas distilled from {rules.stats.get('moves')} observed moves, the same file for any number of objects")

@@ -59,6 +59,7 @@ from typing import Iterable, Sequence
 from pddl_export.end_moves import EndRule
 from pddl_export.lifted_rules import LiftedRules, Rule, relative_change, release_locations
 from pddl_export.lifted_scene import FAR_ROW, NEAR_ROW, N_LOCATIONS, neighbours, read_scene, top_of
+from pddl_export.pddl_writer import checked_name
 from pddl_export.symbolic import SymbolicGoal
 
 LEVELS = 8
@@ -100,9 +101,14 @@ def level_name(h: int) -> str:
     return f"h{int(h)}"
 
 
+def model_hash_text(rules: LiftedRules) -> str:
+    """The transition model's hash as the domain states it (checked_name: a piece of a PDDL name), or 'nohash'."""
+    return checked_name(rules.model_hash, "the lifted rules' model_hash", "part") if rules.model_hash else "nohash"
+
+
 def domain_name(rules: LiftedRules) -> str:
     """The domain's name: carries the transition model's hash, so two runs' domains are told apart."""
-    return f"symlearn-{rules.model_hash or 'nohash'}"
+    return checked_name(f"symlearn-{model_hash_text(rules)}", "domain name")
 
 
 @dataclass(frozen=True)
@@ -831,7 +837,7 @@ def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
     pooled = " ".join(dict.fromkeys(s.predicate for s in found if s.predicate))
     requirements = ":strips :typing :action-costs" if costs else ":strips :typing"
     functions = "  (:functions (total-cost) - number)\n" if costs else ""
-    return (f"; A lifted domain distilled from the transition model {rules.model_hash or '(no hash)'} by symlearn.\n"
+    return (f"; A lifted domain distilled from the transition model {model_hash_text(rules)} by symlearn.\n"
             f"; Blocks stand at locations l0-l5 (far row l0-l2, near row l3-l5) on a support, at a level (5 cm layers).\n"
             f"(define (domain {domain_name(rules)})\n"
             f"  (:requirements {requirements})\n"
@@ -849,7 +855,7 @@ def domain_pddl(rules: LiftedRules, costs: bool = False) -> str:
 
 
 def object_name(i: int) -> str:
-    return f"o{i}"
+    return checked_name(f"o{int(i)}", "object name")
 
 
 def _surface_of(pieces, t: int | None, loc: int) -> str:
@@ -925,7 +931,8 @@ def problem_pddl(rules: LiftedRules, start_codes: Sequence[int], goal: SymbolicG
     init_s = "\n    ".join(init)
     goal_s = "\n    ".join(goals)
     metric = "\n  (:metric minimize (total-cost))" if costs else ""
-    return (f"(define (problem {name})\n  (:domain {domain_name(rules)})\n  (:objects {objs})\n"
+    return (f"(define (problem {checked_name(name, 'problem name')})\n  (:domain {domain_name(rules)})\n"
+            f"  (:objects {objs})\n"
             f"  (:init\n    {init_s})\n  (:goal (and\n    {goal_s})){metric})\n")
 
 

@@ -81,12 +81,39 @@ _OBJECT_RE = re.compile(r"^o([0-9]+)$", re.IGNORECASE)
 # ----------------------------------------------------------------------------- names
 
 
+PDDL_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")  # PDDL's name grammar: a letter, then letters, digits, - and _
+PDDL_NAME_PART = re.compile(r"[A-Za-z0-9_-]+")  # a piece of a name, such as a hash (it may start with a digit)
+MAX_NAME_CHARS = 100
+MAX_COMMENT_CHARS = 200
+NAME_FORMS = ("name", "part", "comment")
+
+
+def checked_name(text: object, what: str, form: str = "name") -> str:
+    """The one check of every string a writer puts into a PDDL (or SAS+) file, whatever file it came from.
+
+    form "name" (domain, problem and object names): `text` itself where it is a PDDL name (PDDL_NAME, at most
+    MAX_NAME_CHARS characters), else a one-line ValueError naming `what`; "part": the same for a piece of a name
+    that may start with a digit (a hash); "comment": any text for a `;` comment, escaped onto one line (every run of
+    whitespace, newlines included, one space; an unprintable character as its escape), at most MAX_COMMENT_CHARS.
+    So no string can end its name or comment and start PDDL text of its own."""
+    if form == "comment":
+        flat = "".join(c if c.isprintable() else ascii(c)[1:-1] for c in " ".join(str(text).split()))
+        return flat if len(flat) <= MAX_COMMENT_CHARS else flat[:MAX_COMMENT_CHARS - 3] + "..."
+    pattern = {"name": PDDL_NAME, "part": PDDL_NAME_PART}[form]
+    if not (isinstance(text, str) and len(text) <= MAX_NAME_CHARS and pattern.fullmatch(text)):
+        first = "letters" if form == "part" else "a letter, then letters"
+        raise ValueError(f"{what} {str(text)[:60]!r} is not a PDDL name ({first}, digits, '-' and '_'; at most "
+                         f"{MAX_NAME_CHARS} characters)")
+    return text
+
+
 def pddl_name(text: str) -> str:
-    """A valid PDDL name from any text: lowercase letters, digits, '-' and '_', starting with a letter."""
+    """A valid PDDL name from any text: lowercase letters, digits, '-' and '_', starting with a letter (checked_name
+    refuses one longer than MAX_NAME_CHARS)."""
     name = re.sub(r"[^a-z0-9_-]+", "-", str(text).strip().lower()).strip("-_")
     if not name:
-        raise ValueError(f"cannot make a PDDL name from {text!r}")
-    return name if name[0].isalpha() else f"x-{name}"
+        raise ValueError(f"cannot make a PDDL name from {str(text)[:60]!r}")
+    return checked_name(name if name[0].isalpha() else f"x-{name}", "PDDL name")
 
 
 def code_predicate(code: int, bits: int) -> str:
@@ -104,7 +131,7 @@ def code_from_predicate(name: str) -> int:
 
 def object_name(index: int) -> str:
     """'o3' for object 3: the PDDL name of the object at that index of the scene."""
-    return f"o{int(index)}"
+    return checked_name(f"o{int(index)}", "object name")
 
 
 def object_index(name: str) -> int:
@@ -134,7 +161,7 @@ def action_id_from_name(name: str) -> int:
 
 
 def _header(kind: str, model_hash: str, rules: RuleSet, extra: Sequence[str] = ()) -> list[str]:
-    one_line = " ".join(str(model_hash).split())
+    one_line = checked_name(model_hash, "model hash", "comment")
     lines = [
         f";; symlearn learned {kind}",
         f";; model-hash: {one_line}",

@@ -24,7 +24,7 @@ from typing import Iterator, Sequence
 import numpy as np
 
 from pddl_export.end_moves import distil_end_rules
-from pddl_export.files import atomic_write_text, sha256_file
+from pddl_export.files import atomic_write_files, atomic_write_folder, json_text, sha256_file
 from pddl_export.lifted_rules import MIN_GAIN, POOL_MIN_COUNT, POOL_STRUCTURE_MIN, POOLED_CLASSES, LiftedRules, \
     build_codebook, distil_lifted, observed_end_moves, observed_moves, participants, stick_reader, \
     with_network_answers
@@ -32,11 +32,16 @@ from pddl_export.lifted_scene import FIELD_BITS, CodeLayout, kept_bits, read_sce
 from pddl_export.lifted_writer import domain_pddl, schemas
 from pddl_export.rules_io import PDDL_DIR
 from pddl_export.symbolic import bits_from_codes
-from symlearn.provenance import atomic_write_json, versions
+from symlearn.outputs import file_output, folder_output
+from symlearn.problems.paths import check_safe_name, path_under
+from symlearn.provenance import versions
 
 LIFTED_FILE = "lifted.json"
 LIFTED_DIR = "lifted"
+DOMAIN_FILE = "domain.pddl"  # in LIFTED_DIR, and in each problem folder (write_problem_folder)
 COST_FORM_DIR = "costs"  # a problem folder's all-outcomes cost form (write_problem_folder)
+LIFTED_MAGIC = (b'{\n  "kind": "symlearn-lifted-rules"',)  # how a lifted.json the export wrote begins
+DOMAIN_MAGIC = (b"; A lifted domain",)  # and its domain.pddl
 
 
 SOURCES = ("observed", "network")
@@ -287,6 +292,7 @@ def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = 
 
     run_dir = Path(run_dir)
     out = Path(out_dir) if out_dir else run_dir / PDDL_DIR
+    domain_path, lifted_path = lifted_outputs(out, "--out" if out_dir else "--run")  # before minutes of work
     reader, transition = planning_models(run_dir)
     if reader.location_bits != FIELD_BITS:
         raise ValueError(f"{run_dir / TRANSITION_FILE}: a lifted domain needs m(z) on {FIELD_BITS} location bits "
@@ -317,10 +323,59 @@ def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = 
                               np.concatenate([_pad(s.mask, width) for s in train] * 2))
     rules = LiftedRules(layout, stick_of, rules.rules, model_hash,
                         {**rules.stats, **report, "end_rules": len(rules.end_rules)}, codebook, rules.end_rules)
-    (out / LIFTED_DIR).mkdir(parents=True, exist_ok=True)
-    atomic_write_text(out / LIFTED_DIR / "domain.pddl", domain)
-    atomic_write_json(out / LIFTED_FILE, rules.to_json())
+    atomic_write_files({domain_path: domain, lifted_path: json_text(rules.to_json())})  # replaced as one unit
     return rules.stats
+
+
+def lifted_outputs(pddl_dir: Path, flag: str = "--out") -> tuple[Path, Path]:
+    """The files export_lifted replaces together, PDDL_DIR/lifted/domain.pddl and PDDL_DIR/lifted.json, checked
+    before any work (symlearn.outputs): the folders no files, the files absent or what the export itself wrote
+    there (never a user's file of that name); ValueError in one line naming `flag` and the path."""
+    pddl_dir = folder_output(Path(pddl_dir), flag)
+    folder_output(pddl_dir / LIFTED_DIR, flag)
+    return (file_output(pddl_dir / LIFTED_DIR / DOMAIN_FILE, flag, kind="a lifted domain", magic=DOMAIN_MAGIC),
+            file_output(pddl_dir / LIFTED_FILE, flag, kind="a lifted-rules JSON", magic=LIFTED_MAGIC))
+
+
+def check_problem_folder(folder: Path, flag: str) -> Path:
+    """A folder write_problem_folder may replace whole: absent, or one holding only what it writes (.pddl and .json
+    files, costs/); refused in one line naming `flag` otherwise (a file, a link, a folder of other files), before
+    any work. Returns the folder."""
+    folder = folder_output(Path(folder), flag)
+    if folder.is_symlink():
+        raise ValueError(f"{flag}: {folder} is a symbolic link; refusing to replace it")
+    if folder.is_dir() and any(p.suffix not in (".pddl", ".json") and p.name != COST_FORM_DIR
+                               for p in folder.iterdir()):
+        raise ValueError(f"{flag}: {folder} holds files other than a problem folder's; give another folder")
+    return folder
+
+
+def problem_folder(pddl_dir: Path, problems_dir: Path) -> Path:
+    """Where export-pddl writes a problem set's standalone folder: PDDL_DIR/lifted/NAME, NAME the name of the set's
+    folder itself (its resolved path: `--problems ..` names the folder it is), a safe name (symlearn.problems.paths)
+    other than the domain's file; checked as check_problem_folder does."""
+    flag = f"--problems {problems_dir}"
+    name = check_safe_name(Path(problems_dir).resolve().name, flag)
+    if name == DOMAIN_FILE:
+        raise ValueError(f"{flag}: a problem folder cannot be named {DOMAIN_FILE}, the lifted domain's file")
+    return check_problem_folder(path_under(Path(pddl_dir) / LIFTED_DIR, name), flag)
+
+
+def export_paths(run_dir: Path, out_dir: Path | None, problem_sets: Sequence[Path] = ()) -> dict[Path, Path]:
+    """Every path a lifted `export-pddl` writes, checked before any work (the distillation takes minutes): its
+    --out (default RUN/pddl), the domain and lifted.json there (lifted_outputs) and one folder per problem set
+    (problem_folder); two sets whose folders share a name are refused, naming both. Returns each set's folder."""
+    pddl_dir = Path(out_dir) if out_dir else Path(run_dir) / PDDL_DIR
+    lifted_outputs(pddl_dir, "--out" if out_dir else "--run")
+    folders: dict[Path, Path] = {}
+    for d in map(Path, problem_sets):
+        folder = problem_folder(pddl_dir, d)
+        other = next((o for o, f in folders.items() if f == folder), None)
+        if other is not None:
+            raise ValueError(f"--problems {other} and {d} would both be written to {folder}; give sets whose "
+                             f"folders have different names")
+        folders[d] = folder
+    return folders
 
 
 def _pad(a: np.ndarray, k: int) -> np.ndarray:
@@ -333,7 +388,7 @@ MAX_DATA_OBJECTS = 5  # the most objects a scene of the data sets had: problems 
 
 
 def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None = None,
-                         pddl_dir: Path | None = None) -> dict:
+                         pddl_dir: Path | None = None, rules: LiftedRules | None = None) -> dict:
     """A standalone benchmark folder of a problem set: the lifted domain.pddl and one pNN.pddl per problem, and
     the same in the domain's all-outcomes cost form under costs/ (COST_FORM_DIR: `:action-costs`, for a cost-aware
     search such as A* with LM-cut).
@@ -341,7 +396,9 @@ def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None
     Each problem's start and goal are the run's codes of its scenes (rendered in the simulator), as the
     planners see them; index.json maps pNN to the source problem, its object count and shortest plan length
     where the problem file records it. Loading the folder needs no torch, no pybullet: only a PDDL planner. The
-    rules are read from pddl_dir (default RUN/pddl: export-pddl's --out), and the folder goes beside them.
+    rules are read from pddl_dir (default RUN/pddl: export-pddl's --out) unless given, and the folder goes beside
+    them (problem_folder). The folder is written whole (a temp folder renamed into place: an earlier one is replaced
+    with no stale file left), and only where check_problem_folder allows it, which is checked first.
     Returns the index; problems with more objects than the data ever showed are listed under `zero_shot`.
     """
     from pddl_export.lifted_rules import load_lifted
@@ -353,9 +410,9 @@ def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None
 
     run_dir, problems_dir = Path(run_dir), Path(problems_dir)
     pddl_dir = Path(pddl_dir) if pddl_dir else run_dir / PDDL_DIR  # where export_lifted wrote (its out_dir)
-    rules = load_lifted(pddl_dir / LIFTED_FILE)
+    out = check_problem_folder(Path(out_dir), "out_dir") if out_dir else problem_folder(pddl_dir, problems_dir)
+    rules = rules if rules is not None else load_lifted(pddl_dir / LIFTED_FILE)
     problems = load_problems(problems_dir)  # refuses a missing or empty folder before any work
-    out = Path(out_dir) if out_dir else pddl_dir / LIFTED_DIR / problems_dir.name
     reader, _ = planning_models(run_dir)
     index = {"domain": "domain.pddl", "cost_form": f"{COST_FORM_DIR}/domain.pddl", "model_hash": rules.model_hash,
              "source": str(problems_dir), "problems": {}, "zero_shot": []}
@@ -375,10 +432,7 @@ def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None
                 index["zero_shot"].append(name)
     finally:
         sim.close()
-    (out / COST_FORM_DIR).mkdir(parents=True, exist_ok=True)
-    atomic_write_text(out / "domain.pddl", domain_pddl(rules))
-    atomic_write_text(out / COST_FORM_DIR / "domain.pddl", domain_pddl(rules, costs=True))
-    for name, text in texts.items():
-        atomic_write_text(out / f"{name}.pddl", text)
-    atomic_write_json(out / "index.json", index)
+    files = {DOMAIN_FILE: domain_pddl(rules), f"{COST_FORM_DIR}/{DOMAIN_FILE}": domain_pddl(rules, costs=True)}
+    files.update({f"{name}.pddl": text for name, text in texts.items()})
+    atomic_write_folder(out, {**files, "index.json": json_text(index)})
     return index

@@ -24,12 +24,13 @@ import numpy as np
 from pddl_export.enumeration import enumerate_scenes, enumerate_transitions, vocabulary_closure
 from pddl_export.distil import distil_rules
 from pddl_export.fidelity import pddl_fidelity, rule_fidelity
-from pddl_export.files import atomic_write_text, sha256_file
+from pddl_export.files import atomic_write_files, json_text, sha256_file
 from pddl_export.outcome_rules import MIN_OUTCOME_RATIO, OUTCOMES_FILE, distil_outcomes, outcomes_to_json
 from pddl_export.pddl_writer import conditional_domain
-from pddl_export.rules_io import PDDL_DIR, rules_to_json
+from pddl_export.rules_io import PDDL_DIR, RULES_FILE, rules_to_json
 from pddl_export.symbolic import code_str
-from symlearn.provenance import atomic_write_json, versions
+from symlearn.config_file import Bound, check_bounds
+from symlearn.provenance import versions
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,9 @@ class ExportConfig:
     outcome_min_ratio: float = MIN_OUTCOME_RATIO
 
     def __post_init__(self) -> None:
+        """Refuse what cannot be enumerated or sampled ([export] in a settings file)."""
+        check_bounds(self, {"min_count": Bound(1, 2**62, integer=True), "seed": Bound(0, 2**63 - 1, integer=True),
+                            "pddl_fidelity_cases": Bound(-1, 10_000_000, integer=True)})
         if not 1 <= self.max_objects <= 5:
             raise ValueError(f"max_objects={self.max_objects} must lie in 1..5")
         if not 0 < self.outcome_min_ratio <= 1:
@@ -115,14 +119,14 @@ def observed_scenes(vocab: set[int], max_objects: int, *code_arrays: np.ndarray,
     return sorted(out)
 
 
-def _export_outcomes(transition, enum, min_ratio: float, out: Path, model_hash: str) -> dict:
-    """Distil and write the second-outcome rules (out/outcomes.json); their summary for the report."""
+def _export_outcomes(transition, enum, min_ratio: float, model_hash: str) -> tuple[dict, dict]:
+    """Distil the second-outcome rules: what out/outcomes.json holds, and their summary for the report."""
     t0 = time.perf_counter()
     outcomes, alt_enum = distil_outcomes(transition, enum, min_ratio)
     fid = rule_fidelity(outcomes.rules, alt_enum)
-    atomic_write_json(out / OUTCOMES_FILE, {"model_hash": model_hash, **outcomes_to_json(outcomes)})
-    return {"min_ratio": min_ratio, "n_rules": outcomes.rules.n_rules, "n_alternatives": len(outcomes.costs),
-            "fidelity": round(fid.fraction, 6), "seconds": round(time.perf_counter() - t0, 1)}
+    return ({"model_hash": model_hash, **outcomes_to_json(outcomes)},
+            {"min_ratio": min_ratio, "n_rules": outcomes.rules.n_rules, "n_alternatives": len(outcomes.costs),
+             "fidelity": round(fid.fraction, 6), "seconds": round(time.perf_counter() - t0, 1)})
 
 
 def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path | None = None,
@@ -165,10 +169,7 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
     fid = rule_fidelity(rules, enum)
     t_fid = time.perf_counter() - t1 - t_rules
     domain = conditional_domain(rules, model_hash)
-    out.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(out / "domain.pddl", domain)
-    atomic_write_json(out / "rules.json", {"model_hash": model_hash, **rules_to_json(rules)})
-    outcomes_report = _export_outcomes(transition, enum, cfg.outcome_min_ratio, out, model_hash)
+    outcomes, outcomes_report = _export_outcomes(transition, enum, cfg.outcome_min_ratio, model_hash)
     t2 = time.perf_counter()
     n_pddl = None if cfg.pddl_fidelity_cases < 0 else cfg.pddl_fidelity_cases
     pf = pddl_fidelity(domain, rules, enum, max_cases=n_pddl, seed=cfg.seed) if n_pddl != 0 else None
@@ -195,5 +196,8 @@ def export_pddl(run_dir: Path, data_dir: Path, cfg: ExportConfig, out_dir: Path 
                     "rule_fidelity": round(t_fid, 1), "pddl_fidelity": round(t_pddl, 1)},
         "versions": versions(),
     }
-    atomic_write_json(out / "report.json", report)
+    # the domain, the rules, their outcomes and the report replaced as one unit: a failed write leaves the old ones
+    rules_json = json_text({"model_hash": model_hash, **rules_to_json(rules)})
+    atomic_write_files({out / "domain.pddl": domain, out / RULES_FILE: rules_json,
+                        out / OUTCOMES_FILE: json_text(outcomes), out / "report.json": json_text(report)})
     return report
