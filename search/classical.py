@@ -110,7 +110,8 @@ def _run_guarded(args: tuple, wait_s: float) -> tuple[Any, int | None]:
     """solve_here(*args) in a child process group: (its JSON answer, None if it died, or "late"; its exit code).
 
     The group (the worker and the planner it started) is killed when the answer is in, at wait_s,
-    and on a kill of this process; its temporary files live in a symlearn-up-* folder removed on return.
+    and on a kill of this process (by search.processes' watchdog where this process cannot: SIGKILL);
+    its temporary files live in a symlearn-up-* folder removed on return.
     """
     ctx = _context()
     answer: Any = None  # stays None if the child dies (or on an exception here); "late" at the deadline

@@ -12,6 +12,13 @@ program go on, the call raises PlannerInterrupted; a planner process killed from
 (SIGKILL, SIGTERM, SIGINT, SIGHUP, SIGQUIT; not a crash such as SIGSEGV) is reported with
 `extra["killed_by_signal"]` (see `external_signal`), which the benchmark refuses to record.
 
+A caller that cannot clean up (SIGKILL, the OOM killer, a Ray worker force-exited) is covered by
+its watchdog: a small process, started with the first registration and nobody's child, that keeps
+a copy of the registry sent through a pipe whose only write end the caller holds. End of file,
+which the kernel gives when the caller is gone however it ended, makes it kill the registered
+groups (the planners' own children, such as Fast Downward's translator and search, included) and
+remove the registered folders.
+
     >>> with planner_guard(), temp_dir("symlearn-fd-") as tmp:                 # doctest: +SKIP
     ...     rc, out, err, timed_out = run_group([binary, "--search", s], "task", 10.0, cwd=tmp)
 """
@@ -19,10 +26,12 @@ from __future__ import annotations
 
 import atexit
 import contextlib
+import json
 import os
 import shutil
 import signal
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -68,27 +77,27 @@ def kill_group(pgid: int) -> None:
 
 
 def register_group(pgid: int) -> None:
-    """Track a live planner process group until unregister_group."""
-    with _lock:
-        _GROUPS.add(pgid)
+    """Track a live planner process group until unregister_group (OSError if the watchdog cannot start)."""
+    _track("group", pgid, True)
 
 
 def unregister_group(pgid: int) -> None:
     """Stop tracking a process group (after it was waited for or killed)."""
-    with _lock:
-        _GROUPS.discard(pgid)
+    _track("group", pgid, False)
 
 
 def cleanup() -> None:
     """Kill every registered process group and remove every registered temporary folder."""
     with _lock:
         groups, temps = list(_GROUPS), list(_TEMPS)
-        _GROUPS.clear()
-        _TEMPS.clear()
     for pgid in groups:
         kill_group(pgid)
     for path in temps:
         shutil.rmtree(path, ignore_errors=True)
+    for pgid in groups:
+        unregister_group(pgid)
+    for path in temps:
+        _track("temp", path, False)
 
 
 def forget_inherited() -> None:
@@ -152,18 +161,94 @@ def planner_guard() -> Iterator[None]:
                 _restore()
 
 
+# The watchdog's program (sys.executable -I -S, in a session of its own, deaf to the termination signals). It forks
+# and its first process ends, so it is nobody's child: a kill of its caller's children (Ray's, when a worker exits)
+# misses it. It reads the caller's registry changes, one JSON line [kind, added, value] each; end of file means the
+# caller is gone, however it ended (SIGKILL included), and it kills the groups and removes the folders held then.
+_WATCHDOG = """\
+import json, os, signal, sys
+for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+    signal.signal(s, signal.SIG_IGN)
+if os.fork():
+    os._exit(0)
+held = {"group": set(), "temp": set()}
+for line in sys.stdin.buffer:
+    try:
+        kind, added, value = json.loads(line)
+        (held[kind].add if added else held[kind].discard)(value)
+    except (ValueError, KeyError, TypeError):
+        pass
+def kill():
+    for pgid in held["group"]:
+        for k in (os.killpg, os.kill):
+            try:
+                k(pgid, signal.SIGKILL)
+            except OSError:
+                pass
+import shutil
+kill()
+for path in held["temp"]:
+    shutil.rmtree(path, ignore_errors=True)
+kill()
+"""
+_watchdog: dict[str, int] = {}  # this process's watchdog: "pid" (the process it watches), "fd" (the pipe's write end)
+
+
+def _start_watchdog() -> None:
+    """Start this process's watchdog (OSError if it cannot): the only clean-up a caller killed by SIGKILL gets."""
+    read, write = os.pipe()  # not inherited across exec: this process holds the only write end
+    try:
+        first = subprocess.Popen([sys.executable, "-I", "-S", "-c", _WATCHDOG, str(os.getpid())], stdin=read,
+                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd="/", start_new_session=True)
+        if first.wait() != 0:  # it ends once the watchdog is forked off
+            raise OSError(f"the planner watchdog could not start (exit code {first.returncode})")
+    except BaseException:
+        os.close(write)
+        raise
+    finally:
+        os.close(read)
+    os.set_blocking(write, False)  # a watchdog that stopped reading must not stall the planner calls
+    _watchdog.update(pid=os.getpid(), fd=write)
+
+
+def _tell_watchdog(kind: str, added: bool, value: int | str) -> None:
+    """Pass one registry change on to this process's watchdog, started by the first addition (under _lock)."""
+    if _watchdog.get("pid") != os.getpid():
+        if not added:
+            return
+        _start_watchdog()
+    with contextlib.suppress(OSError):  # one short write: atomic on a pipe; a watchdog killed from outside is gone
+        os.write(_watchdog["fd"], (json.dumps([kind, added, value]) + "\n").encode())
+
+
+def _drop_inherited_watchdog() -> None:
+    """In a forked child: close the parent's pipe, so the parent's death still reaches its watchdog at once."""
+    fd = _watchdog.pop("fd", None)
+    _watchdog.pop("pid", None)
+    if fd is not None:
+        with contextlib.suppress(OSError):
+            os.close(fd)
+
+
+def _track(kind: str, value: int | str, added: bool) -> None:
+    """Add a process group ("group") or a temporary folder ("temp") to the registry or drop it, here and in the
+    watchdog."""
+    with _lock:
+        registry = _GROUPS if kind == "group" else _TEMPS
+        (registry.add if added else registry.discard)(value)
+        _tell_watchdog(kind, added, value)
+
+
 @contextlib.contextmanager
 def temp_dir(prefix: str) -> Iterator[Path]:
-    """A fresh temporary folder, removed on exit, by the signal path and at interpreter exit."""
+    """A fresh temporary folder, removed on exit, by the signal path, at interpreter exit and by the watchdog."""
     path = tempfile.mkdtemp(prefix=prefix)
-    with _lock:
-        _TEMPS.add(path)
     try:
+        _track("temp", path, True)
         yield Path(path)
     finally:
         shutil.rmtree(path, ignore_errors=True)
-        with _lock:
-            _TEMPS.discard(path)
+        _track("temp", path, False)
 
 
 def run_group(args: Sequence[str], stdin_text: str, timeout_s: float, *, cwd: Path,
@@ -171,12 +256,13 @@ def run_group(args: Sequence[str], stdin_text: str, timeout_s: float, *, cwd: Pa
     """Run an argument list (no shell) in its own process group with a wall-clock limit.
 
     Returns (exit code, stdout, stderr, timed out); at the limit, and on any exception, the
-    whole group is killed. OSError if the program cannot be started.
+    whole group is killed, and this process's watchdog kills it if this process dies first (SIGKILL
+    included). OSError if the program, or the watchdog, cannot be started.
     """
     proc = subprocess.Popen(list(map(str, args)), stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, cwd=cwd, start_new_session=True)
-    register_group(proc.pid)
     try:
+        register_group(proc.pid)
         if after_start is not None:
             after_start(proc.pid)
         try:
@@ -226,3 +312,4 @@ def within(fn: Callable[[], Any], seconds: float) -> Any:
 
 
 atexit.register(cleanup)
+os.register_at_fork(after_in_child=_drop_inherited_watchdog)

@@ -11,9 +11,10 @@ Each call runs one process (an argument list, with sys.executable) in its own pr
 in a symlearn-stock-* folder that holds the planner's files (output.sas, sas_plan, the copies
 pyperplan needs); the wall-clock limit covers the whole call, translation or grounding
 included. At the limit the group is killed and the folder removed, and both go on a kill of
-this process (search.processes). The address space is capped at MEMORY_LIMIT_MB as for the
-SAS+ planners: through the driver's own --overall-memory-limit for Fast Downward, on the
-process for pyperplan.
+this process, SIGKILL included (search.processes and its watchdog). The address space is capped at
+MEMORY_LIMIT_MB as for the SAS+ planners: through the driver's own --overall-memory-limit for
+Fast Downward, on the process for pyperplan; the driver also gets its own --overall-time-limit
+(CPU time, a second past the call's limit), so it stops even with nobody left to kill it.
 
     >>> r = solve_files("domain.pddl", "p01.pddl", "fd-lama-first", timeout_s=10)  # doctest: +SKIP
     >>> r.status, r.steps, r.extra["fd_translate_time_s"], r.extra["fd_search_time_s"]  # doctest: +SKIP
@@ -221,13 +222,19 @@ def _phase(out: str) -> str:
     return "translation" if "Running translator" in out else "start-up"
 
 
-def _command(spec: StockPlanner, domain: Path, problem: Path, tmp: Path, memory_mb: int) -> list[str] | str:
-    """The argument list of the run, or a str saying why it cannot run."""
+def _command(spec: StockPlanner, domain: Path, problem: Path, tmp: Path, memory_mb: int,
+             left_s: float) -> list[str] | str:
+    """The argument list of the run, or a str saying why it cannot run.
+
+    Fast Downward's driver gets limits of its own (a memory limit, and a CPU-time limit a second past the
+    call's wall-clock limit of left_s): were this process and its watchdog both gone, it still stops.
+    """
     if spec.tool == "fast-downward":
         driver = fast_downward_driver()
         if driver is None:
             return "Fast Downward's driver was not found (pip install up-fast-downward)"
-        limits = ["--overall-memory-limit", f"{memory_mb}M"] if memory_mb else []
+        limits = ["--overall-time-limit", f"{math.ceil(left_s) + 1}s"]
+        limits += ["--overall-memory-limit", f"{memory_mb}M"] if memory_mb else []
         return [sys.executable, str(driver), "--plan-file", str(tmp / "sas_plan"), "--sas-file",
                 str(tmp / "output.sas"), *limits, *spec.before_files, str(domain), str(problem), *spec.after_files]
     if importlib.util.find_spec("pyperplan") is None:
@@ -282,10 +289,10 @@ def _solve_in(tmp: Path, domain: Path, problem: Path, planner: str, timeout_s: f
     if spec.tool == "pyperplan" and problem.parent != tmp:  # it writes PROBLEM.soln beside the problem:
         domain = Path(shutil.copyfile(domain, tmp / "domain.pddl"))  # it works on copies in the run's folder
         problem = Path(shutil.copyfile(problem, tmp / "problem.pddl"))
-    args = _command(spec, domain, problem, tmp, memory_mb)
+    left = timeout_s - (time.perf_counter() - t0)
+    args = _command(spec, domain, problem, tmp, memory_mb, left)
     if isinstance(args, str):
         return failed(planner, PlanStatus.ERROR, t0, args)
-    left = timeout_s - (time.perf_counter() - t0)
     if left <= 0:
         return failed(planner, PlanStatus.TIMEOUT, t0, f"time limit of {timeout_s:g} s reached before planning")
     limit = None if spec.tool == "fast-downward" or not memory_mb else (lambda pid: _limit_memory(pid, memory_mb))

@@ -28,6 +28,39 @@ class EngineError(RuntimeError):
     """An engine that cannot be used here (Ray not installed, a bad engine name or address)."""
 
 
+class EngineInterrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM reached the driver of a Ray session: the session's tasks are cancelled and the Ray it
+    started is shut down. Without a message, so the CLI ends as on a local engine's Ctrl-C, with 128 + signum."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__()
+        self.signum = signum
+
+
+def _interrupter(received: list[int]) -> Callable[[int, Any], None]:
+    """A session's handler of SIGINT and SIGTERM: it notes the signal in `received` (ray.wait turns the exception
+    into a plain KeyboardInterrupt), ignores later ones, so they cannot cut the clean-up short, and raises
+    EngineInterrupted."""
+    def interrupt(signum: int, frame: Any) -> None:
+        received.append(signum)
+        for s in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(s, signal.SIG_IGN)
+        raise EngineInterrupted(signum)
+
+    return interrupt
+
+
+def _set_handlers(handlers: dict, interrupt: Callable[[int, Any], None] | None) -> None:
+    """Put back the caller's handlers (signal -> handler) or, with `interrupt`, a session's: the caller's own handler
+    or SIG_IGN as it was, else `interrupt` (for SIG_DFL and Python's default SIGINT handler)."""
+    for s, h in handlers.items():
+        own = h == signal.SIG_IGN or (callable(h) and h is not signal.default_int_handler)
+        if interrupt is not None:
+            signal.signal(s, h if own else interrupt)
+        elif h is not None:  # None: a handler not set from Python, which cannot be put back
+            signal.signal(s, h)
+
+
 def check_engine(engine: str, address: str | None = None) -> None:
     """Refuse an unknown engine, an address without Ray, or Ray when it is not installed; one line each."""
     if engine not in ENGINES:
@@ -59,6 +92,7 @@ def ray_session(address: str | None, num_cpus: int) -> Iterator[Any]:
     kwargs: dict = {"address": address} if address else {"num_cpus": num_cpus}
     main = threading.current_thread() is threading.main_thread()
     handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)} if main else {}
+    received: list[int] = []  # the signals this session's handler caught
     try:
         ray.init(include_dashboard=False, log_to_driver=False, configure_logging=False, **kwargs)
     except (ConnectionError, ValueError, RuntimeError) as e:
@@ -66,15 +100,20 @@ def ray_session(address: str | None, num_cpus: int) -> Iterator[Any]:
         raise EngineError(f"could not start or join {where}: {str(e).splitlines()[0] if str(e) else type(e).__name__}"
                           ) from None
     finally:
-        # ray.init makes SIGTERM a sys.exit; a handler the caller set (collect's, which ends in a resumable
-        # CollectInterrupted) is put back. Either way the stack unwinds: tasks are cancelled, Ray shut down.
-        for s, h in handlers.items():
-            if callable(h):
-                signal.signal(s, h)
+        # ray.init makes SIGTERM a sys.exit, and Ray's core a logged abort (exit code 134): a handler the caller
+        # set (collect's, which ends in a resumable CollectInterrupted) is put back, and where it had none, SIGINT
+        # and SIGTERM raise EngineInterrupted. Either way the stack unwinds: tasks are cancelled (a Ray worker
+        # killed in a planner call: search.processes' watchdog ends the planner), Ray shut down.
+        _set_handlers(handlers, _interrupter(received) if ray.is_initialized() else None)
     try:
         yield ray
+    except KeyboardInterrupt as e:
+        if received and not isinstance(e, EngineInterrupted):
+            raise EngineInterrupted(received[0]) from None
+        raise
     finally:
         ray.shutdown()
+        _set_handlers(handlers, None)
 
 
 def as_finished(ray, task: Callable, jobs: Iterable[tuple[Any, tuple]], window: int,

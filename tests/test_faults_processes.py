@@ -8,9 +8,11 @@ failure reaches the terminal in one line with a non-zero exit code.
 """
 from __future__ import annotations
 
+import contextlib
 import fcntl
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -18,6 +20,7 @@ import textwrap
 import threading
 import time
 from pathlib import Path
+from typing import Callable
 
 import pytest
 
@@ -562,3 +565,145 @@ def test_within_calls_a_late_return_a_deadline_even_when_the_alarm_is_lost():
     with pytest.raises(DeadlineExceeded):
         within(swallows_the_alarm, 0.02)
     assert within(lambda: 2, 5.0) == 2
+
+
+# ------------------------------------------------------------------------------- 7. callers that cannot clean up
+
+# the stand-in planner of test_faults_search, which first writes its argument list to $FAKE_PIDS.argv
+RECORDING_PLANNER = textwrap.dedent("""\
+    import os, sys
+    with open(os.environ["FAKE_PIDS"] + ".argv", "w") as f:
+        f.write("\\n".join(sys.argv[1:]))
+""")
+
+STOCK_DRIVER = """
+import sys
+sys.path[:0] = [{repo!r}, {tests!r}]
+from pathlib import Path
+import search.stock_planners as st
+st.fast_downward_driver = lambda: Path({fake!r})
+result = st.solve_texts("(define (domain d))", "(define (problem p) (:domain d))", "fd-lama-first", {timeout})
+print(result.status.value, flush=True)
+"""
+
+
+def _recording_planner(path: Path) -> Path:
+    """The stand-in planner (it sleeps and starts a child of its own) as an executable file at path."""
+    from test_faults_search import FAKE_PLANNER
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(f"#!{sys.executable}\n" + RECORDING_PLANNER + FAKE_PLANNER)
+    path.chmod(0o755)
+    return path
+
+
+def _caller_source(route: str, fake: Path, timeout: float) -> str:
+    """A script that makes one planner call on `route` (the stand-in in place of the planner) and prints its result."""
+    from test_faults_search import SAS_DRIVER, UP_DRIVER
+
+    kw = dict(repo=str(ROOT), tests=str(ROOT / "tests"), fake=str(fake), timeout=timeout)
+    if route == "up":
+        return UP_DRIVER.format(planner="fast-downward", compile_ce=False, **kw)
+    return (SAS_DRIVER if route == "sas" else STOCK_DRIVER).format(**kw)
+
+
+def _left_within(what: Callable[[], list], within_s: float = 5.0) -> list:
+    """what() once it is empty, or what it still holds after within_s seconds."""
+    end = time.monotonic() + within_s
+    while (left := what()) and time.monotonic() < end:
+        time.sleep(0.05)
+    return left
+
+
+def _symlearn_temps(tmpdir: Path) -> list[str]:
+    return sorted(p.name for p in tmpdir.iterdir() if p.name.startswith("symlearn-"))
+
+
+@pytest.mark.parametrize("route", ["sas", "stock", "up"])
+def test_a_sigkilled_caller_leaves_no_planner_and_no_temp_folder(tmp_path, route):
+    """SIGKILL cannot be caught: the planner's group (its own children too) and its folder still go at once."""
+    from test_faults_search import _alive, _procs_mentioning, _start_driver, _wait_dead, _wait_for
+
+    fake = _recording_planner(tmp_path / "fake_planner")
+    proc, pids_file, tmpdir = _start_driver(_caller_source(route, fake, 60), tmp_path)
+    pids = _wait_for(pids_file, proc)  # the planner, its parent (the caller or the worker), the planner's child
+    try:
+        assert all(_alive(p) for p in pids)
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.communicate(timeout=30)
+        assert _wait_dead(pids) == [], "a planner process outlived its SIGKILLed caller"
+        assert _left_within(lambda: _symlearn_temps(tmpdir)) == []
+        assert _left_within(lambda: _procs_mentioning(str(tmpdir))) == []  # nothing works in it (the watchdog ended)
+    finally:
+        for pid in pids:
+            with contextlib.suppress(OSError):
+                os.kill(pid, signal.SIGKILL)
+
+
+def test_fast_downwards_driver_gets_its_own_time_and_memory_limits(tmp_path):
+    """Were its caller and the watchdog both gone, the stock driver still stops: it has limits of its own."""
+    from test_faults_search import _procs_mentioning, _start_driver, _wait_for
+
+    fake = _recording_planner(tmp_path / "fake_planner")
+    proc, pids_file, _ = _start_driver(_caller_source("stock", fake, 7.5), tmp_path)
+    pids = _wait_for(pids_file, proc)
+    try:
+        argv = Path(str(pids_file) + ".argv").read_text().splitlines()
+        assert "--overall-time-limit" in argv and "--overall-memory-limit" in argv, argv
+        limit = argv[argv.index("--overall-time-limit") + 1]
+        assert limit.endswith("s") and 7.5 <= int(limit[:-1]) <= 10, limit  # a little past the call's own limit
+        out, err = proc.communicate(timeout=60)
+        assert out.strip().splitlines()[-1] == "timeout", err[-2000:]
+        assert _procs_mentioning(str(fake)) == []
+    finally:
+        for pid in pids:
+            with contextlib.suppress(OSError):
+                os.kill(pid, signal.SIGKILL)
+
+
+RAY_CLI = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "  # as a foreground shell
+           "from symlearn.cli.main import main; sys.exit(main(sys.argv[1:]))")
+INTERRUPTED_LINE = "symlearn benchmark: interrupted; re-run the same command to resume"  # a local Ctrl-C's line
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_an_interrupted_ray_benchmark_ends_like_a_local_one(tiny_run, problems, tmp_path, sig):
+    """`benchmark --ray` stopped during a planner call (a Ray worker's) ends with 128 + the signal's number (it was
+    134 or 130) and the one line, as the local engine; no planner process and no symlearn-* folder is left. The
+    stand-in planner is SymK's binary, in a stand-in up_symk package first on the path that Ray's workers inherit."""
+    import tempfile
+
+    from test_faults_search import _procs_mentioning, _wait_dead, _wait_for
+
+    packages = tmp_path / "packages"
+    (packages / "up_symk").mkdir(parents=True)
+    (packages / "up_symk" / "__init__.py").write_text("")
+    _recording_planner(packages / "up_symk" / "symk" / "builds" / "release" / "bin" / "downward")
+    tmpdir, pids_file = tmp_path / "tmpdir", tmp_path / "pids"
+    tmpdir.mkdir()
+    ray_tmp = tempfile.mkdtemp(prefix="ray-", dir="/tmp")  # short: Ray's socket paths must fit 107 bytes
+    env = dict(os.environ, TMPDIR=str(tmpdir), RAY_TMPDIR=ray_tmp, FAKE_PIDS=str(pids_file), OMP_NUM_THREADS="1",
+               PYTHONPATH=os.pathsep.join([str(packages), str(ROOT)]))
+    cmd = [sys.executable, "-c", RAY_CLI, "benchmark", "--run", str(tiny_run.path), "--problems", str(problems),
+           "--planners", "symk-sas", "--timeout", "120", "--out", str(tmp_path / "b.json"), "--ray"]
+    proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    pids: list[int] = []
+    try:
+        pids = _wait_for(pids_file, proc, within_s=180.0)
+        os.kill(proc.pid, sig)
+        out, err = proc.communicate(timeout=120)
+        lines = err.strip().splitlines()
+        assert proc.returncode == 128 + sig, err[-3000:]
+        assert [ln for ln in lines if ln.startswith("symlearn")] == [INTERRUPTED_LINE], err[-3000:]
+        assert _wait_dead([pids[0], pids[2]]) == [], "a planner process outlived the interrupted benchmark"
+        assert _left_within(lambda: _symlearn_temps(tmpdir)) == []
+        assert _left_within(lambda: _procs_mentioning(str(tmpdir))) == []
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+        for pid in pids + _procs_mentioning(ray_tmp):  # what a failure left: planners, Ray's own processes
+            with contextlib.suppress(OSError):
+                os.kill(pid, signal.SIGKILL)
+        shutil.rmtree(ray_tmp, ignore_errors=True)
