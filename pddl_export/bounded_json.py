@@ -5,7 +5,9 @@ a run's result files, manifests, pipeline records) goes through `read_json_file`
 mistaken file meets the same limits everywhere:
 
 - only a regular file is opened (a FIFO, /dev/zero or a folder is refused before anything is read;
-  the open itself does not block), and at most `max_bytes` of it are read;
+  the open itself does not block), and at most `max_bytes` of it are read; `open_regular_file` is that
+  open-and-check alone, for readers of other files (a data shard streamed into numpy), and
+  `follow_symlinks=False` refuses a symbolic link too (the report's run files);
 - the text must be UTF-8 JSON without NaN or Infinity, and every float finite (1e999 is refused);
   in a file of up to SCAN_BYTES (every kind but a paper-scale rules file), every integer must also lie
   within 64 bits and nothing be nested deeper than `max_depth`. A larger file is parsed with the same
@@ -29,6 +31,7 @@ expected a finite number, got 'abc'`. It lives in the lowest package of the data
 """
 from __future__ import annotations
 
+import errno
 import json
 import math
 import os
@@ -36,6 +39,7 @@ import re
 import stat
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import BinaryIO
 
 MiB = 1 << 20
 DEFAULT_MAX_BYTES = 16 * MiB  # a result file, a manifest, a problem: kilobytes in practice
@@ -59,19 +63,28 @@ def _short(v) -> str:
 # ---------------------------------------------------------------------------------------- bounded bytes
 
 
-def read_bounded_bytes(path: str | os.PathLike, max_bytes: int, what: str = "file") -> bytes:
-    """The bytes of a regular file of at most `max_bytes`; JsonFileError (one line, naming the file) otherwise.
+def open_regular_file(path: str | os.PathLike, max_bytes: int, what: str = "file", *,
+                      follow_symlinks: bool = True) -> BinaryIO:
+    """An open binary file object of a regular file of at most `max_bytes`; JsonFileError (one line, naming
+    the file) otherwise. For readers that stream a large file (a data shard) instead of reading it whole.
 
     The file is opened non-blocking and checked with fstat on the open descriptor, so a FIFO does not
-    hang the open and a device (/dev/zero) or folder is refused before a byte is read; at most
-    max_bytes + 1 bytes are ever read, whatever the file claims or grows to.
+    hang the open and a device (/dev/zero), folder or socket is refused before a byte is read. With
+    follow_symlinks=False the last part of the path must not be a symbolic link (O_NOFOLLOW: refused,
+    not followed). The caller closes the file (use it in a `with`); it may still grow past max_bytes
+    while open, so a reader that must stay bounded reads at most max_bytes + 1 bytes (read_bounded_bytes).
     """
     path = Path(path)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+    if not follow_symlinks:
+        flags |= getattr(os, "O_NOFOLLOW", 0)
     try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+        fd = os.open(path, flags)
     except FileNotFoundError:
         raise JsonFileError(f"{path}: no such {what}") from None
     except OSError as e:
+        if e.errno == errno.ELOOP and not follow_symlinks and os.path.islink(path):
+            raise JsonFileError(f"{path}: is a symbolic link, not a regular {what}") from None
         raise JsonFileError(f"{path}: cannot be opened ({e.strerror or type(e).__name__})") from None
     try:
         st = os.fstat(fd)
@@ -81,17 +94,32 @@ def read_bounded_bytes(path: str | os.PathLike, max_bytes: int, what: str = "fil
             raise JsonFileError(f"{path}: is {kind}, not a regular {what}")
         if st.st_size > max_bytes:
             raise JsonFileError(f"{path}: {st.st_size} bytes, more than the {max_bytes} bytes a {what} may have")
-        chunks, left = [], max_bytes + 1
-        while left > 0:
-            chunk = os.read(fd, min(left, 4 * MiB))
-            if not chunk:
-                break
-            chunks.append(chunk)
-            left -= len(chunk)
-    except OSError as e:
-        raise JsonFileError(f"{path}: cannot be read ({e.strerror or type(e).__name__})") from None
-    finally:
+        return os.fdopen(fd, "rb")
+    except BaseException:
         os.close(fd)
+        raise
+
+
+def read_bounded_bytes(path: str | os.PathLike, max_bytes: int, what: str = "file", *,
+                       follow_symlinks: bool = True) -> bytes:
+    """The bytes of a regular file of at most `max_bytes`; JsonFileError (one line, naming the file) otherwise.
+
+    Opened and checked by open_regular_file (non-blocking open, fstat on the descriptor: a FIFO does not
+    hang, a device or folder is refused before a byte is read; follow_symlinks=False refuses a symbolic
+    link); at most max_bytes + 1 bytes are ever read, whatever the file claims or grows to.
+    """
+    path = Path(path)
+    chunks, left = [], max_bytes + 1
+    with open_regular_file(path, max_bytes, what, follow_symlinks=follow_symlinks) as f:
+        try:
+            while left > 0:  # in chunks: a read of max_bytes + 1 at once would allocate all of it up front
+                chunk = f.read(min(left, 4 * MiB))
+                if not chunk:
+                    break
+                chunks.append(chunk)
+                left -= len(chunk)
+        except OSError as e:
+            raise JsonFileError(f"{path}: cannot be read ({e.strerror or type(e).__name__})") from None
     data = b"".join(chunks)
     if len(data) > max_bytes:
         raise JsonFileError(f"{path}: more than the {max_bytes} bytes a {what} may have")
@@ -165,14 +193,16 @@ def _check_values(value, where: str, max_depth: int) -> None:
 
 
 def read_json_file(path: str | os.PathLike, schema: "Schema | None" = None, *, what: str = "JSON file",
-                   max_bytes: int = DEFAULT_MAX_BYTES, max_depth: int = DEFAULT_MAX_DEPTH):
+                   max_bytes: int = DEFAULT_MAX_BYTES, max_depth: int = DEFAULT_MAX_DEPTH,
+                   follow_symlinks: bool = True):
     """The JSON value of a regular file, bounded and checked against `schema` (None: any JSON value).
 
     JsonFileError (one line naming the file, and the field for a schema refusal) for anything else:
-    see the module docstring for the limits.
+    see the module docstring for the limits. follow_symlinks=False refuses a symbolic link (the report's
+    run files).
     """
     path = Path(path)
-    data = read_bounded_bytes(path, max_bytes, what)
+    data = read_bounded_bytes(path, max_bytes, what, follow_symlinks=follow_symlinks)
     value = loads_bounded(data, str(path), max_depth, scan=len(data) <= SCAN_BYTES)
     if schema is not None:
         check(value, schema, str(path))

@@ -343,7 +343,7 @@ def test_wrong_shaped_row_is_refused_naming_file_and_line(tmp_path, bad, words):
 
 
 def test_benchmark_refuses_a_wrong_shaped_row_before_running_any(tiny_run, tmp_path, capsys):
-    from symlearn.planning.benchmark import RowLog, _settings, load_sets, problem_sets
+    from symlearn.planning.benchmark import ExecutionConfig, RowLog, _settings, load_sets, problem_sets
 
     problems = tmp_path / "problems"
     problems.mkdir()
@@ -351,7 +351,8 @@ def test_benchmark_refuses_a_wrong_shaped_row_before_running_any(tiny_run, tmp_p
     shutil.copy(PRETRAINED / "problems" / "three_objects_two_actions.json", problems / "b.json")
     out = tmp_path / "bench.json"
     sets = problem_sets(problems)
-    settings = _settings(tiny_run.path, sets, load_sets(sets), ["astar"], True, 10.0, 3)
+    settings = _settings(tiny_run.path, sets, load_sets(sets), ["astar"],
+                         ExecutionConfig(closed_loop=True, timeout_s=10.0))
     log = RowLog(out.with_name(out.name + ".rows.jsonl"), settings)
     log.open()
     log.append(("a.json", "astar", False), {**ROW, "replans": "three"})
@@ -695,3 +696,95 @@ def test_lifted_rules_file_goes_through_the_bounded_reader(tmp_path, text, words
         path.write_text(text)
     out = _refusal_within(load_lifted, path)
     assert out.startswith(f"{path}") and "\n" not in out and all(w in out for w in words), out
+
+
+
+# ----------------------------------------------------------- issue 59: data shards, overlapping objects, --length
+
+
+def _command_refusal(*args):
+    """A loader for _refusal_within: `symlearn ARGS` in this process; its error line (the last on stderr, after
+    any banner) as a ValueError when it exits 2 (a refusal), None (accepted) otherwise."""
+    import contextlib
+
+    def run(_path):
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            rc, _ = cli(*args)
+        lines = err.getvalue().strip().splitlines()
+        if rc == 2:
+            ok = lines and lines[-1].startswith(f"symlearn {args[0]}: error: ")
+            raise ValueError(lines[-1] if ok else f"no error line: {err.getvalue()}")
+        return None
+
+    run.__name__ = f"symlearn {args[0]}"
+    return run
+
+
+@pytest.mark.parametrize("command", ["collect", "train", "load_split"])
+def test_fifo_in_place_of_a_data_shard_is_refused_at_once(tiny_data, tmp_path, command):
+    """A FIFO named like a shard: resuming `collect`, `train` and the shard reader (load_split, what evaluate and
+    symbols read with too) refuse it in one line naming it, instead of blocking on it forever."""
+    from conftest import TINY_DATA_ARGS, TINY_TRAIN_ARGS
+    from symlearn.data.dataset import load_split
+
+    data = tmp_path / "data"
+    shutil.copytree(tiny_data.path, data)
+    shard = data / "shard_00000.npz"  # a train shard
+    shard.unlink()
+    os.mkfifo(shard)
+    loader = {"collect": _command_refusal("collect", "--out", data, *TINY_DATA_ARGS, "--quiet"),
+              "train": _command_refusal("train", "--data", data, "--out", tmp_path / "run", *TINY_TRAIN_ARGS,
+                                        "--quiet"),
+              "load_split": lambda _: load_split(data, "train")}[command]
+    text = _refusal_within(loader, shard, seconds=60)
+    assert str(shard) in text and "FIFO" in text and "\n" not in text, text
+    assert not (tmp_path / "run" / "best.pt").exists()
+
+
+def _overlapping(tmp_path: Path, scene: str, i: int, j: int) -> Path:
+    doc = json.loads(PROBLEM.read_text())
+    objects = doc[scene]["objects"]
+    objects[j]["position"] = list(objects[i]["position"])  # two objects at one position
+    path = tmp_path / "p.json"
+    path.write_text(json.dumps(doc))
+    return path
+
+
+@pytest.mark.parametrize("scene", ["initial", "goal"])
+def test_problem_with_two_objects_at_one_position_is_refused(tmp_path, scene):
+    """Two objects at one position (the lifted start then says two blocks stand at one location and level):
+    refused when the problem file is read, naming the file and both objects; real problems still load."""
+    from symlearn.problems.problem import load_problem, load_problems
+
+    path = _overlapping(tmp_path, scene, 0, 1)
+    with pytest.raises(ValueError) as info:
+        load_problem(path)
+    _one_line(info.value, str(path), f"{scene} scene", "objects 0 (cube) and 1 (cube) overlap")
+    # nudged apart by less than a cube's width still overlaps; the shipped problems (centres >= 7.5 cm) all load
+    doc = json.loads(path.read_text())
+    doc[scene]["objects"][1]["position"][0] += 0.03
+    path.write_text(json.dumps(doc))
+    with pytest.raises(ValueError, match="overlap"):
+        load_problem(path)
+    for folder in (PRETRAINED / "problems", ROOT / "pretrained" / "recommended" / "problems"):
+        assert len(load_problems(folder)) >= 3
+
+
+def test_problems_length_beyond_what_a_problem_may_list_is_refused_before_any_work(tmp_path, capsys, monkeypatch):
+    """`problems --length 150-150` wrote problems that plan and benchmark then refuse (more than 100 actions):
+    now refused at the flag, before any problem is drawn; ProblemConfig (a settings file's [problems]) too."""
+    from symlearn.problems import problem_generation
+    from symlearn.problems.problem import MAX_ACTIONS
+    from symlearn.problems.problem_generation import ProblemConfig
+
+    drawn = []
+    monkeypatch.setattr(problem_generation, "_generate", lambda *a, **k: drawn.append(a) or [])
+    out = tmp_path / "problems"
+    rc, _ = cli("problems", "--kind", "walks", "--out", out, "--n", "1", "--length", "150-150")
+    assert rc == 2 and not drawn and not out.exists()
+    _cli_error(capsys, "problems", "150-150", f"1-{MAX_ACTIONS}")
+    with pytest.raises(ValueError) as info:
+        ProblemConfig(length=(MAX_ACTIONS + 1, MAX_ACTIONS + 1))
+    _one_line(info.value, f"1-{MAX_ACTIONS}")
+    assert ProblemConfig(length=(MAX_ACTIONS, MAX_ACTIONS)).length == (MAX_ACTIONS, MAX_ACTIONS)

@@ -205,7 +205,7 @@ def test_report_with_missing_inputs_says_not_run(tiny_run_copy, tmp_path):
     assert str(tmp_path / "no_data") in notes
     assert "effect_loss" in p.figures and "transition_loss" not in p.figures
     verdicts = [r[-1] for r in p.tables["scorecard"][1:]]
-    assert verdicts == []  # nothing measured, nothing claimed
+    assert verdicts == ["invalid", "invalid"]  # nothing measured; the refused table1.json's two criteria: invalid
     assert "not run" in (tiny_run_copy / "report.md").read_text()
 
 

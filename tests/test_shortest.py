@@ -166,7 +166,7 @@ def test_undecidable_problems_say_why_and_have_no_length():
     off = Problem("off", 0, far.spec, far.initial, (), off_goal)
     assert off.goal_off_locations == 1
     assert shortest_plan(off).reason == "goal_off_locations" and shortest_plan(off).length is None
-    near = Scene((far.goal.objects[0], ObjectState(C, (0.8, -0.15, 0.45))))  # 3 cm off location 0
+    near = Scene((far.goal.objects[0], ObjectState(C, (0.8, 0.15, 0.45))))  # 3 cm off location 2 (0 is taken)
     assert shortest_plan(Problem("near", 0, far.spec, far.initial, (), near)).reason == "pose_not_covered"
     capped = shortest_plan(_problem(spec, (ObjectGoal(3, 1), ObjectGoal(3))), max_length=2)
     assert capped.reason == "search_cap" and capped.length is None

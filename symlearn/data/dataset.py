@@ -15,9 +15,10 @@ from typing import Sequence
 import numpy as np
 
 from pddl_export.bounded_json import JsonFileError, read_json_file
-from symlearn.provenance import sha256_bytes, sha256_file
+from symlearn.provenance import sha256_bytes
 # the format is the writer's (collect); re-exported here, where readers have always found it
-from symlearn.sim.data_format import DATA_KIND, FORMAT_VERSION, SPLITS, DataError, check_shard_entries  # noqa: F401
+from symlearn.sim.data_format import (DATA_KIND, FORMAT_VERSION, SPLITS, DataError, check_shard_entries,  # noqa: F401
+                                      open_shard, stream_sha256)
 
 ARRAY_NAMES = ("pre_depth", "post_depth", "pre_origin", "post_origin", "pre_pixels", "post_pixels",
                "action", "effect", "n_objects", "obj_type", "pre_pose", "post_pose", "grasped",
@@ -81,16 +82,21 @@ def load_manifest(root: Path, require_complete: bool = True) -> dict:
 
 
 def _load_shard(root: Path, entry: dict, verify: bool) -> dict[str, np.ndarray]:
+    """One shard's arrays, read from the file opened once (open_shard: a regular file, else refused in one line;
+    a FIFO in its place does not block) and, with `verify`, checked against the manifest's checksum first."""
     path = root / entry["name"]
     if not path.exists():
         raise DataError(f"shard {entry['name']} listed in the manifest is missing from {root}")
-    if verify and sha256_file(path) != entry["sha256"]:
-        raise DataError(f"shard {entry['name']} is corrupted or truncated (checksum mismatch)")
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            return {k: z[k] for k in ARRAY_NAMES}
-    except (zipfile.BadZipFile, KeyError, ValueError, OSError, EOFError) as e:
-        raise DataError(f"shard {entry['name']} cannot be read: {e}") from None
+    with open_shard(path) as f:
+        if verify:
+            if stream_sha256(f) != entry["sha256"]:
+                raise DataError(f"shard {entry['name']} is corrupted or truncated (checksum mismatch)")
+            f.seek(0)
+        try:
+            with np.load(f, allow_pickle=False) as z:
+                return {k: z[k] for k in ARRAY_NAMES}
+        except (zipfile.BadZipFile, KeyError, ValueError, OSError, EOFError) as e:
+            raise DataError(f"shard {entry['name']} cannot be read: {e}") from None
 
 
 def load_split(root: Path, split: str, verify: bool = True) -> InteractionData:

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from pddl_export.bounded_json import MiB, read_json_file
+from symlearn.problems.problem import check_no_overlap
 from symlearn.provenance import atomic_write_json
 from symlearn.sim.exploration import MAX_OBJECTS
 from symlearn.world import (FAR_ROW, LOCATIONS, N_ACTIONS, N_LOCATIONS, OBJECT_SIZE, TABLE_TOP_Z, ObjectType, Scene,
@@ -174,7 +175,7 @@ def stick_covers(stick_loc: int, loc: int) -> bool:
 
 
 def check_goal(goal: Goal, where: str) -> None:
-    """Refuse arrangements the simulator cannot build: bad supports, cycles, clashes on the table."""
+    """Refuse arrangements the simulator cannot build: bad supports, cycles, clashes on the table, overlaps."""
     types, targets = [t for t, _ in goal.spec], goal.targets
     if types.count(ObjectType.STICK) > 1:
         raise ValueError(f"{where}: more than one stick (objects {[i for i, t in enumerate(types) if t == ObjectType.STICK]})")
@@ -211,6 +212,8 @@ def check_goal(goal: Goal, where: str) -> None:
             if g is not None and g.on is None and i != s and stick_covers(targets[s].location, g.location):
                 raise ValueError(f"{where}: object {i} on the table at location {g.location} lies under an end of "
                                  f"the stick (object {s}) at location {targets[s].location}")
+    # the seats above keep objects apart; this states the physical rule itself, as problem files are checked
+    check_no_overlap([(i, types[i], p) for i, p in expected_positions(goal).items()], where)
 
 
 def _check_cycles(targets, where: str) -> None:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Sequence
 
 import numpy as np
 
@@ -21,7 +22,8 @@ from pddl_export.bounded_json import MiB, read_json_file
 from symlearn.problems.paths import check_safe_name, is_safe_name
 from symlearn.sim.exploration import MAX_OBJECTS
 from symlearn.provenance import atomic_write_json
-from symlearn.world import LOCATIONS, N_ACTIONS, N_LOCATIONS, TABLE_TOP_Z, ObjectType, Scene, decode_action
+from symlearn.world import (LOCATIONS, N_ACTIONS, N_LOCATIONS, OBJECT_SIZE, TABLE_TOP_Z, ObjectType, Scene,
+                            decode_action)
 
 PROBLEM_FORMAT = "symlearn-problem"
 PROBLEM_VERSION = 3  # 2 added "task" and "free", 3 the shortest plan; version 1 and 2 files still load (not computed)
@@ -37,6 +39,11 @@ REACH_CENTER_X = (min(x for x, _ in LOCATIONS) + max(x for x, _ in LOCATIONS)) /
 REACH_HALF_X, REACH_HALF_Y = 0.5, 0.6
 REACH_Z_MAX = 1.0
 QUATERNION_NORM_TOL = 1e-3
+# Two objects overlap when their centres lie closer than the balls inscribed in their boxes allow (a box holds
+# the ball of half its smallest side around its centre, whatever its orientation: 2.5 cm for a cube and a stick),
+# less what settling presses objects into each other (shipped problems keep >= 7.5 cm between centres, 36
+# random walks of 4-8 objects >= 6.3 cm).
+OVERLAP_SLACK_M = 0.005
 _KEYS = ("format", "version", "name", "seed", "spec", "initial", "actions", "goal", "generator_length")
 MAX_ACTIONS = 100  # generator actions a problem file may list (random walks take a handful)
 MAX_TASK_CHARS = 10_000
@@ -222,8 +229,8 @@ class OutOfReach(ValueError):
 
 
 def check_scene(scene: Scene, where: str) -> None:
-    """Refuse (one-line ValueError) non-finite poses, non-unit quaternions and positions out of the table's reach
-    (OutOfReach)."""
+    """Refuse (one-line ValueError) non-finite poses, non-unit quaternions, positions out of the table's reach
+    (OutOfReach) and objects that overlap (check_no_overlap)."""
     for i, o in enumerate(scene.objects):
         pos, quat = np.asarray(o.position, np.float64), np.asarray(o.orientation, np.float64)
         if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(quat))):
@@ -237,6 +244,22 @@ def check_scene(scene: Scene, where: str) -> None:
             raise OutOfReach(f"{where}: object {i} position {list(o.position)} is out of the table's reach "
                              f"(|x-{REACH_CENTER_X:.2f}| < {REACH_HALF_X}, |y| < {REACH_HALF_Y}, "
                              f"{TABLE_TOP_Z} <= z <= {REACH_Z_MAX})")
+    check_no_overlap([(i, o.type, o.position) for i, o in enumerate(scene.objects)], where)
+
+
+def check_no_overlap(objects: Sequence[tuple[int, ObjectType, Sequence[float]]], where: str) -> None:
+    """Refuse (one-line ValueError naming both objects) two of `objects` (index, type, centre) whose centres lie
+    closer than their shapes allow: nearer than the sum of their inscribed balls' radii (half the smallest side)
+    less OVERLAP_SLACK_M. Such a scene cannot stand on the table, and symbols would put both objects at one
+    location and level."""
+    for a, (i, ti, pi) in enumerate(objects):
+        for j, tj, pj in objects[a + 1:]:
+            least = (min(OBJECT_SIZE[ObjectType(ti)]) + min(OBJECT_SIZE[ObjectType(tj)])) / 2 - OVERLAP_SLACK_M
+            dist = math.dist(pi, pj)
+            if dist < least:
+                raise ValueError(f"{where}: objects {i} ({ObjectType(ti).name.lower()}) and {j} "
+                                 f"({ObjectType(tj).name.lower()}) overlap: their centres lie {dist * 100:.1f} cm "
+                                 f"apart, less than the {least * 100:.1f} cm their shapes allow")
 
 
 def _is_int(x) -> bool:

@@ -19,8 +19,8 @@ import numpy as np
 from pddl_export.bounded_json import JsonFileError, read_json_file
 from symlearn.folder_lock import LOCK_NAME, folder_lock
 from symlearn.problems.paths import path_under
-from symlearn.problems.problem import (GOAL_TOLERANCE_M, PROBLEM_VERSION, OutOfReach, Problem, load_problem,
-                                       load_problems, save_problem)
+from symlearn.problems.problem import (GOAL_TOLERANCE_M, MAX_ACTIONS, PROBLEM_VERSION, OutOfReach, Problem,
+                                       load_problem, load_problems, save_problem)
 from symlearn.problems.shortest import with_shortest
 from symlearn.provenance import atomic_write_json
 from symlearn.sim.exploration import MAX_OBJECTS, ExplorationConfig, sample_action, sample_scene_spec
@@ -48,8 +48,9 @@ class ProblemConfig:
         if not 1 <= lo <= hi <= MAX_OBJECTS:
             raise ValueError(f"object range {lo}-{hi} must lie within 1-{MAX_OBJECTS}")
         lo, hi = self.length
-        if not 1 <= lo <= hi:
-            raise ValueError(f"length range {lo}-{hi} must be non-empty and start at 1 or more")
+        if not 1 <= lo <= hi <= MAX_ACTIONS:  # a longer walk would write problems that plan and benchmark refuse
+            raise ValueError(f"length range {lo}-{hi} must be non-empty and lie within 1-{MAX_ACTIONS} "
+                             f"(the generator actions a problem file may list)")
         if self.max_step_tries < 1 or self.max_scene_tries < 1:
             raise ValueError("max_step_tries and max_scene_tries must be positive")
 

@@ -23,7 +23,7 @@ MAX_IMAGE_BYTES = 64 * MiB  # a figure of the run (symbols.png: ~150 KB)
 def _data_dir(run: Path, data: Path | None) -> tuple[Path | None, str]:
     if data is not None:
         return Path(data), ""
-    cfg, why = g.read_json(run / "config.json")
+    cfg, why = g.read_json(run / "config.json", run=run)
     if cfg and cfg.get("data"):
         return Path(cfg["data"]), ""
     return None, why and f"no --data given and {why}"
@@ -46,7 +46,7 @@ def find_recording(run: Path, recording: Path | None = None) -> Path | None:
     """The plan GIF to show: the one given, else RUN/plan.gif, else the first of RUN/recordings/*.gif."""
     if recording is not None:
         return Path(recording) if Path(recording).is_file() else None
-    if (run / "plan.gif").is_file():
+    if (run / "plan.gif").is_file() or (run / "plan.gif").is_symlink():  # a link: refused by build_report
         return run / "plan.gif"
     gifs = sorted((run / "recordings").glob("*.gif")) if (run / "recordings").is_dir() else []
     return gifs[0] if gifs else None
@@ -58,25 +58,29 @@ def build_report(run: Path, data: Path | None = None, benchmark: Path | None = N
     run = Path(run)
     if not run.is_dir():
         raise ValueError(f"no run directory at {run}")
+    files = files_dir(run)
     data, data_why = _data_dir(run, data)
     summary, shares, why = _data_inputs(data)
-    ev, ev_why = g.read_json(run / "eval.json")
-    t1, t1_why = g.read_json(run / "table1.json")
-    sy, sy_why = g.read_json(run / "symbols.json")
-    tm, tm_why = g.read_json(run / "transition_metrics.json")
-    _, metrics_why = g.read_json(run / "metrics.json")
+    ev, ev_why = g.read_json(run / "eval.json", run=run)
+    t1, t1_why = g.read_json(run / "table1.json", run=run)
+    sy, sy_why = g.read_json(run / "symbols.json", run=run)
+    tm, tm_why = g.read_json(run / "transition_metrics.json", run=run)
+    _, metrics_why = g.read_json(run / "metrics.json", run=run)
     curves_why = "; ".join(w for w in (metrics_why, tm_why) if "cannot be read" in w)
     bench_path = Path(benchmark) if benchmark is not None else run / "benchmark.json"
-    bench, bench_why = g.read_json(bench_path, schemas.BENCHMARK)
-    if benchmark is None and not bench_path.exists():
+    bench, bench_why = g.read_json(bench_path, schemas.BENCHMARK, run=run if benchmark is None else None)
+    if benchmark is None and not (bench_path.exists() or bench_path.is_symlink()):
         bench_why = ""
     gif = find_recording(run, recording)
     strip, gif_why = None, ""
-    if gif is not None:
+    outside = g.outside_run(run, gif) if gif is not None and recording is None else ""
+    if outside:
+        gif_why = f"{gif} cannot be read: {outside}"
+    elif gif is not None:
         from symlearn.planning.recording import RecordingError, filmstrip_from_gif
 
         try:
-            strip = filmstrip_from_gif(gif, run / FILES_DIR / "plan_filmstrip.png")
+            strip = filmstrip_from_gif(gif, files / "plan_filmstrip.png")
         except RecordingError as e:  # beyond the pixel caps, or not a GIF: the section says so in one line
             gif_why = g.cannot_read(gif, e)
     sections = [g.data_section(summary, shares, why or data_why),
@@ -91,6 +95,16 @@ def build_report(run: Path, data: Path | None = None, benchmark: Path | None = N
     return rep
 
 
+def files_dir(run: Path) -> Path:
+    """RUN/report_files, where the report writes its PNGs; ValueError (one line) when it is a symbolic link or
+    lies outside the run: the report writes nothing outside its run folder."""
+    files = Path(run) / FILES_DIR
+    if g.outside_run(run, files):
+        raise ValueError(f"{files} is a symbolic link or lies outside the run: the report writes only inside its "
+                         f"run folder; remove it")
+    return files
+
+
 def _reason(why: str, command: str) -> str:
     return f"{why}: run '{command}'" if why.endswith("not found") else why
 
@@ -98,7 +112,7 @@ def _reason(why: str, command: str) -> str:
 def write_report(report: Report, run: Path) -> tuple[Path, Path]:
     """Write RUN/report.html (self-contained) and RUN/report.md with its PNGs in RUN/report_files/."""
     run = Path(run)
-    files = run / FILES_DIR
+    files = files_dir(run)
     files.mkdir(parents=True, exist_ok=True)
     pngs: dict[str, bytes] = {}
     for s in report.sections:
@@ -107,7 +121,7 @@ def write_report(report: Report, run: Path) -> tuple[Path, Path]:
         for p in s.plots:
             pngs[p.name] = plot_png(p)
         for im in s.images:
-            pngs[im.name] = read_bounded_bytes(im.path, MAX_IMAGE_BYTES, "image")
+            pngs[im.name] = read_bounded_bytes(im.path, MAX_IMAGE_BYTES, "image", follow_symlinks=False)
     rel = {}
     for name, blob in pngs.items():
         target = files / f"{name}.png"

@@ -6,6 +6,7 @@ unreadable input becomes a "not run" section naming the file and the command tha
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from pddl_export.bounded_json import JsonFileError, Schema, check, read_json_file
@@ -17,25 +18,44 @@ PAPER_EFFECT_MAE_MM = {"x": 8.6, "y": 15.0, "z": 6.0}  # the paper's test error 
 PAPER_SYMBOLS_95 = 35  # the paper: 35 symbols cover 95% of the objects
 OBJECT_ORDER = (1, 0, 2)  # Table I's columns: first cube (green), stick (orange), second cube (red)
 OBJECT_NAMES = ("first cube", "stick", "second cube")
+RUN_FILES_ONLY = "the report reads only regular files inside the run"
 SYMBOL_IMAGES = (("symbols.png", "Symbol prototypes (the paper's Fig. 4)"),
                  ("symbol_examples.png", "Examples of one symbol (the paper's Fig. 5)"))
 
 
-def read_json(path: Path, schema: Schema | None = None) -> tuple[dict | None, str]:
+def read_json(path: Path, schema: Schema | None = None, run: Path | None = None) -> tuple[dict | None, str]:
     """(document, '') or (None, one-line reason): missing, refused by the bounded reader (not a regular file,
     too large, not JSON, too deep, non-finite numbers) or not fitting `schema` (default: the schema of the
-    run file of that name in symlearn.report.schemas, else any JSON object)."""
+    run file of that name in symlearn.report.schemas, else any JSON object). With `run`, the file must also
+    be a run file (outside_run): no symbolic link (opened with O_NOFOLLOW too), inside the run folder."""
     path = Path(path)
-    if not path.exists():
+    if not path.exists() and not path.is_symlink():
         return None, f"{path} not found"
+    why = outside_run(run, path) if run is not None else ""
+    if why:
+        return None, f"{path} cannot be read: {why}"
     schema = schema or schemas.RUN_FILES.get(path.name)
     try:
-        doc = read_json_file(path, schema, what="run file")
+        doc = read_json_file(path, schema, what="run file", follow_symlinks=run is None)
     except JsonFileError as e:
         return None, cannot_read(path, e)
     if not isinstance(doc, dict):
         return None, f"{path} is not a JSON object"
     return doc, ""
+
+
+def outside_run(run: Path, path: Path) -> str:
+    """'' when `path` is no symbolic link (lstat) and lies inside the run folder once resolved (so a linked folder
+    on the way is refused too); else the one-line reason. The report reads nothing else of the run: a link such as
+    symbols.png -> ../secret.txt would copy its target into report.html and report_files/."""
+    path = Path(path)
+    if path.is_symlink():
+        return f"is a symbolic link, not a regular run file ({RUN_FILES_ONLY})"
+    try:
+        path.resolve().relative_to(Path(run).resolve())
+    except ValueError:
+        return f"lies outside the run folder {run} ({RUN_FILES_ONLY})"
+    return ""
 
 
 def cannot_read(path: Path, e: Exception) -> str:
@@ -68,10 +88,10 @@ def effect_section(ev: dict | None, why: str = "") -> Section:
     """Test-split effect MAE per axis next to the paper's 8.6 / 15 / 6 mm, with the ablation rows."""
     title = "Effect prediction error (test split)"
     if ev is None:
-        return not_run("effect", title, why or "RUN/eval.json missing: run 'symlearn evaluate'")
+        return not_run("effect", title, why or "RUN/eval.json missing: run 'symlearn evaluate'",
+                       _effect_marks({}, True) if refused(why) else [])
     ours = ev.get("effect_mae_mm") or {}
-    marks = [Mark(f"effect MAE {a} (mm)", ours.get(a), PAPER_EFFECT_MAE_MM[a], "below the paper's",
-                  None if ours.get(a) is None else ours[a] < PAPER_EFFECT_MAE_MM[a]) for a in "xyz"]
+    marks = _effect_marks(ours)
     rows = [("attentive (ours)", *(ours.get(a) for a in "xyz")),
             ("paper", *(PAPER_EFFECT_MAE_MM[a] for a in "xyz"))]
     for name, r in (ev.get("ablations") or {}).items():
@@ -87,6 +107,18 @@ def effect_section(ev: dict | None, why: str = "") -> Section:
                                  key="effect")])
 
 
+def refused(why: str) -> bool:
+    """Whether a section's reason says its file was refused (read_json, cannot_read), not merely missing."""
+    return " cannot be read: " in why
+
+
+def _effect_marks(ours: dict, invalid: bool = False) -> list[Mark]:
+    """Our effect MAE per axis against the paper's; an error below zero (or a refused eval.json) is invalid."""
+    return [Mark(f"effect MAE {a} (mm)", ours.get(a), PAPER_EFFECT_MAE_MM[a], "below the paper's",
+                 None if ours.get(a) is None else ours[a] < PAPER_EFFECT_MAE_MM[a], invalid, (0.0, math.inf))
+            for a in "xyz"]
+
+
 def _vec(v) -> str:
     return "(" + ", ".join(f"{x:.0f}" for x in v) + ")" if v is not None else "-"
 
@@ -95,7 +127,8 @@ def table1_section(t1: dict | None, why: str = "", run: Path | None = None) -> S
     """Table I: predicted and true effects in the three stick cases, ours beside the paper's, and the criteria."""
     title = "Table I: the three stick cases"
     if t1 is None:
-        return not_run("table1", title, why or "RUN/table1.json missing: run 'symlearn table1'")
+        return not_run("table1", title, why or "RUN/table1.json missing: run 'symlearn table1'",
+                       _table1_marks({"motion_right": None, "riders_within_50mm": None}, True) if refused(why) else [])
     paper = t1.get("paper") or {}
     rows = []
     for key, label in (("predicted_mm", "predicted"), ("truth_mm", "truth")):
@@ -108,14 +141,7 @@ def table1_section(t1: dict | None, why: str = "", run: Path | None = None) -> S
                 cells.append(_vec(ref[j]) if j < len(ref) else "-")
             rows.append((f"case {i + 1} {label}", *cells))
     header = ("row",) + tuple(f"{n} {w}" for n in OBJECT_NAMES for w in ("ours", "paper"))
-    c = t1.get("criteria") or {}
-    marks = []
-    if "motion_right" in c:
-        marks.append(Mark("Table I: every object's motion right", c.get("objects_motion_right"), "all objects",
-                          "moved >= 100 mm in y the right way, or within 20 mm of still", bool(c["motion_right"])))
-    if "riders_within_50mm" in c:
-        marks.append(Mark("Table I: riders' y within 50 mm of the truth", c.get("riders_right"), "all riders",
-                          "|predicted y - true y| <= 50 mm", bool(c["riders_within_50mm"])))
+    marks = _table1_marks(t1.get("criteria") or {})
     mae = t1.get("mean_abs_error_mm") or {}
     text = [f"mean absolute error over the cases (mm): {fmt(mae or None)}"]
     for i, case in enumerate(t1.get("cases", [])):
@@ -125,30 +151,67 @@ def table1_section(t1: dict | None, why: str = "", run: Path | None = None) -> S
                             f"{' / '.join(fmt(w) for w in rider['on_stick'])} of its attention on the stick, "
                             f"layer by layer")
     name = t1.get("attention_figure")  # the figure table1 drew and recorded in table1.json (a bare file name)
-    figure = Path(run) / name if run is not None and isinstance(name, str) and Path(name).name == name else None
-    images = [Image("table1_attention", "Attention of each object on each object in the three cases (rows: who "
-                    "attends), per layer", figure)] if figure is not None and figure.is_file() else []
+    figures = [("table1_attention", name, "Attention of each object on each object in the three cases (rows: who "
+                "attends), per layer")] if run is not None and isinstance(name, str) and Path(name).name == name else []
+    images, notes = run_images(run, figures)
+    text += notes
     return Section("table1", title, marks=marks, text=text, images=images,
                    tables=[Table("Effects (mm), ours next to the paper's", header, tuple(rows), key="table1")])
+
+
+def _table1_marks(c: dict, invalid: bool = False) -> list[Mark]:
+    """Table I's two criteria as recorded in table1.json's `criteria` (each only when there), or invalid ones."""
+    marks = []
+    if "motion_right" in c:
+        marks.append(Mark("Table I: every object's motion right", c.get("objects_motion_right"), "all objects",
+                          "moved >= 100 mm in y the right way, or within 20 mm of still",
+                          None if invalid else bool(c["motion_right"]), invalid))
+    if "riders_within_50mm" in c:
+        marks.append(Mark("Table I: riders' y within 50 mm of the truth", c.get("riders_right"), "all riders",
+                          "|predicted y - true y| <= 50 mm", None if invalid else bool(c["riders_within_50mm"]),
+                          invalid))
+    return marks
+
+
+def run_images(run: Path, figures) -> tuple[list[Image], list[str]]:
+    """Images of the run's figure files (name, file name, caption) that are there, and a line for each refused
+    (a symbolic link, or outside the run: outside_run): the report copies only the run's own files."""
+    images, notes = [], []
+    for name, file_name, caption in figures:
+        path = Path(run) / file_name
+        if not (path.is_file() or path.is_symlink()):
+            continue
+        why = outside_run(run, path)
+        if why:
+            notes.append(f"{path} not shown: {why}")
+        else:
+            images.append(Image(name, caption, path))
+    return images, notes
 
 
 def symbols_section(sy: dict | None, run: Path, why: str = "") -> Section:
     """Symbol counts next to the paper's '35 symbols cover 95%', the frequent symbols, and the figures."""
     title = "Symbols"
     if sy is None:
-        return not_run("symbols", title, why or "RUN/symbols.json missing: run 'symlearn symbols'")
+        return not_run("symbols", title, why or "RUN/symbols.json missing: run 'symlearn symbols'",
+                       _symbols_marks(None, True) if refused(why) else [])
     n95 = sy.get("n_symbols_for_95pct")
-    marks = [Mark("symbols covering 95% of objects", n95, PAPER_SYMBOLS_95, "at most the paper's 35",
-                  None if n95 is None else n95 <= PAPER_SYMBOLS_95)]
+    marks = _symbols_marks(n95)
     rows = tuple((k, sy.get(k)) for k in ("n_objects", "n_distinct", "n_symbols_for_95pct", "weighted_type_purity",
                                           "weighted_moved_purity", "example_symbol"))
     top = tuple((r.get("code"), r.get("count"), r.get("cube_fraction"), r.get("times_picked"),
                  r.get("moved_when_picked")) for r in (sy.get("symbols") or [])[:15])
-    images = [Image(Path(name).stem, cap, Path(run) / name) for name, cap in SYMBOL_IMAGES if (Path(run) / name).is_file()]
-    return Section("symbols", title, marks=marks, images=images,
+    images, notes = run_images(run, [(Path(name).stem, name, cap) for name, cap in SYMBOL_IMAGES])
+    return Section("symbols", title, marks=marks, images=images, text=notes,
                    tables=[Table("Symbol statistics", ("quantity", "value"), rows, key="symbols"),
                            Table("Most frequent symbols", ("code", "count", "cube fraction", "times picked",
                                                            "moved when picked"), top, key="symbol_list")])
+
+
+def _symbols_marks(n95: int | None, invalid: bool = False) -> list[Mark]:
+    """Symbols covering 95% of the objects against the paper's 35 (a count below zero is invalid)."""
+    return [Mark("symbols covering 95% of objects", n95, PAPER_SYMBOLS_95, "at most the paper's 35",
+                 None if n95 is None else n95 <= PAPER_SYMBOLS_95, invalid, (0, math.inf))]
 
 
 def _series(history: list, keys: tuple[str, ...]) -> dict:
@@ -271,10 +334,10 @@ def scorecard_section(report: Report) -> Section:
 
 def history_from_checkpoint(run: Path) -> list | None:
     """The effect model's per-epoch history from RUN/metrics.json, else from RUN/best.pt; None without either."""
-    doc, _ = read_json(Path(run) / "metrics.json")
+    doc, _ = read_json(Path(run) / "metrics.json", run=run)
     if doc and isinstance(doc.get("history"), list):
         return doc["history"]
-    if (Path(run) / "best.pt").is_file():
+    if (Path(run) / "best.pt").is_file() and not outside_run(run, Path(run) / "best.pt"):
         from symlearn.learning.checkpoint import CheckpointError, load_checkpoint
 
         try:

@@ -6,10 +6,11 @@ draws the plots. Nothing here computes anything.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-OK, NOT_RUN = "ok", "not run"
+OK, NOT_RUN, INVALID = "ok", "not run", "invalid"
 
 
 @dataclass(frozen=True)
@@ -21,10 +22,15 @@ class Mark:
     paper: float | str
     criterion: str  # e.g. "below the paper's"
     met: bool | None  # None: ours unknown
+    invalid: bool = False  # ours is impossible, or its file was refused: never counted as met
+    valid: tuple[float, float] = (-math.inf, math.inf)  # the values ours can take (an error is >= 0)
 
     @property
     def verdict(self) -> str:
-        """'met', 'not met', or 'not run'."""
+        """'invalid' (refused, or a number outside `valid`), else 'met', 'not met', or 'not run'."""
+        number = isinstance(self.ours, (int, float)) and not isinstance(self.ours, bool)
+        if self.invalid or (number and not self.valid[0] <= self.ours <= self.valid[1]):
+            return INVALID
         return NOT_RUN if self.met is None else "met" if self.met else "not met"
 
 
@@ -86,6 +92,6 @@ class Report:
         return [m for s in self.sections for m in s.marks]
 
 
-def not_run(key: str, title: str, why: str) -> Section:
-    """A section whose inputs are missing."""
-    return Section(key, title, status=NOT_RUN, note=why)
+def not_run(key: str, title: str, why: str, marks: list[Mark] | None = None) -> Section:
+    """A section whose inputs are missing; `marks` (invalid ones, for a file refused) still reach the scorecard."""
+    return Section(key, title, status=NOT_RUN, note=why, marks=list(marks or []))

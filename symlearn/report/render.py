@@ -14,7 +14,7 @@ from symlearn.report.model import NOT_RUN, Report, Section
 CSS = """body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
 table{border-collapse:collapse;margin:.6em 0}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}
 th{background:#f3f3f3}td:first-child{text-align:left}.met{color:#1a7f37;font-weight:bold}
-.not-met{color:#c62828;font-weight:bold}.not-run{color:#888}img{max-width:100%;border:1px solid #ddd}
+.not-met,.invalid{color:#c62828;font-weight:bold}.not-run{color:#888}img{max-width:100%;border:1px solid #ddd}
 section{margin-bottom:2em}caption{text-align:left;font-style:italic}"""
 
 
@@ -33,7 +33,7 @@ def fmt(v) -> str:
 
 
 def _css_class(verdict: str) -> str:
-    return {"met": "met", "not met": "not-met"}.get(verdict, "not-run")
+    return {"met": "met", "not met": "not-met", "invalid": "invalid"}.get(verdict, "not-run")
 
 
 def _html_table(t, verdict_col: int | None = None) -> str:

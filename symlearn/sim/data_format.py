@@ -7,15 +7,45 @@ the stage that produces the data never imports the stages that consume it. See d
 """
 from __future__ import annotations
 
+import hashlib
 from pathlib import Path
+from typing import BinaryIO
+
+from pddl_export.bounded_json import JsonFileError, open_regular_file
 
 FORMAT_VERSION = 1
 DATA_KIND = "symlearn-interaction-data"
 SPLITS = ("train", "val", "test")
+MAX_SHARD_BYTES = 4 << 30  # a shard of 250 samples (the default) is a few MB; 4 GiB is far beyond any setting
 
 
 class DataError(ValueError):
     """A data set that is missing, foreign, incomplete or corrupted."""
+
+
+def open_shard(path: Path) -> BinaryIO:
+    """A shard opened for reading (close it: `with open_shard(p) as f`), refused in one line naming the file
+    (DataError) unless it is a regular file of at most MAX_SHARD_BYTES: a FIFO in a shard's place would
+    block a plain open (resume, training) forever, a device would be read without end.
+    The open-and-check is pddl_export.bounded_json's (non-blocking open, fstat on the descriptor)."""
+    try:
+        return open_regular_file(path, MAX_SHARD_BYTES, "data shard")
+    except JsonFileError as e:
+        raise DataError(str(e)) from None
+
+
+def stream_sha256(f: BinaryIO) -> str:
+    """Hex SHA-256 of what is left to read of an open file, in 1 MiB chunks (the file stays open)."""
+    h = hashlib.sha256()
+    for chunk in iter(lambda: f.read(1 << 20), b""):
+        h.update(chunk)
+    return h.hexdigest()
+
+
+def shard_sha256(path: Path) -> str:
+    """Hex SHA-256 of a shard file, opened by open_shard (DataError for anything but a regular file)."""
+    with open_shard(path) as f:
+        return stream_sha256(f)
 
 
 def check_shard_entries(path: Path, m: dict) -> None:
