@@ -12,10 +12,14 @@ open loop).
 
 Each stage is a call of the library function its `symlearn` sub-command calls, with a frozen config dataclass
 built from the settings and the preset; what the stage prints, and the traceback of a crash, go to
-OUT/logs/<stage>.log. OUT/pipeline.json (written atomically after every finished stage) records each stage's
+OUT/logs/<stage>.log. OUT/pipeline.json (written atomically as every stage starts and finishes) records each stage's
 config (as JSON), the hashes of its inputs and of its outputs. A stage is skipped when its record holds the same
 config and input hashes and its outputs are still there unchanged; so an interrupted pipeline, run again, redoes
-only what did not finish (and what depends on a change).
+only what did not finish (and what depends on a change). A stage is recorded (config and inputs) before it runs: one
+interrupted under the same config and inputs resumes (collect's shards, train's last.pt), while one whose record
+holds another config or other inputs, or lost outputs, first removes the files it writes (Stage.written, inside OUT)
+and runs as in a fresh run. So a run with other settings redoes exactly the stages whose config or inputs changed
+and the stages after them that read their outputs, and ends with the files a fresh run of those settings writes.
 
 The pipeline calls the library, never the command line: `symlearn pipeline` (symlearn.cli.pipeline) is a thin
 front end to run_pipeline, and tests/test_layout.py keeps imports going that one way.
@@ -28,6 +32,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import json
+import shutil
 import time
 import traceback
 from dataclasses import dataclass
@@ -122,7 +127,8 @@ class PipelineSettings:
     out: Path
     preset: str = DEFAULT_PRESET
     n: int | None = None  # samples of each collected set (the main one and the extra one)
-    seed: int = 0
+    # every stage's seed; None: a settings-file table's `seed` for its stage ([collect], [train], [export]), else 0
+    seed: int | None = None
     epochs: int | None = None
     transition_epochs: int | None = None
     problems: int | None = None  # problems, per cell with a stratified preset
@@ -230,6 +236,11 @@ def _first(*values):
     return next((v for v in values if v is not None), None)
 
 
+def _seed(s: PipelineSettings, table: str | None = None) -> int:
+    """A stage's seed: --seed, else the `seed` of the stage's settings-file table, else 0."""
+    return _first(s.seed, s.table(table).get("seed") if table else None, 0)
+
+
 def _extra_data(s: PipelineSettings) -> tuple[str, ...]:
     """OUT's folders of the extra data sets this preset collects."""
     return (DATA_EXTRA,) if s.preset_values.extra_objects else ()
@@ -240,7 +251,7 @@ def _collect_config(s: PipelineSettings) -> CollectConfig:
     from symlearn.sim.collect import CollectConfig
 
     cfg = replace_nested(CollectConfig(**_given(n=s.preset_values.samples)), s.table("collect"))
-    return dataclasses.replace(cfg, seed=s.seed, **_given(n=s.n))
+    return dataclasses.replace(cfg, seed=_seed(s, "collect"), **_given(n=s.n))
 
 
 def _collect_extra_config(s: PipelineSettings) -> CollectConfig:
@@ -251,7 +262,7 @@ def _collect_extra_config(s: PipelineSettings) -> CollectConfig:
 
     p = s.preset_values
     cfg = replace_nested(CollectConfig(**_given(n=p.extra_samples)), s.table("collect"))
-    return dataclasses.replace(cfg, seed=s.seed + EXTRA_SEED_OFFSET, **_given(n=s.n),
+    return dataclasses.replace(cfg, seed=_seed(s, "collect") + EXTRA_SEED_OFFSET, **_given(n=s.n),
                                exploration=ExplorationConfig.with_k_range(*p.extra_objects))
 
 
@@ -264,7 +275,7 @@ def _train_config(s: PipelineSettings) -> TrainConfig:
     p = s.preset_values
     # bf16 autocast on a GPU only, as the pipeline has always trained (plain float32 on a CPU)
     values = {"bf16": torch.cuda.is_available(), **_given(epochs=p.epochs), **flat_overrides(s.table("train"))}
-    return TrainConfig.from_preset(p.models, **{**values, "seed": s.seed, **_given(epochs=s.epochs)})
+    return TrainConfig.from_preset(p.models, **{**values, "seed": _seed(s, "train"), **_given(epochs=s.epochs)})
 
 
 def _symbols_config(s: PipelineSettings) -> SymbolsStageConfig:
@@ -281,7 +292,7 @@ def _transition_config(s: PipelineSettings) -> TransitionStageConfig:
     values = {**_given(epochs=p.transition_epochs, location_bits=FIELD_BITS if p.lifted else None),
               **s.table("transition"), **_given(epochs=s.transition_epochs)}
     cfg = TransitionConfig.from_preset(p.models, **values)
-    return TransitionStageConfig(cfg, seed=s.seed, extra_data=_extra_data(s))
+    return TransitionStageConfig(cfg, seed=_seed(s), extra_data=_extra_data(s))
 
 
 def _export_config(s: PipelineSettings) -> ExportConfig:
@@ -290,8 +301,8 @@ def _export_config(s: PipelineSettings) -> ExportConfig:
     from symlearn.config_file import replace_nested
 
     p = s.preset_values
-    cfg = ExportConfig(seed=s.seed, **_given(max_objects=p.max_objects, pddl_fidelity_cases=p.fidelity_cases))
-    return replace_nested(cfg, s.table("export"))
+    cfg = ExportConfig(**_given(max_objects=p.max_objects, pddl_fidelity_cases=p.fidelity_cases))
+    return dataclasses.replace(replace_nested(cfg, s.table("export")), seed=_seed(s, "export"))
 
 
 def _lifted_config(s: PipelineSettings) -> LiftedStageConfig:
@@ -309,14 +320,14 @@ def _problems_config(s: PipelineSettings) -> ProblemsStageConfig:
     from symlearn.config_file import replace_nested
 
     n = _first(s.problems, s.preset_values.problems, N_PROBLEMS)
-    return ProblemsStageConfig(n=n, seed=s.seed, problem=replace_nested(ProblemConfig(), s.table("problems")))
+    return ProblemsStageConfig(n=n, seed=_seed(s), problem=replace_nested(ProblemConfig(), s.table("problems")))
 
 
 def _stratified_config(s: PipelineSettings) -> StratifiedStageConfig:
     from symlearn.problems.stratified import OBJECTS, PER_CELL
 
     p = s.preset_values
-    return StratifiedStageConfig(n=_first(s.problems, p.problems, PER_CELL), seed=s.seed,
+    return StratifiedStageConfig(n=_first(s.problems, p.problems, PER_CELL), seed=_seed(s),
                                  objects=_first(p.problem_objects, OBJECTS))
 
 
@@ -451,9 +462,8 @@ def _benchmark(out: Path, cfg: BenchmarkStageConfig, s: PipelineSettings) -> Non
 
     run, ex = out / RUN, cfg.execution
     with _torch_threads(cfg.threads):
-        res = benchmark(run, out / PROBLEMS, list(cfg.planners), run / "benchmark.json", closed_loop=ex.closed_loop,
-                        timeout_s=ex.timeout_s, max_replans=ex.max_replans, show_progress=False,
-                        record_dir=run / "recordings", risk_weight=ex.risk_weight)
+        res = benchmark(run, out / PROBLEMS, list(cfg.planners), run / "benchmark.json", execution=ex,
+                        show_progress=False, record_dir=run / "recordings")
         print(format_table(res))
         planner = cfg.planners[0]
         done = plan_problem(run, _first_problem(out), planner, ex, record=run / "plan.gif")
@@ -484,6 +494,13 @@ class Stage:
     run: Callable[[Path, Any, PipelineSettings], None]  # (OUT, config, settings)
     inputs: tuple[str, ...]
     outputs: tuple[str, ...]
+    # what else it writes (its resume state, side files and folders): removed with its outputs when it starts over
+    owns: tuple[str, ...] = ()
+
+    @property
+    def written(self) -> tuple[str, ...]:
+        """Every file and folder (relative to OUT) the stage writes, and only those: what a fresh start removes."""
+        return self.outputs + self.owns
 
 
 def pipeline_stages(p: PipelinePreset) -> list[Stage]:
@@ -497,28 +514,32 @@ def pipeline_stages(p: PipelinePreset) -> list[Stage]:
     if p.lifted:
         domain = f"{R}/pddl/lifted.json"
         export = Stage("export-pddl", _lifted_config, _export_lifted, data + extra + nets,
-                       (f"{R}/pddl/lifted/domain.pddl", domain))
+                       (f"{R}/pddl/lifted/domain.pddl", domain), (f"{R}/pddl/lifted",))
     else:
         domain = f"{R}/pddl/rules.json"
-        export = Stage("export-pddl", _export_config, _export_pddl, data + nets, (f"{R}/pddl/domain.pddl", domain))
+        export = Stage("export-pddl", _export_config, _export_pddl, data + nets, (f"{R}/pddl/domain.pddl", domain),
+                       (f"{R}/pddl/report.json", f"{R}/pddl/outcomes.json"))
     problems = (Stage("problems", _stratified_config, _stratified, (), (P,)) if p.stratified
                 else Stage("problems", _problems_config, _problems, (), (P,)))
-    collect_extra = [Stage("collect-extra", _collect_extra_config, _collect_into(X), (), extra)] if extra else []
+    collect_extra = [Stage("collect-extra", _collect_extra_config, _collect_into(X), (), extra, (X,))] if extra else []
     return [
-        Stage("collect", _collect_config, _collect_into(D), (), data),
+        Stage("collect", _collect_config, _collect_into(D), (), data, (D,)),
         *collect_extra,
-        Stage("train", _train_config, _train, data, (f"{R}/best.pt", f"{R}/metrics.json")),
+        Stage("train", _train_config, _train, data, (f"{R}/best.pt", f"{R}/metrics.json"),
+              (f"{R}/last.pt", f"{R}/config.json")),
         Stage("evaluate", empty, _evaluate, data + (f"{R}/best.pt",), (f"{R}/eval.json",)),
-        Stage("table1", empty, _table1, (f"{R}/best.pt",), (f"{R}/table1.json",)),
-        Stage("symbols", _symbols_config, _symbols, data + (f"{R}/best.pt",), (f"{R}/symbols.json", f"{R}/symbols.png")),
+        Stage("table1", empty, _table1, (f"{R}/best.pt",), (f"{R}/table1.json",), (f"{R}/table1_attention.png",)),
+        Stage("symbols", _symbols_config, _symbols, data + (f"{R}/best.pt",), (f"{R}/symbols.json", f"{R}/symbols.png"),
+              (f"{R}/symbol_examples.png",)),
         Stage("train-transition", _transition_config, _train_transition, data + extra + (f"{R}/best.pt",),
               (f"{R}/transition.pt", f"{R}/transition_metrics.json")),
         export,
         problems,
-        Stage("benchmark", _benchmark_config, _benchmark, nets + (domain, P), (f"{R}/benchmark.json", f"{R}/plan.gif")),
+        Stage("benchmark", _benchmark_config, _benchmark, nets + (domain, P), (f"{R}/benchmark.json", f"{R}/plan.gif"),
+              (f"{R}/benchmark.json.rows.jsonl", f"{R}/plan.png", f"{R}/recordings", f"{R}/pddl/problems")),
         Stage("report", empty, _report,
               (f"{R}/eval.json", f"{R}/table1.json", f"{R}/symbols.json", f"{R}/transition_metrics.json",
-               f"{R}/benchmark.json", f"{R}/plan.gif"), (f"{R}/report.html", f"{R}/report.md")),
+               f"{R}/benchmark.json", f"{R}/plan.gif"), (f"{R}/report.html", f"{R}/report.md"), (f"{R}/report_files",)),
     ]
 
 
@@ -549,8 +570,9 @@ def _hashes(out: Path, rels: tuple[str, ...]) -> dict[str, str | None]:
 _HASHES = Map(Opt(Str(64)), 100)  # relative path -> 16 hex digits, None where missing
 # One finished stage as run_pipeline records it; is_done compares config, inputs and outputs. A record from
 # before configs were recorded holds command lines ("argv") instead: it has no config, so its stage runs again.
+# A stage that started and has not finished records its config and inputs, and when it started (no outputs).
 STAGE_RECORD = Obj(optional={"config": Map(AnyJson(), 100), "inputs": _HASHES, "outputs": _HASHES,
-                             "wall_s": Opt(Num()), "finished": Str(100), "out": Str(4096)})
+                             "wall_s": Opt(Num()), "finished": Str(100), "started": Str(100), "out": Str(4096)})
 RECORD_SCHEMA = Obj({"kind": Str(100), "stages": Map(STAGE_RECORD, 100)},
                     optional={"out": Str(4096), "preset": Str(100)})
 
@@ -581,6 +603,36 @@ def is_done(stage: Stage, rec: dict | None, config: dict, inputs: dict) -> bool:
     outputs = rec.get("outputs") or {}
     return set(outputs) == set(stage.outputs) and all(
         h is not None and path_hash(Path(rec["out"]) / r) == h for r, h in outputs.items())
+
+
+def starts_over(rec: dict | None, config: dict, inputs: dict) -> bool:
+    """Whether a stage that is not done must start afresh, its earlier files removed: its record holds another
+    config or other inputs, or says it finished (an output since lost or changed). A stage that started with this
+    very config and these inputs and did not finish resumes (collect's shards, train's last.pt); one without a record
+    is left to its library call, which resumes its own files or refuses foreign ones."""
+    if rec is None:
+        return False
+    return rec.get("config") != config or rec.get("inputs") != inputs or "outputs" in rec
+
+
+def clear_stage(out: Path, stage: Stage) -> list[str]:
+    """Remove the files and folders `stage` writes in OUT (Stage.written), so that it starts as in a fresh run;
+    returns those removed. Nothing else is touched: a symbolic link is removed as a link, and a path whose folder
+    lies outside OUT (through a link) is refused in one line before anything is removed."""
+    root = out.resolve()
+    present = [r for r in stage.written if (out / r).is_symlink() or (out / r).exists()]
+    present = [r for r in present if not any(o != r and Path(r).is_relative_to(o) for o in present)]  # in a folder
+    for r in present:
+        if not (out / r).parent.resolve().is_relative_to(root):
+            raise ValueError(f"{out / r} lies outside {out} (through a symbolic link); stage {stage.name} must start "
+                             "over and removes only files inside OUT: move it away or choose another --out")
+    for r in present:
+        path = out / r
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path)
+        else:
+            path.unlink()
+    return present
 
 
 class StageError(RuntimeError):
@@ -638,7 +690,13 @@ def _run_stages(s: PipelineSettings, configs: dict[str, Any], out: Path, echo: C
             missing = [r for r, h in inputs.items() if h is None]
             if missing:
                 raise RuntimeError(f"stage {stage.name} needs {out / missing[0]}, which an earlier stage did not write")
-            record["stages"].pop(stage.name, None)
+            if starts_over(rec, config, inputs):
+                removed = clear_stage(out, stage)
+                echo(f"{prefix} starting over" + (f": removed {', '.join(removed)}" if removed else ""))
+            # recorded before it runs: an interrupted stage resumes only under this config and these inputs
+            record["stages"][stage.name] = {"config": config, "inputs": inputs,
+                                            "started": time.strftime("%Y-%m-%dT%H:%M:%S")}
+            atomic_write_json(out / RECORD_FILE, record)
             t0 = time.perf_counter()
             _run_stage(stage, configs[stage.name], out, s, out / "logs" / f"{stage.name}.log")
             wall = time.perf_counter() - t0

@@ -39,7 +39,9 @@ def add_pipeline_command(sub) -> None:
                    help="folder for data/, data_extra/, run/, problems/, logs/ and pipeline.json")
     # each value is checked here, before OUT is made, not first by the stage that uses it
     p.add_argument("--n", type=positive_int, help="samples of each collected set (preset's if unset)")
-    p.add_argument("--seed", type=non_negative_int, default=0)
+    p.add_argument("--seed", type=non_negative_int,
+                   help="every stage's seed (if unset: a settings file's [collect], [train] or [export] seed for "
+                        "its stage, else 0)")
     p.add_argument("--epochs", type=positive_int, help="effect model epochs (preset's if unset)")
     p.add_argument("--problems", type=positive_int,
                    help="planning problems to benchmark, per cell of objects x shortest-plan length with the "

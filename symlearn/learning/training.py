@@ -386,12 +386,36 @@ def _resume(run_dir: Path, cfg: TrainConfig, fingerprint: str, model: AttentiveD
     if (_resumable(ck.meta.get("train_config", {})) != _resumable(cfg.to_json())
             or ck.meta.get("data_fingerprint") != fingerprint):
         raise TrainingError(f"{run_dir} holds a run with other settings or data; use a new --out or --no-resume")
+    problem = _schedule_problem(ck.meta["train_config"].get("epochs"), cfg, ck.epoch + 1)
+    if problem:
+        raise TrainingError(f"{run_dir} holds a run whose {problem}: resumed, it would not be the model these "
+                            "settings train; use a new --out or --no-resume")
     load_weights(model, ck.model_state, run_dir / "last.pt")
     opt.load_state_dict(ck.optimizer_state)
     gen.set_state(ck.rng_states["shuffle"])
     noise_gen.set_state(ck.rng_states["noise"])
     torch.set_rng_state(ck.rng_states["torch"])  # dropout
-    return ck.epoch + 1, ck.best_val, ck.history
+    return ck.epoch + 1, ck.best_val, _timed(ck.history, run_dir / "metrics.json")
+
+
+# fields of a history row that record wall times: in metrics.json, not in the checkpoints
+WALL_TIME_FIELDS = ("crops_per_s", "epoch_time_s")
+
+
+def _untimed(row: dict) -> dict:
+    """A history row without its wall times, as the checkpoints hold it."""
+    return {k: v for k, v in row.items() if k not in WALL_TIME_FIELDS}
+
+
+def _timed(history: list, metrics: Path) -> list:
+    """A resumed checkpoint's history with the wall times RUN/metrics.json recorded for its epochs (where it has
+    them: it is written after the checkpoints, so a killed run's last epoch may have none)."""
+    try:
+        rows = read_json_file(metrics, what="training metrics").get("history") or []
+        times = {r["epoch"]: {k: r[k] for k in WALL_TIME_FIELDS if k in r} for r in rows}
+    except (ValueError, AttributeError, TypeError, KeyError):  # missing or damaged: the rows stay without them
+        times = {}
+    return [{**row, **times.get(row.get("epoch"), {})} for row in history]
 
 
 def _train_epoch(loop: _Loop, tr: SplitTensors, epoch: int) -> tuple[float, int, float]:
@@ -457,7 +481,10 @@ def _save_epoch(loop: _Loop, epoch: int, row: dict, val_loss: float, best: float
     """Rank 0 after an epoch: write last.pt, best.pt when improved and metrics.json; returns the new best."""
     improved = val_loss < best
     best = min(best, val_loss)
-    state = dict(model=loop.model, optimizer=loop.opt, epoch=epoch, best_val=best, history=history,
+    # the checkpoints' history leaves out the wall times, so that a checkpoint is byte for byte the same file
+    # in every run of the same settings (its hash is recorded downstream: m(z), the export, the report)
+    state = dict(model=loop.model, optimizer=loop.opt, epoch=epoch, best_val=best,
+                 history=[_untimed(r) for r in history],
                  rng_states={"shuffle": loop.gen.get_state(), "noise": loop.noise_gen.get_state(),
                              "torch": torch.get_rng_state()},
                  effect_mean=loop.mean, effect_std=loop.std, meta=loop.meta)
@@ -506,6 +533,20 @@ def _resumable(train_config: dict) -> dict:
     except (TypeError, ValueError, KeyError):
         pass  # unreadable: compared as written, so it cannot match
     return {k: v for k, v in train_config.items() if k != "epochs"}
+
+
+def _schedule_problem(trained_for: object, cfg: TrainConfig, trained: int) -> str | None:
+    """Why the first `trained` epochs of a run of `trained_for` epochs (otherwise cfg's settings) are not those of a
+    run of cfg: more epochs than cfg has, or other learning rates (the cosine schedule spans all the epochs);
+    None when resuming it trains, bit for bit, what cfg trains from scratch."""
+    if trained > cfg.epochs:
+        return f"{trained} epochs are more than the {cfg.epochs} asked"
+    if not _is_int(trained_for) or trained_for < 1:
+        return f"number of epochs {trained_for!r} cannot be read"
+    before = dataclasses.replace(cfg, epochs=trained_for)
+    if any(epoch_lr(before, e) != epoch_lr(cfg, e) for e in range(trained)):
+        return f"{trained} epochs followed the learning rates of {trained_for} epochs, not of {cfg.epochs}"
+    return None
 
 
 def _ranks_identical(model: torch.nn.Module) -> bool:
