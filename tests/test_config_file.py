@@ -65,7 +65,7 @@ def test_unreadable_and_oversized_files_are_refused(tmp_path):
     with pytest.raises(ConfigFileError, match="cannot read the settings file"):
         read_config_file(tmp_path / "missing.toml")
     big = _write(tmp_path, "# " + "x" * MAX_CONFIG_BYTES + "\n")
-    with pytest.raises(ConfigFileError, match="larger than"):
+    with pytest.raises(ConfigFileError, match="more than the 1048576 bytes a settings file may have"):
         read_config_file(big)
 
 

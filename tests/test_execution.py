@@ -404,10 +404,13 @@ def test_benchmark_records_the_risk_weight_of_astar_likely(tmp_path, sim, run_di
     assert all(r["planner"] == "astar-likely" for r in res["rows"])
     # an interrupted run resumes only under the same weight: the weight is part of the settings
     problems = bench.load_sets([pdir])
-    settings = [bench._settings(run_dir, [pdir], problems, ["astar-likely"], False, 2.0, 3, w) for w in (1.0, 2.5)]
+    ex = ExecutionConfig(timeout_s=2.0)
+    settings = [bench._settings(run_dir, [pdir], problems, ["astar-likely"], dataclasses.replace(ex, risk_weight=w))
+                for w in (1.0, 2.5)]
     assert settings[0]["risk_weight"] == 1.0 and settings[0] != settings[1]
-    assert bench._settings(run_dir, [pdir], problems, ["astar-outcomes"], False, 2.0, 3, 2.5)["risk_weight"] == 2.5
-    assert "risk_weight" not in bench._settings(run_dir, [pdir], problems, ["astar"], False, 2.0, 3, 2.5)
+    weighted = dataclasses.replace(ex, risk_weight=2.5)
+    assert bench._settings(run_dir, [pdir], problems, ["astar-outcomes"], weighted)["risk_weight"] == 2.5
+    assert "risk_weight" not in bench._settings(run_dir, [pdir], problems, ["astar"], weighted)
 
 
 def test_unknown_planner_lists_every_planner(tmp_path, run_dir):

@@ -129,8 +129,8 @@ def test_ray_benchmark_gives_the_local_rows_and_resumes(ray_cluster, tiny_run, t
     assert not bench.rows_path(out).exists()
     # a killed run: its log holds some rows; the Ray engine runs only the others and ends with the same result
     log = bench.rows_path(out)
-    settings = bench._settings(tiny_run.path, [two_problems], bench.load_sets([two_problems]), planners, True,
-                               5.0, 3)
+    settings = bench._settings(tiny_run.path, [two_problems], bench.load_sets([two_problems]), planners,
+                               bench.ExecutionConfig(closed_loop=True, timeout_s=5.0))
     first = bench.RowLog(log, settings)
     first.open()
     keys = {p.label: p.key for p in bench.load_sets([two_problems])}

@@ -24,12 +24,13 @@ from symlearn.outputs import folder_output
 
 def cmd_collect(args: argparse.Namespace) -> int:
     from symlearn.cluster import check_engine
-    from symlearn.config_file import replace_nested
+    from symlearn.config_file import built, replace_nested
     from symlearn.data.dataset import summarize
     from symlearn.sim.collect import CollectConfig, collect
     from symlearn.sim.exploration import ExplorationConfig
 
-    cfg = replace_nested(CollectConfig(), read_config_file(args.config).get("collect", {}))  # [collect]
+    table = read_config_file(args.config).get("collect", {})  # [collect]
+    cfg = built(args.config, "collect", table, lambda v: replace_nested(CollectConfig(), v))
     if args.objects is not None:
         cfg = dataclasses.replace(cfg, exploration=ExplorationConfig.with_k_range(*args.objects))
     cfg = dataclasses.replace(cfg, **{k: v for k, v in dict(n=args.n, seed=args.seed).items() if v is not None})
@@ -79,14 +80,15 @@ def _init_distributed() -> None:
 
 
 def cmd_train(args: argparse.Namespace) -> int:
-    from symlearn.config_file import flat_overrides
+    from symlearn.config_file import built, flat_overrides
     from symlearn.learning.training import TrainConfig, train
 
-    over = flat_overrides(read_config_file(args.config).get("train", {}))  # [train] and [train.model]
-    over.update({k: v for k, v in dict(epochs=args.epochs, seed=args.seed).items() if v is not None})
+    flags = {k: v for k, v in dict(epochs=args.epochs, seed=args.seed).items() if v is not None}
     if args.no_attention:
-        over["attention"] = False
-    cfg = TrainConfig.from_preset(args.preset, **over)
+        flags["attention"] = False
+    table = read_config_file(args.config).get("train", {})  # [train] and [train.model]
+    cfg = built(args.config, "train", table,
+                lambda v: TrainConfig.from_preset(args.preset, **{**flat_overrides(v), **flags}))
     folder_output(Path(args.out), "--out")
     set_threads(args.threads)
     _init_distributed()
@@ -134,16 +136,18 @@ def cmd_symbols(args: argparse.Namespace) -> int:
 
 
 def cmd_export_lifted(args: argparse.Namespace) -> int:
-    from symlearn.config_file import replace_nested
+    from symlearn.config_file import built, replace_nested
     from symlearn.export.lifted_export import (LIFTED_DIR, LIFTED_FILE, LIFTED_PRESETS, MAX_DATA_OBJECTS,
-                                                 export_lifted, write_problem_folder)
+                                                 export_lifted, export_paths, write_problem_folder)
     from symlearn.problems.problem import load_problems
 
-    cfg = replace_nested(LIFTED_PRESETS[args.preset], read_config_file(args.config).get("lifted", {}))  # [lifted]
-    for d in args.problems or []:
-        load_problems(Path(d))  # a missing, empty or malformed problem set is refused before any work
-    set_threads(args.threads)
+    table = read_config_file(args.config).get("lifted", {})  # [lifted]
+    cfg = built(args.config, "lifted", table, lambda v: replace_nested(LIFTED_PRESETS[args.preset], v))
     out = Path(args.out) if args.out else None
+    folders = export_paths(Path(args.run), out, [Path(d) for d in args.problems or []])  # every output, first
+    for d in folders:
+        load_problems(d)  # a missing, empty or malformed problem set is refused before any work
+    set_threads(args.threads)
     rep = export_lifted(Path(args.run), Path(args.data[0]), tuple(Path(d) for d in args.data[1:]), cfg, out)
     where = out or Path(args.run) / "pddl"
     print(f"kept learned bits {rep['kept_bits']} (bits {rep['position_bits']} track the location); "
@@ -156,9 +160,8 @@ def cmd_export_lifted(args: argparse.Namespace) -> int:
                   f"m(z) {c['accuracy_net']:.3f}; where they disagree ({c['disagree']}) the world sides with the rules "
                   f"{c['world_sides_with_rules']} times, with m(z) {c['world_sides_with_net']}")
     print(f"wrote {where / LIFTED_DIR / 'domain.pddl'} and {where / LIFTED_FILE}")
-    for d in args.problems or []:
-        index = write_problem_folder(Path(args.run), Path(d), pddl_dir=out)
-        folder = where / LIFTED_DIR / Path(d).name
+    for d, folder in folders.items():
+        index = write_problem_folder(Path(args.run), d, folder, pddl_dir=out)
         print(f"wrote {folder}: domain.pddl and {len(index['problems'])} problems (p01.pddl ...), index.json")
         if index["zero_shot"]:
             print(f"warning: {len(index['zero_shot'])} problems of {d} have more than {MAX_DATA_OBJECTS} objects, "
@@ -167,7 +170,7 @@ def cmd_export_lifted(args: argparse.Namespace) -> int:
 
 
 def cmd_export_pddl(args: argparse.Namespace) -> int:
-    from symlearn.config_file import replace_nested
+    from symlearn.config_file import built, replace_nested
     from symlearn.export.rules_export import ExportConfig, export_pddl
 
     if not args.rules:
@@ -176,7 +179,8 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
         raise ValueError("--problems writes problem folders of the lifted domain; --rules does not")
     if args.preset != "fast":
         raise ValueError(f"--preset {args.preset} chooses the lifted domain's settings; --rules takes [export] ones")
-    cfg = replace_nested(ExportConfig(), read_config_file(args.config).get("export", {}))  # [export]
+    table = read_config_file(args.config).get("export", {})  # [export]
+    cfg = built(args.config, "export", table, lambda v: replace_nested(ExportConfig(), v))
     out = folder_output(Path(args.out), "--out") if args.out else None  # before hours of enumeration
     set_threads(args.threads)
     rep = export_pddl(Path(args.run), Path(args.data[0]), cfg, out, extra_data=tuple(Path(d) for d in args.data[1:]))

@@ -25,26 +25,23 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import math
 import sys
 from pathlib import Path
 
 from symlearn.cli.args import (THREADS_HELP, TRAIN_PRESET_NAMES, add_config_flag, add_ray_flag, int_range,
                                non_negative_int, planner_list, positive_int, ray_engine, set_threads, thread_count)
-from symlearn.config_file import read_config_file
+from symlearn.config_file import MAX_TIMEOUT_S, TIMEOUT_S, built, read_config_file
 from symlearn.planning.planner_catalogue import DEFAULT_PLANNER, planners_help
 
 
-MAX_TIMEOUT_S = 86_400.0  # one day: larger values are typos, and the SAS+ planners need a finite limit
-
-
 def timeout_seconds(text: str) -> float:
-    """argparse type: a finite number of seconds in (0, MAX_TIMEOUT_S]; inf, nan, 0 and negatives are refused."""
+    """argparse type: a finite number of seconds in (0, MAX_TIMEOUT_S], the bound of [execution] timeout_s too
+    (config_file.TIMEOUT_S); inf, nan, 0 and negatives are refused."""
     try:
         v = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"timeout {text!r} is not a number of seconds") from None
-    if not (math.isfinite(v) and 0 < v <= MAX_TIMEOUT_S):
+    if not TIMEOUT_S.holds(v):
         raise argparse.ArgumentTypeError(f"timeout {text!r} must be a finite number of seconds in (0, {MAX_TIMEOUT_S:g}]")
     return v
 
@@ -53,7 +50,8 @@ def cmd_train_transition(args: argparse.Namespace) -> int:
     from symlearn.symbolic.transition_model import TransitionConfig
     from symlearn.symbolic.transition_training import train_transition
 
-    cfg = TransitionConfig.from_preset(args.preset, **read_config_file(args.config).get("transition", {}))
+    table = read_config_file(args.config).get("transition", {})  # [transition]
+    cfg = built(args.config, "transition", table, lambda v: TransitionConfig.from_preset(args.preset, **v))
     set_threads(args.threads)
     located = f", {cfg.location_bits} location bits" if cfg.location_bits else ""
     modes = f", {cfg.modes} outcome modes" if cfg.modes > 1 else ""
@@ -110,10 +108,11 @@ def cmd_problems(args: argparse.Namespace) -> int:
 
 def _cmd_walks(args: argparse.Namespace, reference: bool, on_locations: bool) -> int:
     """`problems --kind walks|located-walks|reference`: random-walk problems."""
-    from symlearn.problems.problem_generation import N_PROBLEMS, generate_problems
+    from symlearn.problems.problem_generation import N_PROBLEMS, ProblemConfig, generate_problems
 
     n, objects = args.n or N_PROBLEMS, args.objects or (1, 3)
     length, seed = args.length or (1, 4), args.seed or 0
+    ProblemConfig(objects=objects, length=length)  # --objects, --length out of bounds: one line, before any work
     per = " per cell" if reference else ""
     placed = ", goals on the table locations" if on_locations else ""
     print(f"problems: {n} problems{per}, objects {objects[0]}-{objects[1]}, length {length[0]}-{length[1]}{placed}, "
@@ -192,7 +191,8 @@ def execution_config(args: argparse.Namespace):
     from symlearn.config_file import replace_nested
     from symlearn.planning.execution import RECOMMENDED_EXECUTION
 
-    cfg = replace_nested(RECOMMENDED_EXECUTION, read_config_file(args.config).get("execution", {}))
+    table = read_config_file(args.config).get("execution", {})
+    cfg = built(args.config, "execution", table, lambda v: replace_nested(RECOMMENDED_EXECUTION, v))
     return cfg if args.timeout is None else dataclasses.replace(cfg, timeout_s=args.timeout)
 
 
@@ -234,9 +234,8 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
     # another busy process shares the cores (docs/BENCHMARKS.md): one thread a planning call, here and in Ray tasks
     set_threads(1)
     note_rule_loading(Path(args.run), list(args.planners))
-    res = benchmark(Path(args.run), args.problems, args.planners, Path(args.out), closed_loop=cfg.closed_loop,
-                    timeout_s=cfg.timeout_s, max_replans=cfg.max_replans, show_progress=True,
-                    risk_weight=cfg.risk_weight, engine=engine, workers=args.workers, address=address)
+    res = benchmark(Path(args.run), args.problems, args.planners, Path(args.out), execution=cfg, show_progress=True,
+                    engine=engine, workers=args.workers, address=address)
     print(format_table(res))
     print(format_goal_placement(res))
     print()

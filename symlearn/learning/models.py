@@ -24,6 +24,7 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
+from symlearn.config_file import Bound, check_bounds
 from symlearn.world import N_ACTIONS
 
 MAX_CODE_BITS = 16  # the longest learned code
@@ -53,6 +54,8 @@ class ModelConfig:
     action_per_object: bool = False
 
     def __post_init__(self) -> None:
+        """Refuse an architecture that cannot be built ([train.model] in a settings file): sizes, a zero divisor."""
+        check_bounds(self, MODEL_BOUNDS)
         if self.d_model % self.n_heads:
             raise ValueError(f"d_model {self.d_model} is not divisible by n_heads {self.n_heads}")
         if self.crop % (2 ** len(self.conv_channels)):
@@ -80,6 +83,13 @@ class ModelConfig:
             raise ValueError(f"unknown model config fields {sorted(unknown)}")
         return ModelConfig(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
 
+
+_SIZE = Bound(1, 65_536, integer=True)
+MODEL_BOUNDS = {"crop": Bound(1, 1024, integer=True), "conv_channels": _SIZE, "d_model": _SIZE,
+                "n_heads": Bound(1, 1024, integer=True), "n_layers": Bound(1, 256, integer=True), "ff_dim": _SIZE,
+                "dropout": Bound(0.0, 1.0, hi_open=True), "decoder_hidden": _SIZE,
+                "tau": Bound(0.0, 1000.0, lo_open=True), "depth_ref": Bound(-100.0, 100.0),
+                "depth_scale": Bound(0.0, 100.0, lo_open=True)}
 
 PRESETS = {
     "paper": ModelConfig(),

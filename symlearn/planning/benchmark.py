@@ -17,7 +17,6 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import json
-import math
 import os
 import signal
 import statistics
@@ -335,9 +334,10 @@ def load_sets(sets: Sequence[Path]) -> list[SetProblem]:
             for d in sets for path, pr in load_problems(d)]
 
 
-def _settings(run_dir: Path, sets: list[Path], problems: list[SetProblem], planners: list[str], closed_loop: bool,
-              timeout_s: float, max_replans: int, risk_weight: float = 1.0) -> dict:
-    """What a benchmark's result depends on: a partial run resumes only under the very same settings."""
+def _settings(run_dir: Path, sets: list[Path], problems: list[SetProblem], planners: list[str],
+              execution: ExecutionConfig) -> dict:
+    """What a benchmark's result depends on: a partial run resumes only under the very same settings, the whole
+    execution config among them (risk_weight only where a planner weighs risk: it changes no other result)."""
     from symlearn.planning.planners import planner_spec
     from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE
 
@@ -345,13 +345,13 @@ def _settings(run_dir: Path, sets: list[Path], problems: list[SetProblem], plann
     needs_rules = any(planner_spec(n).needs_rules for n in planners)
     folders = [str(d.resolve()) for d in sets]
     out = {"run": str(run_dir.resolve()), "problems": folders[0] if len(folders) == 1 else folders,
-           "planners": list(planners), "closed_loop": closed_loop, "timeout_s": timeout_s,
-           "max_replans": max_replans, "transition_sha256": sha256_file(run_dir / TRANSITION_FILE)[:16],
+           "planners": list(planners), **dataclasses.asdict(execution),
+           "transition_sha256": sha256_file(run_dir / TRANSITION_FILE)[:16],
            "rules_sha256": sha256_file(rules)[:16] if needs_rules else None,
            "problems_sha256": sha256_bytes(b"".join(sha256_bytes(p.path.read_bytes()).encode()
                                                     for p in problems))[:16]}
-    if any(p in RISK_PLANNERS for p in planners):  # only then does the weight change a result
-        out["risk_weight"] = risk_weight
+    if not any(p in RISK_PLANNERS for p in planners):  # only then does the weight change a result
+        del out["risk_weight"]
     if any(planner_spec(n).needs_lifted for n in planners):  # a re-export changes what they plan on
         from symlearn.export.lifted_export import LIFTED_FILE
         out["lifted_sha256"] = sha256_file(run_dir / PDDL_DIR / LIFTED_FILE)[:16]
@@ -419,14 +419,18 @@ def _current_rules(run_dir: Path, fns: dict):
     return rules
 
 
-def _run_rows(run_dir: Path, problems: list[SetProblem], fns: dict, log: RowLog, closed_loop: bool,
-              timeout_s: float, max_replans: int, show_progress: bool,
-              record_dir: Path | None = None) -> list[ProblemRun]:
+def _loops(execution: ExecutionConfig) -> list[bool]:
+    """The loops each (problem, planner) pair runs: open loop, and closed loop too where execution.closed_loop."""
+    return [False, True] if execution.closed_loop else [False]
+
+
+def _run_rows(run_dir: Path, problems: list[SetProblem], fns: dict, log: RowLog, execution: ExecutionConfig,
+              show_progress: bool, record_dir: Path | None = None) -> list[ProblemRun]:
     """Every (problem, planner, loop) row in order: finished ones from the log, the rest run and logged."""
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.learned_transition import planning_models
 
-    loops = [False, True] if closed_loop else [False]
+    loops = _loops(execution)
     todo = [(p, name, loop) for p in problems for name in fns for loop in loops if (p.key, name, loop) not in log.done]
     if todo:
         encoder, transition = planning_models(run_dir)
@@ -444,7 +448,7 @@ def _run_rows(run_dir: Path, problems: list[SetProblem], fns: dict, log: RowLog,
                     pair_loops = [loop for loop in loops if (p.key, name, loop) not in log.done]
                     if pair_loops:
                         _run_pair(sim, encoder, transition, rules, p, name, _not_killed(fns[name], name), pair_loops,
-                                  timeout_s, max_replans, record_dir, emit)
+                                  execution, record_dir, emit)
     elif show_progress:
         print(f"every row was already in {log.path}", flush=True)
     return [ProblemRun(**log.done[(p.key, name, loop)]) for p in problems for name in fns for loop in loops]
@@ -456,14 +460,14 @@ def progress_line(n_done: int, total: int, key: tuple, row: dict) -> str:
             f"len {row['plan_length']} success {row['success']}")
 
 
-def _run_pair(sim, encoder, transition, rules, p: SetProblem, name: str, fn, loops: list[bool], timeout_s: float,
-              max_replans: int, record_dir: Path | None, emit: Callable[[tuple, dict], None]) -> None:
+def _run_pair(sim, encoder, transition, rules, p: SetProblem, name: str, fn, loops: list[bool],
+              execution: ExecutionConfig, record_dir: Path | None, emit: Callable[[tuple, dict], None]) -> None:
     """The rows of one (problem, planner) pair for `loops` in order, each handed to emit(row key, row JSON) as it
-    finishes. Closed loop starts from the open loop's very plan when both run, so the two differ only by what
-    execution does."""
+    finishes; each row runs with the whole `execution` config, its closed_loop set to the row's loop. Closed loop
+    starts from the open loop's very plan when both run, so the two differ only by what execution does."""
     first_plans: dict[tuple, object] = {}  # (problem key, planner) -> the open loop's plan
     for loop in loops:
-        cfg = ExecutionConfig(closed_loop=loop, max_replans=max_replans, timeout_s=timeout_s)
+        cfg = dataclasses.replace(execution, closed_loop=loop)
         rec = None if record_dir is None or loop else PlanRecorder()
         planner = fn if loop else _first_call_kept(fn, first_plans, (p.key, name))
         row = run_problem(sim, encoder, transition, p.problem, name, planner, cfg, recorder=rec, rules=rules,
@@ -478,9 +482,8 @@ INTERRUPTED = "interrupted"  # _ray_pair's last entry when a planner was killed 
 _worker_state: dict = {}  # in a Ray worker: the loaded models, planners and simulator of the last settings seen
 
 
-def _ray_pair(settings_json: str, run_dir: str, planners: list[str], risk_weight: float, p: SetProblem, name: str,
-              loops: list[bool], timeout_s: float, max_replans: int,
-              record_dir: str | None) -> list[tuple[tuple, dict]]:
+def _ray_pair(settings_json: str, run_dir: str, planners: list[str], p: SetProblem, name: str,
+              loops: list[bool], execution: ExecutionConfig, record_dir: str | None) -> list[tuple[tuple, dict]]:
     """One (problem, planner) pair as a Ray task, on one torch thread; a worker loads the run once per settings."""
     import torch
 
@@ -493,27 +496,27 @@ def _ray_pair(settings_json: str, run_dir: str, planners: list[str], risk_weight
         if old is not None:
             old.close()
         _worker_state.clear()
-        fns = make_planners(list(planners), Path(run_dir), risk_weight=risk_weight)
+        fns = make_planners(list(planners), Path(run_dir), risk_weight=execution.risk_weight)
         encoder, transition = planning_models(Path(run_dir))
         _worker_state.update(settings=settings_json, fns=fns, encoder=encoder, transition=transition,
                              rules=_current_rules(Path(run_dir), fns), sim=TabletopSimulator())
     w, rows = _worker_state, []
     try:
         _run_pair(w["sim"], w["encoder"], w["transition"], w["rules"], p, name, _not_killed(w["fns"][name], name),
-                  loops, timeout_s, max_replans, Path(record_dir) if record_dir else None,
+                  loops, execution, Path(record_dir) if record_dir else None,
                   lambda key, row: rows.append((key, row)))
     except PlannerInterrupted as e:  # no row for it: the driver logs the rows before it, then stops (_run_rows_ray)
         rows.append((INTERRUPTED, {"signum": e.signum, "message": str(e)}))
     return rows
 
 
-def _run_rows_ray(run_dir: Path, problems: list[SetProblem], planners: list[str], risk_weight: float, settings: dict,
-                  log: RowLog, closed_loop: bool, timeout_s: float, max_replans: int, show_progress: bool,
-                  record_dir: Path | None, workers: int, address: str | None) -> None:
+def _run_rows_ray(run_dir: Path, problems: list[SetProblem], planners: list[str], settings: dict, log: RowLog,
+                  execution: ExecutionConfig, show_progress: bool, record_dir: Path | None, workers: int,
+                  address: str | None) -> None:
     """The rows the log lacks, one Ray task per (problem, planner) pair, `workers` in flight; logged as they finish."""
     from symlearn.cluster import as_finished, ray_session
 
-    loops = [False, True] if closed_loop else [False]
+    loops = _loops(execution)
     total = len(problems) * len(planners) * len(loops)
     jobs = []
     for p in problems:
@@ -521,7 +524,7 @@ def _run_rows_ray(run_dir: Path, problems: list[SetProblem], planners: list[str]
             todo = [loop for loop in loops if (p.key, name, loop) not in log.done]
             if todo:
                 jobs.append(((p.key, name), (json.dumps(settings, sort_keys=True), str(run_dir.resolve()),
-                                             list(planners), risk_weight, p, name, todo, timeout_s, max_replans,
+                                             list(planners), p, name, todo, execution,
                                              str(record_dir.resolve()) if record_dir else None)))
     if not jobs:
         if show_progress:
@@ -538,10 +541,17 @@ def _run_rows_ray(run_dir: Path, problems: list[SetProblem], planners: list[str]
 
 
 def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners: list[str], out_file: Path,
-              closed_loop: bool = False, timeout_s: float = 30.0, max_replans: int = 3,
-              show_progress: bool = True, record_dir: Path | None = None, risk_weight: float = 1.0,
-              engine: str = "local", workers: int = 1, address: str | None = None) -> dict:
+              closed_loop: bool | None = None, timeout_s: float | None = None, max_replans: int | None = None,
+              show_progress: bool = True, record_dir: Path | None = None, risk_weight: float | None = None,
+              engine: str = "local", workers: int = 1, address: str | None = None,
+              execution: ExecutionConfig | None = None) -> dict:
     """Plan and execute every problem with every planner (closed loop too if asked); write out_file.
+
+    execution: how every row is executed (ExecutionConfig(): open loop, 30 s a planner call, by default); each row
+    runs with it whole, its closed_loop False for the open-loop rows and True for the closed-loop ones, which run
+    too where execution.closed_loop. The loose closed_loop, timeout_s, max_replans and risk_weight, where given,
+    replace those fields of it (the older form of the call). The whole config is part of the settings a partial
+    run resumes under, and of the result ("execution").
 
     problems_dir is one problem folder or several (see problem_sets): with several, each row's key and
     problem name start with its set's folder name. Each finished row is appended to OUT.rows.jsonl at
@@ -561,8 +571,8 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
     if not (isinstance(workers, int) and workers >= 1) or (workers > 1 and engine != "ray"):
         raise ValueError(f"workers={workers!r}: the local engine runs rows one after another; "
                          "more workers need the ray engine (--ray)")
-    if not (isinstance(timeout_s, (int, float)) and math.isfinite(timeout_s) and timeout_s > 0):
-        raise ValueError(f"timeout {timeout_s!r} must be a finite positive number of seconds")
+    loose = dict(closed_loop=closed_loop, timeout_s=timeout_s, max_replans=max_replans, risk_weight=risk_weight)
+    execution = dataclasses.replace(execution or ExecutionConfig(), **{k: v for k, v in loose.items() if v is not None})
     run_dir, out_file = Path(run_dir), Path(out_file)
     check_outputs(out_file, record_dir)  # before any row runs
     created = not out_file.parent.exists()
@@ -570,14 +580,12 @@ def benchmark(run_dir: Path, problems_dir: str | Path | Sequence[Path], planners
     try:
         with locked(lock_path(out_file), out_file):  # a second benchmark on this --out is refused at once
             # refuses unknown names (and missing or stale rules) first
-            fns = make_planners(list(planners), run_dir, risk_weight=risk_weight)
+            fns = make_planners(list(planners), run_dir, risk_weight=execution.risk_weight)
             sets = problem_sets(problems_dir)
             problems = load_sets(sets)
-            settings = _settings(run_dir, sets, problems, list(planners), closed_loop, timeout_s, max_replans,
-                                 risk_weight)
-            return _run_and_write(run_dir, sets, problems, list(planners), fns, out_file, settings, closed_loop,
-                                  timeout_s, max_replans, show_progress, record_dir, risk_weight,
-                                  time.perf_counter(), engine, workers, address)
+            settings = _settings(run_dir, sets, problems, list(planners), execution)
+            return _run_and_write(run_dir, sets, problems, list(planners), fns, out_file, settings, execution,
+                                  show_progress, record_dir, time.perf_counter(), engine, workers, address)
     finally:
         if created:
             with contextlib.suppress(OSError):
@@ -623,24 +631,23 @@ def check_outputs(out_file: Path, record_dir: Path | None = None) -> None:
 
 
 def _run_and_write(run_dir: Path, sets: list[Path], problems: list[SetProblem], planners: list[str], fns: dict,
-                   out_file: Path, settings: dict, closed_loop: bool, timeout_s: float, max_replans: int,
-                   show_progress: bool, record_dir: Path | None, risk_weight: float, t0: float, engine: str,
-                   workers: int, address: str | None) -> dict:
+                   out_file: Path, settings: dict, execution: ExecutionConfig, show_progress: bool,
+                   record_dir: Path | None, t0: float, engine: str, workers: int, address: str | None) -> dict:
     """Run (or resume) the rows through OUT.rows.jsonl (on `engine`), then write out_file and remove the log."""
     log = RowLog(rows_path(out_file), settings)
     try:
         log.open()
         if engine == "ray":
-            _run_rows_ray(run_dir, problems, list(fns), risk_weight, settings, log, closed_loop, timeout_s,
-                          max_replans, show_progress, Path(record_dir) if record_dir else None, workers, address)
-        rows = _run_rows(run_dir, problems, fns, log, closed_loop, timeout_s, max_replans, show_progress and
-                         engine != "ray", record_dir)
+            _run_rows_ray(run_dir, problems, list(fns), settings, log, execution, show_progress,
+                          Path(record_dir) if record_dir else None, workers, address)
+        rows = _run_rows(run_dir, problems, fns, log, execution, show_progress and engine != "ray", record_dir)
     finally:
         log.close()
     result = {"run": str(run_dir), "problems": str(sets[0]) if len(sets) == 1 else [str(d) for d in sets],
-              "n_problems": len(problems), "planners": list(planners), "closed_loop": closed_loop,
-              "timeout_s": timeout_s, "max_replans": max_replans,
-              **({"risk_weight": risk_weight} if "risk_weight" in settings else {}),
+              "n_problems": len(problems), "planners": list(planners), "closed_loop": execution.closed_loop,
+              "timeout_s": execution.timeout_s, "max_replans": execution.max_replans,
+              **({"risk_weight": execution.risk_weight} if "risk_weight" in settings else {}),
+              "execution": dataclasses.asdict(execution),
               "transition_sha256": settings["transition_sha256"],
               "problems_sha256": settings["problems_sha256"],
               "versions": versions(), "wall_time_s": round(time.perf_counter() - t0, 2),

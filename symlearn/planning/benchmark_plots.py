@@ -48,12 +48,13 @@ def grid_of(result: dict) -> dict:
 def merge_results(results: list[dict], names: list[str]) -> dict:
     """One result from benchmarks of the same run and problems split by planner (e.g. run in parallel).
 
-    Refused (ValueError naming the files) when they were run on other runs, problems, time limits or
-    replan bounds, or when two of them hold the same (problem, planner, loop) row.
+    Refused (ValueError naming the files) when they were run on other runs, problems, time limits, replan bounds
+    or other execution settings, or when two of them hold the same (problem, planner, loop) row.
     """
     if len(results) == 1:
         return results[0]
-    keys = ("run", "problems", "problems_sha256", "transition_sha256", "timeout_s", "max_replans", "closed_loop")
+    keys = ("run", "problems", "problems_sha256", "transition_sha256", "timeout_s", "max_replans", "closed_loop",
+            "execution")
     for name, r in zip(names[1:], results[1:]):
         diff = [k for k in keys if r.get(k) != results[0].get(k)]
         if diff:

@@ -29,7 +29,6 @@ disagree on that step, aliasing, replans.
 """
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import asdict, dataclass, field
 from enum import Enum
@@ -40,6 +39,7 @@ import numpy as np
 from search.result import PlanResult, PlanStatus, failed
 from pddl_export.rules import RuleSet, apply_rules
 from pddl_export.symbolic import SymbolicGoal, TransitionFn, bits_from_codes
+from symlearn.config_file import MAX_TIMEOUT_S, TIMEOUT_S, Bound, check_bounds
 from symlearn.problems.problem import GOAL_TOLERANCE_M, Problem, max_goal_distance
 from symlearn.planning.recovery import Progress, Segment, recover, replanned
 from symlearn.symbolic.scenes import place_scene, symbolic_goal
@@ -81,14 +81,22 @@ class ExecutionConfig:
     risk_weight: float = 1.0
 
     def __post_init__(self) -> None:
-        if not self.tolerance_m > 0:
-            raise ValueError(f"tolerance_m={self.tolerance_m} must be positive")
-        if self.max_replans < 0 or self.max_fallbacks < 0:
-            raise ValueError(f"max_replans={self.max_replans} and max_fallbacks={self.max_fallbacks} must be >= 0")
-        if not (math.isfinite(self.timeout_s) and self.timeout_s > 0):
-            raise ValueError(f"timeout_s={self.timeout_s} must be a finite positive number of seconds")
-        if not (math.isfinite(self.risk_weight) and self.risk_weight > 0):
-            raise ValueError(f"risk_weight={self.risk_weight} must be a finite positive number")
+        """Refuse what no execution can use (the checks of [execution] in a settings file, and of --timeout)."""
+        if not TIMEOUT_S.holds(self.timeout_s):
+            raise ValueError(f"timeout_s={self.timeout_s!r} must be a finite positive number of seconds, "
+                             f"in (0, {MAX_TIMEOUT_S:g}]")
+        check_bounds(self, EXECUTION_BOUNDS)
+        for name in ("closed_loop", "keep_plan_on_failed_replan"):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f"{name}={getattr(self, name)!r} must be true or false")
+
+
+EXECUTION_BOUNDS = {
+    "tolerance_m": Bound(0.0, 1.0, lo_open=True),  # metres: the table is about a metre across
+    "max_replans": Bound(0, 1000, integer=True),
+    "max_fallbacks": Bound(0, 1000, integer=True),
+    "risk_weight": Bound(0.0, 1e6, lo_open=True),
+}
 
 
 # How plan and benchmark execute by default, the recipe's (docs/RESULTS.md): replan when the scene departs from the

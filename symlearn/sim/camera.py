@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from symlearn.config_file import Bound, check_bounds
+
 
 @dataclass(frozen=True)
 class CameraConfig:
@@ -28,10 +30,23 @@ class CameraConfig:
     near: float = 0.75
     far: float = 5.5
 
+    def __post_init__(self) -> None:
+        """Refuse a camera no view can be rendered with ([collect.sim.camera] in a settings file)."""
+        check_bounds(self, CAMERA_BOUNDS)
+        if not self.near < self.far:
+            raise ValueError(f"near={self.near!r} must be less than far={self.far!r}")
+        if tuple(self.eye) == tuple(self.target) or not any(self.up):
+            raise ValueError("eye and target must differ, and up must not be zero")
+
     @staticmethod
     def from_json(d: dict) -> "CameraConfig":
         """The camera back from its JSON form (a data manifest's settings.sim.camera); lists become tuples."""
         return CameraConfig(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
+
+
+CAMERA_BOUNDS = {"eye": Bound(-100.0, 100.0), "target": Bound(-100.0, 100.0), "up": Bound(-100.0, 100.0),
+                 "fov_deg": Bound(0.0, 180.0, lo_open=True, hi_open=True), "size": Bound(16, 4096, integer=True),
+                 "near": Bound(0.0, 100.0, lo_open=True), "far": Bound(0.0, 1000.0, lo_open=True)}
 
 
 def metric_depth(buffer: np.ndarray, cam: CameraConfig) -> np.ndarray:

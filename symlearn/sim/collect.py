@@ -34,7 +34,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from pddl_export.bounded_json import JsonFileError, read_json_file
-from symlearn.sim.data_format import DATA_KIND, FORMAT_VERSION, SPLITS, DataError, check_shard_entries
+from symlearn.sim.data_format import DATA_KIND, FORMAT_VERSION, SPLITS, DataError, check_shard_entries, shard_sha256
 from symlearn.sim.exploration import ExplorationConfig, sample_action, sample_scene_spec
 from symlearn.folder_lock import folder_lock
 from symlearn.provenance import atomic_write_bytes, atomic_write_json, sha256_file, versions
@@ -57,6 +57,10 @@ class CollectInterrupted(KeyboardInterrupt):
         self.signum = signum
 
 
+MAX_SAMPLES = 10**9  # a data set of 4 TB of crops: a larger n is a typo, and only its shard list would take memory
+MAX_SHARDS = 1_000_000  # the manifest lists every shard
+
+
 @dataclass(frozen=True)
 class CollectConfig:
     """What to collect; the paper's set is the default (12,000 samples, 10,000/1,000/1,000)."""
@@ -74,6 +78,9 @@ class CollectConfig:
             raise CollectError(f"shard_size={self.shard_size!r} must be a positive integer")
         if not _is_int(self.seed) or self.seed < 0:
             raise CollectError(f"seed={self.seed!r} must be a non-negative integer")
+        if self.n > MAX_SAMPLES or math.ceil(self.n / self.shard_size) > MAX_SHARDS:
+            raise CollectError(f"n={self.n!r} in shards of {self.shard_size!r}: at most {MAX_SAMPLES} samples in "
+                               f"at most {MAX_SHARDS} shards")
 
     @property
     def max_objects(self) -> int:
@@ -272,8 +279,11 @@ def _resume_state(out: Path, cfg: CollectConfig) -> dict[int, dict]:
     done = {}
     for d in old["shards"]:
         p = out / d["name"]
-        if p.exists() and sha256_file(p) == d["sha256"]:
-            done[int(d["index"])] = {k: v for k, v in d.items() if k != "split"}
+        try:  # a FIFO or device in a shard's place is refused at once (open_shard), not hashed forever
+            if p.exists() and shard_sha256(p) == d["sha256"]:
+                done[int(d["index"])] = {k: v for k, v in d.items() if k != "split"}
+        except DataError as e:
+            raise CollectError(f"{e}; remove it or choose another --out") from None
     return done
 
 

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from symlearn.config_file import Bound, check_bounds
 from symlearn.world import N_LOCATIONS, NEAR_ROW, Action, ObjectType
 
 MAX_OBJECTS = 8  # the largest scene the simulator builds, a problem holds and the planners take; the data sets
@@ -43,6 +44,7 @@ class ExplorationConfig:
     def __post_init__(self) -> None:
         if len(self.k_values) != len(self.k_probs) or not self.k_values:
             raise ValueError("k_values and k_probs must have the same, non-zero length")
+        check_bounds(self, {"k_probs": Bound(0.0, 1.0), "episode_lengths": Bound(1, 10_000, integer=True)})
         for k in self.k_values:
             if not (isinstance(k, (int, np.integer)) and 1 <= k <= MAX_OBJECTS):
                 raise ValueError(f"number of objects k={k!r} is out of range 1..{MAX_OBJECTS}")

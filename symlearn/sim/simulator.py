@@ -46,6 +46,7 @@ def _quiet_import_pybullet():
 
 pb = _quiet_import_pybullet()
 
+from symlearn.config_file import Bound, check_bounds
 from symlearn.sim.camera import CameraConfig, crop_origins, cut_crops, metric_depth
 from symlearn.sim.ur10_urdf import forward_kinematics, ur10_urdf
 from symlearn.world import (LOCATIONS, OBJECT_MASS, OBJECT_SIZE, TABLE_TOP_Z, Action, ObjectState,
@@ -110,8 +111,25 @@ class SimConfig:
     camera: CameraConfig = field(default_factory=CameraConfig)
 
     def __post_init__(self) -> None:
-        if self.crop <= 0 or self.crop > self.camera.size:
-            raise ValueError(f"crop size {self.crop} must be in 1..{self.camera.size}")
+        """Refuse settings the simulator cannot run with (a zero time step divides; [collect.sim] in a file)."""
+        if not Bound(1, self.camera.size, integer=True).holds(self.crop):
+            raise ValueError(f"crop size {self.crop!r} must be in 1..{self.camera.size}")
+        check_bounds(self, SIM_BOUNDS)
+        if self.min_travel_z > self.max_travel_z:
+            raise ValueError(f"min_travel_z={self.min_travel_z!r} must not exceed max_travel_z={self.max_travel_z!r}")
+
+
+_ACCEL = Bound(0.0, 1000.0, lo_open=True)  # m/s^2: each motion's duration divides by it
+SIM_BOUNDS = {
+    "time_step": Bound(1e-4, 0.1),  # seconds: every duration is divided by it into simulation steps
+    "solver_iterations": Bound(1, 1000, integer=True),
+    "accel_free": _ACCEL, "accel_loaded": _ACCEL, "accel_loaded_vertical": _ACCEL, "accel_cube": _ACCEL,
+    "min_segment_s": Bound(0.0, 10.0), "pause_s": Bound(0.0, 10.0), "settle_max_s": Bound(0.0, 60.0),
+    "min_travel_z": Bound(0.0, 2.0), "max_travel_z": Bound(0.0, 2.0), "clearance": Bound(0.0, 1.0),
+    "grasp_reach": Bound(0.0, 0.5, lo_open=True), "release_gap": Bound(0.0, 0.5),
+    "home": Bound(-10.0, 10.0), "robot_base": Bound(-10.0, 10.0),
+    "friction": Bound(0.0, 10.0), "position_gain": Bound(0.0, 10.0, lo_open=True),
+}
 
 
 @dataclass(frozen=True)

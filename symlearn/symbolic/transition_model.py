@@ -24,6 +24,7 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
+from symlearn.config_file import Bound, check_bounds
 from symlearn.learning.models import MAX_CODE_BITS
 from symlearn.symbolic.locations import LOCATION_BITS
 from symlearn.world import N_ACTIONS
@@ -52,6 +53,8 @@ class TransitionConfig:
     modes: int = 1  # whole-scene outcomes of the mixture; 1: the paper's independent bits
 
     def __post_init__(self) -> None:
+        """Refuse what cannot be built or trained ([transition] in a settings file): sizes, a zero that divides."""
+        check_bounds(self, TRANSITION_BOUNDS)
         if self.hidden % self.n_heads:
             raise ValueError(f"hidden {self.hidden} is not divisible by n_heads {self.n_heads}")
         if not (isinstance(self.code_bits, int) and 1 <= self.code_bits <= MAX_CODE_BITS):
@@ -105,6 +108,12 @@ class TransitionConfig:
             raise ValueError(f"bits={total!r} is not code_bits {cfg.code_bits} + location_bits {cfg.location_bits}")
         return cfg
 
+
+_SIZE = Bound(1, 65_536, integer=True)
+TRANSITION_BOUNDS = {"hidden": _SIZE, "n_heads": Bound(1, 1024, integer=True),
+                     "epochs": Bound(1, 1_000_000, integer=True), "batch_size": _SIZE, "encode_batch_size": _SIZE,
+                     "lr": Bound(0.0, 10.0, lo_open=True), "weight_decay": Bound(0.0, 10.0),
+                     "copy_prior": Bound(0.0, 100.0), "attention_rounds": Bound(1, 64, integer=True)}
 
 TRANSITION_PRESETS = {
     # copy_prior 3: on paper24 it raised closed-loop A* success from 0.81 to 0.91 (an early paper24 run; git history of docs/BENCHMARKS.md).
