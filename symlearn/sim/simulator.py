@@ -21,8 +21,9 @@ from __future__ import annotations
 
 import math
 import os
-import sys
+import secrets
 import signal
+import sys
 import tempfile
 import time
 from dataclasses import dataclass, field
@@ -59,19 +60,25 @@ REST_POSE = (0.0, -1.6, -1.6, 1.6, -1.57, 0.0)  # elbow up, wrist over the table
 
 
 def _load_urdf_text(text: str, base: tuple[float, float, float], client: int) -> int:
-    """Load a URDF given as text (pybullet reads files only) through a temp file that never outlives the call:
-    SIGTERM and SIGINT are held back from writing it to removing it, so a kill cannot strand it."""
+    """Load a URDF given as text (pybullet reads files only) through a temp file that never outlives the call.
+
+    SIGTERM and SIGINT are held back in this thread while the file exists. That alone is not enough where another
+    thread takes the signal (a collect worker's parent watcher): Python then runs the handler in this thread at the
+    next bytecode, which may fall inside tempfile.mkstemp, after the file is made and before its name is returned. So
+    the name is chosen first and the file made inside the try whose finally removes it."""
     held = {signal.SIGTERM, signal.SIGINT}
     old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    path = os.path.join(tempfile.gettempdir(), f"symlearn-ur10-{os.getpid()}-{secrets.token_hex(8)}.urdf")
     try:
-        fd, path = tempfile.mkstemp(suffix=".urdf", prefix="symlearn-ur10-")
-        try:
-            with os.fdopen(fd, "w") as f:
-                f.write(text)
-            return pb.loadURDF(path, base, useFixedBase=True, physicsClientId=client)
-        finally:
-            os.unlink(path)
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0), 0o600)
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
+        return pb.loadURDF(path, base, useFixedBase=True, physicsClientId=client)
     finally:
+        try:
+            os.unlink(path)
+        except FileNotFoundError:  # the signal came before the file was made
+            pass
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
