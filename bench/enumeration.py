@@ -1,9 +1,9 @@
 """Enumeration speed: (scene, action) queries per second through a run's transition network.
 
 Enumerates every multiset of 1..K codes over the first V codes of the run's exported
-vocabulary (RUN/pddl/rules.json) times the 36 actions, as `symlearn export-pddl --scenes all`
-does, once per thread count and batch size. The baseline in the same run is one network call
-per scene (36 rows), the way a search queries the network. Writes JSON.
+vocabulary (RUN/pddl/rules.json) times the 36 actions, as `symlearn export-pddl --rules` does with
+`[export] scenes = "all"` in its --config, once per thread count and batch size. The baseline in the same
+run is one network call per scene (36 rows), the way a search queries the network. Writes JSON.
 
     python bench/enumeration.py --run runs/quick32 --out bench/results/enumeration_quick32.json
 """

@@ -18,9 +18,8 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from pddl_export.bounded_json import loads_bounded  # noqa: E402
-from symlearn.provenance import atomic_write_json, bench_context  # noqa: E402
+from pddl_export.bounded_json import loads_bounded
+from symlearn.provenance import atomic_write_json, bench_context
 
 
 def rules_text(n_rules: int, seed: int = 0) -> str:

@@ -3,7 +3,7 @@
 Three ways to collect the same set (same seed and shard size, so the same bytes, which the script checks):
   local      `collect(workers=W)`: a pool of W spawned processes (today's engine)
   ray        `collect(engine="ray", workers=W)`: a local Ray of W CPUs started and shut down by the call,
-             as a one-off `symlearn collect --engine ray` on one machine pays it
+             as a one-off `symlearn collect --ray` on one machine pays it
   ray_warm   the same on a Ray already running (started before the clock), as on a cluster whose head
              outlives each collection
 Each is run `--repeats` times, interleaved, and the medians compared: ratio = ray time / local time. The

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from pddl_export.outcome_rules import load_outcomes
-from pddl_export.rules import INF, Rule, RuleSet, _dense_group, _first_overlap, apply_rules_batch
+from pddl_export.rules import INF, Rule, RuleSet, apply_rules_batch
 from pddl_export.rules_io import load_rules
 from pddl_export.symbolic import N_ACTIONS
 from symlearn.provenance import atomic_write_json, bench_context
@@ -73,16 +73,13 @@ def pairwise_int64_overlap(rules: RuleSet) -> int:
 
 
 def dense_overlap(rules: RuleSet) -> int:
-    """The exclusivity check as RuleSet runs it now (group arrays built, then compared in chunks)."""
-    n = 0
-    for a, c in rules.dense_groups:
-        group = rules.rules_for(a, c)
-        if len(group) < 2:
-            continue
-        if _first_overlap(*_dense_group(group)[1:3]) is not None:
-            raise SystemExit("dense check found overlapping rules")
-        n += 1
-    return n
+    """The exclusivity check as RuleSet runs it now (group arrays built, then compared in chunks): a fresh RuleSet
+    of the same rules, which refuses overlapping ones; returns the groups checked."""
+    try:
+        fresh = RuleSet(rules.bits, rules.vocabulary, rules.max_objects, rules.rules, rules.n_rules_before_generalization)
+    except ValueError as e:
+        raise SystemExit(f"dense check found overlapping rules: {e}") from None
+    return sum(len(fresh.rules_for(a, c)) > 1 for a, c in fresh.dense_groups)
 
 
 def batch(rules: RuleSet, n_scenes: int, seed: int) -> tuple[np.ndarray, np.ndarray]:

@@ -65,6 +65,20 @@ def groups_step(rules, dense_group, first_overlap) -> tuple[float, dict, list]:
     return time.perf_counter() - t, dense, verdicts
 
 
+def ruleset_step(rules) -> tuple[float, dict, list]:
+    """What RuleSet does on load, timed on a fresh RuleSet of the same rules (the collector paused, as rules_io
+    loads them): seconds, every group's arrays, and each group's verdict (None: RuleSet refuses overlapping rules,
+    so a built RuleSet has no overlap)."""
+    from pddl_export.rules import RuleSet
+    from pddl_export.rules_io import paused_gc
+
+    t = time.perf_counter()
+    with paused_gc():
+        fresh = RuleSet(rules.bits, rules.vocabulary, rules.max_objects, rules.rules, rules.n_rules_before_generalization)
+    took = time.perf_counter() - t
+    return took, {k: fresh.dense_groups[k] for k in sorted(fresh.dense_groups)}, [None] * len(fresh.dense_groups)
+
+
 def same_arrays(a: dict, b: dict) -> bool:
     return a.keys() == b.keys() and all(
         all(x.dtype == y.dtype and np.array_equal(x, y) for x, y in zip(a[k], b[k])) for k in a)
@@ -76,7 +90,6 @@ def main() -> int:
     ap.add_argument("--out", required=True)
     args = ap.parse_args()
     from pddl_export.outcome_rules import load_outcomes
-    from pddl_export.rules import _dense_group, _first_overlap
     from pddl_export.rules_io import load_rules
     from symlearn.provenance import atomic_write_json, bench_context
 
@@ -86,7 +99,7 @@ def main() -> int:
         loaded, model_hash = load(Path(args.run))
         load_s = time.perf_counter() - t
         rules = loaded if name == "rules" else loaded.rules
-        new_s, new_dense, new_verdicts = groups_step(rules, _dense_group, _first_overlap)
+        new_s, new_dense, new_verdicts = ruleset_step(rules)
         base_s, base_dense, base_verdicts = groups_step(rules, baseline_dense_group, baseline_first_overlap)
         if not same_arrays(new_dense, base_dense) or new_verdicts != base_verdicts:
             raise SystemExit(f"rules_load: {name}: the baseline's arrays or verdicts differ")

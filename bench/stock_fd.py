@@ -22,9 +22,6 @@ import sys
 from pathlib import Path
 
 DEFAULT_PLANNERS = ("fd-lama-first", "fd-lmcut")
-_TIMES = ("fd_translate_time_s", "fd_search_time_s", "fd_total_time_s", "fd_driver_time_s", "planner_time_s")
-_SIZES = ("translator_variables", "translator_derived_variables", "translator_uncovered_facts",
-          "translator_operators", "translator_axioms")
 
 
 def problem_files(domain: Path, specs: list[str]) -> list[Path]:
@@ -46,18 +43,6 @@ def problem_files(domain: Path, specs: list[str]) -> list[Path]:
         else:
             raise SystemExit(f"stock_fd: problem file or folder not found: {p}")
     return out
-
-
-def row(result) -> dict:
-    """One problem's record for one planner."""
-    e = dict(result.extra)
-    rec = {"status": result.status.value, "plan_length": len(result.steps) if result.found else None,
-           "plan_cost": e.get("plan_cost"), "expansions": result.expansions, "message": result.message,
-           "call_time_s": round(result.planning_time_s, 4)}
-    rec.update({k: e[k] for k in _TIMES + _SIZES if k in e})
-    if "fd_translate_time_s" in e and "fd_total_time_s" in e:
-        rec["translate_plus_search_s"] = round(e["fd_translate_time_s"] + e["fd_total_time_s"], 4)
-    return rec
 
 
 def summarize(rows: list[dict], planners: list[str]) -> dict:
@@ -96,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--planners", default=",".join(DEFAULT_PLANNERS), help="search.stock_planners names")
     ap.add_argument("--timeout", type=float, default=10.0, help="seconds per call (translate + search)")
     args = ap.parse_args(argv)
-    from search.stock_planners import STOCK_PLANNERS, solve_files
+    from search.stock_planners import STOCK_PLANNERS, call_record, solve_files
     from symlearn.provenance import atomic_write_json, bench_context, sha256_file
 
     try:
@@ -126,7 +111,7 @@ def main(argv: list[str] | None = None) -> int:
             continue
         rec = {"problem": str(problem), "sha256": digest, "planners": {}}
         for name in planners:
-            rec["planners"][name] = row(solve_files(args.domain, problem, name, args.timeout))
+            rec["planners"][name] = call_record(solve_files(args.domain, problem, name, args.timeout))
         rows.append(rec)
         print(f"{problem.name}: " + ", ".join(f"{n} {r['status']} {r['call_time_s']:.2f}s"
                                              for n, r in rec["planners"].items()), flush=True)

@@ -1,4 +1,6 @@
-"""The bench scripts that stay: the symbol purity analysis (bench/symbol_purity.py) and the baselines of the speed benches."""
+"""bench/ holds speed benchmarks on public names only; experiments/ the studies that chose settings. Here: the
+baselines of the speed benches, the symbol purity analysis (experiments/symbol_purity.py) and the held-out check."""
+import ast
 import importlib.util
 import json
 import shutil
@@ -7,25 +9,64 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-BENCH = Path(__file__).resolve().parent.parent / "bench"
+ROOT = Path(__file__).resolve().parent.parent
+BENCH, EXPERIMENTS = ROOT / "bench", ROOT / "experiments"
 
 
-def _load(name):
-    spec = importlib.util.spec_from_file_location(name, BENCH / f"{name}.py")
+def _load(name, folder=BENCH):
+    spec = importlib.util.spec_from_file_location(name, folder / f"{name}.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     return mod
 
 
+def import_problems(script: Path) -> list[str]:
+    """What in a script's imports bench/ does not allow: a private name, a sibling script, or sys.path edited."""
+    siblings = {p.stem for p in script.parent.glob("*.py")}
+    out = []
+    for node in ast.walk(ast.parse(script.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom):
+            out += [f"private name {node.module}.{a.name}" for a in node.names if a.name.startswith("_")
+                    and a.name != "annotations"]
+            modules = [node.module or ""]
+        elif isinstance(node, ast.Import):
+            modules = [a.name for a in node.names]
+        else:
+            modules = []
+        out += [f"sibling script {m}" for m in modules if m.split(".")[0] in siblings]
+        if isinstance(node, ast.Attribute) and node.attr == "path" and getattr(node.value, "id", "") == "sys":
+            out.append(f"sys.path at line {node.lineno}")
+    return out
+
+
+def test_bench_holds_speed_benchmarks_importing_public_names_only():
+    scripts = sorted(BENCH.glob("*.py"))
+    assert len(scripts) >= 10 and not list(BENCH.glob("*.sh"))
+    assert {p.name: import_problems(p) for p in scripts if import_problems(p)} == {}
+    # the studies that chose settings live in experiments/, one line each in its README
+    readme = (EXPERIMENTS / "README.md").read_text(encoding="utf-8")
+    studies = sorted(p.name for p in EXPERIMENTS.iterdir() if p.suffix in (".py", ".sh"))
+    assert studies and all(f"`{name}`" in readme for name in studies), studies
+    assert not set(studies) & {p.name for p in scripts}
+
+
+def test_the_import_check_finds_what_it_forbids(tmp_path):
+    (tmp_path / "helper.py").write_text("")
+    bad = tmp_path / "bad.py"
+    bad.write_text("import sys\nsys.path.insert(0, '.')\nfrom helper import x\nfrom pddl_export.rules import _first_overlap\n")
+    assert sorted(import_problems(bad)) == ["private name pddl_export.rules._first_overlap", "sibling script helper",
+                                            "sys.path at line 2"]
+
+
 def test_majority_share_counts_the_most_common_value_per_key():
-    sp = _load("symbol_purity")
+    sp = _load("symbol_purity", EXPERIMENTS)
     keys, values = np.array([1, 1, 1, 2, 2]), np.array([7, 7, 8, 9, 9])
     assert sp.majority_share(keys, values) == pytest.approx(4 / 5)  # key 1: 2 of 3 agree; key 2: both
     assert sp.majority_share(values, keys) == 1.0  # each value has one key
 
 
 def test_symbol_purity_on_a_trained_run(tiny_run):
-    sp = _load("symbol_purity")
+    sp = _load("symbol_purity", EXPERIMENTS)
     r = sp.purity(tiny_run.path, tiny_run.data, n_shift=8)
     assert r["objects"] > 0 and 1 <= r["distinct_codes"] <= r["objects"]
     for k in ("type_purity", "location_purity", "level_purity", "arrangement_purity", "arrangement_determinism"):
@@ -36,34 +77,31 @@ def test_symbol_purity_on_a_trained_run(tiny_run):
 
 
 def test_the_baselines_of_the_speed_benches_answer_as_the_code_they_time():
-    """bench/rule_successors_memo.py's dense comparison and bench/sas_body.py's brute-force cells are the
-    baselines their speedups are measured against: they must give what the faster code gives."""
+    """bench/rule_successors_memo.py's dense comparison is the baseline its speedup is measured against: it must
+    give what the faster code gives."""
     import itertools
 
     from pddl_export.rule_successors import RuleSuccessors
-    from pddl_export.sas_writer import satisfying_cells
     from tests.test_overrides import VOCAB, random_rules
 
-    memo, body = _load("rule_successors_memo"), _load("sas_body")
+    memo = _load("rule_successors_memo")
     rules = random_rules(np.random.default_rng(1), n=25)
     succ = RuleSuccessors(rules)
     states = np.array(list(itertools.product(VOCAB, repeat=3)), np.int64)
     assert np.array_equal(memo.dense_successors(succ, states), succ(states))
     assert not np.array_equal(memo.dense_successors(succ, states), np.repeat(states[:, None], len(succ.actions), 1))
-    for intervals, k in [(((0, 1), (1, 3)), 3), (((2, 9),), 2), ((), 2), (((0, 0),), 1)]:
-        assert body.brute_force_cells(intervals, k) == satisfying_cells(intervals, k)
 
 
 def test_the_rules_load_baseline_builds_and_checks_groups_as_ruleset_does():
     """bench/rules_load.py times RuleSet's group arrays and exclusivity check against the earlier per-entry
     arrays and every-pair comparison: on random rules both must give the same arrays, and the same verdicts on
     exclusive groups and on a group made to overlap."""
-    from pddl_export.rules import _dense_group, _first_overlap
+    from pddl_export.rules import _first_overlap
     from tests.test_overrides import random_rules
 
     load = _load("rules_load")
     rules = random_rules(np.random.default_rng(4), n=40)
-    new = load.groups_step(rules, _dense_group, _first_overlap)
+    new = load.ruleset_step(rules)
     base = load.groups_step(rules, load.baseline_dense_group, load.baseline_first_overlap)
     assert load.same_arrays(new[1], base[1]) and new[2] == base[2]
     assert any(len(rules.rules_for(*k)) > 1 for k in rules.dense_groups) and set(new[2]) == {None}
@@ -75,11 +113,12 @@ def test_the_rules_load_baseline_builds_and_checks_groups_as_ruleset_does():
     assert _first_overlap(lo, hi) == load.baseline_first_overlap(lo, hi) == (0, 1)
 
 
-def test_heldout_accuracy_interval_and_refusals(tmp_path):
-    """bench/heldout_accuracy.py: the paired interval brackets the mean difference and narrows with more steps;
+def test_heldout_accuracy_interval_and_refusals(tmp_path, monkeypatch):
+    """experiments/heldout_accuracy.py: the paired interval brackets the mean difference and narrows with more steps;
     a held-out set that made the rules (the same folder, or a copy of it) or no data set at all is refused in
     one line before any model is read."""
-    ho = _load("heldout_accuracy")
+    monkeypatch.syspath_prepend(str(EXPERIMENTS))  # as `python experiments/heldout_accuracy.py` has it
+    ho = _load("heldout_accuracy", EXPERIMENTS)
     rng = np.random.default_rng(0)
     net = rng.random(4000) < 0.7
     mine = np.where(rng.random(4000) < 0.1, ~net, net)  # flips a tenth of the steps either way

@@ -20,8 +20,8 @@ from search.stock_planners import STOCK_PLANNERS
 from symlearn.planning.planners import PLANNERS
 
 ROOT = Path(__file__).resolve().parents[1]
-DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
-STARTS = ("symlearn ", "python bench/")
+DOCS = [ROOT / "experiments" / "README.md", ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+STARTS = ("symlearn ", "python bench/", "python experiments/")
 
 
 def doc_commands(text: str) -> list[str]:
@@ -112,7 +112,7 @@ def test_every_documented_command_is_accepted(doc):
     ("symlearn train --data D --out R --preset huge", "--preset huge: not one of"),
     ("symlearn train --data D --out R --epoch 3", "unknown flag --epoch"),
     ("symlearn teach --run R", "no sub-command 'teach'"),
-    ("python bench/sas_body.py --run R --objects 2,3 --max-objects 4", "unknown flag --max-objects"),
+    ("python bench/stock_fd.py --domain D --problems P --floor --out x.json", "unknown flag --floor"),
     ("python bench/no_such_script.py --out x.json", "no script bench/no_such_script.py"),
 ])
 def test_the_check_refuses_what_the_code_would(command, expected):
@@ -124,5 +124,5 @@ def test_the_check_accepts_placeholders_and_fragments():
     for command in ("symlearn problems --kind {walks,structures} [--n 4]",
                     "symlearn train-transition --run COPY --config C.toml --seed S",
                     "symlearn benchmark --run COPY --problems A,B --planners P --timeout 10",
-                    "python bench/sas_body.py --run COPY --objects 2,3,4,5 --baseline-max-objects 4 --out x.json"):
+                    "python bench/stock_fd.py --domain D --problems A,B --planners fd-lama-first --out x.json"):
         assert command_problems(command, subs) == [], command

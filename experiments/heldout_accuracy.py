@@ -8,27 +8,24 @@ of it beside m(z), and gives the difference with a paired bootstrap 95% interval
 rules make of a step (`step_checks`, which `check_lifted` tallies).
 
     symlearn collect --out data/k15h2 --n 12000 --objects 1-5 --workers 2 --seed 102
-    python bench/heldout_accuracy.py --run RUN --data data/paper_a data/k15 --heldout data/k15h2 \
+    python experiments/heldout_accuracy.py --run RUN --data data/paper_a data/k15 --heldout data/k15h2 \
         --setting fast=min_count:50,rider_min_count:3 --setting m20r6=min_count:20,rider_min_count:6 \
         --setting accurate=min_count:30,pair_min_count:10,pool_min_count:20,pool_classes:cube,pool_structure_min:12,end_min_count:6 \
         --out bench/results/heldout_k15h2.json
 
-A setting is NAME=FIELD:VALUE,... over LiftedConfig's fields, as in bench/preset_sweep.py; empty: the defaults
+A setting is NAME=FIELD:VALUE,... over LiftedConfig's fields, as in experiments/preset_sweep.py; empty: the defaults
 (min count 20, rider moves 6 since 2026-12-06: `m20r6` above; `fast` there is the earlier default).
 """
 from __future__ import annotations
 
 import argparse
 import dataclasses
-import sys
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from preset_sweep import parse_settings  # noqa: E402  (NAME=FIELD:VALUE,... -> LiftedConfig)
+from preset_sweep import parse_settings  # experiments/preset_sweep.py, beside this script (NAME=FIELD:VALUE,...)
 
 SPLITS = ("train", "val", "test")
 GROUPS = (("all", lambda k: k > 0), ("1-3", lambda k: k <= 3), ("4-5", lambda k: k >= 4))

@@ -13,7 +13,7 @@ of that trade. This script puts any settings beside them, on one reading of the 
   same problems): not a domain to plan with, a measure of what the stick schemas cost the translator.
 
     symlearn export-pddl ... (once, for the run's data), then
-    python bench/preset_sweep.py --run RUN --data data/paper_a data/k15 --problems problems/dev \
+    python experiments/preset_sweep.py --run RUN --data data/paper_a data/k15 --problems problems/dev \
         --setting fast= --setting accurate=pool_min_count:20,end_min_count:6,pair_min_count:8 \
         --setting cubes20=pool_min_count:20,pool_classes:cube,pool_structure_min:20 --probe-sticks \
         --out bench/results/preset_sweep_dev.json
@@ -28,12 +28,9 @@ import dataclasses
 import hashlib
 import json
 import statistics
-import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from stock_fd import row  # noqa: E402  (one call's record, as stock_fd.py writes it)
+from search.stock_planners import call_record
 
 STICK_PROBE = "{}-without-sticks"
 
@@ -146,7 +143,7 @@ def solve_all(problems, forms: dict, texts: dict, reader, planner: str, timeout:
     """Every form (forms: name -> rules; texts: name -> (domain, static facts)) on every problem the calls do not
     hold yet, the order rotated from problem to problem; each call appended to calls, checkpoint() after each
     problem."""
-    from pddl_export.lifted_writer import problem_pddl
+    from pddl_export.lifted_problem import problem_pddl
     from search.stock_planners import solve_texts
     from symlearn.sim.simulator import TabletopSimulator
     from symlearn.symbolic.scenes import scene_codes, symbolic_goal
@@ -164,7 +161,7 @@ def solve_all(problems, forms: dict, texts: dict, reader, planner: str, timeout:
             for form in todo[shift:] + todo[:shift]:  # the order rotates from problem to problem
                 domain, statics = texts[form]
                 text = problem_pddl(forms[form], start, goal, f"p{n + 1:02d}", statics=statics)
-                rec = row(solve_texts(domain, text, planner, timeout))
+                rec = call_record(solve_texts(domain, text, planner, timeout))
                 calls.append({"problem": path.name, "objects": problem.k, "form": form,
                               **{k: rec.get(k) for k in ("status", "translate_plus_search_s", "fd_translate_time_s",
                                                          "translator_operators", "call_time_s")}})
@@ -192,7 +189,8 @@ def main(argv: list[str] | None = None) -> int:
 
     from pddl_export.bounded_json import read_json_file
     from pddl_export.files import sha256_file
-    from pddl_export.lifted_writer import domain_pddl, moves, schemas, static_facts
+    from pddl_export.lifted_domain import domain_pddl, schemas, static_facts
+    from pddl_export.lifted_moves import moves
     from symlearn.export.lifted_export import check_lifted, distil_rules, network_steps, split_codes, \
         training_moves
     from symlearn.problems.problem import load_problems

@@ -5,7 +5,7 @@ scene; the check holds when every judged object ends within 2 cm of its goal pos
 longer than the reference plan (when there is one). tests/test_shortest.py does the same on a few small
 problems; this script covers sets (e.g. problems/dev) and writes the counts, the misses and the time as JSON.
 
-    python bench/shortest_check.py --problems problems/dev --out bench/results/shortest_check_dev.json
+    python experiments/shortest_check.py --problems problems/dev --out bench/results/shortest_check_dev.json
 """
 from __future__ import annotations
 

@@ -9,18 +9,15 @@ gives it, the medians of both and their ratio.
     # the shipped test folder against the same export without `stands` (each fact is one line of a problem)
     mkdir -p base && git show be6739b:pretrained/recommended/pddl/lifted/domain.pddl > base/domain.pddl
     for f in RUN/pddl/lifted/test/p*.pddl; do grep -v '(stands ' "$f" > base/$(basename "$f"); done
-    python bench/domain_ab.py --a base --b RUN/pddl/lifted/test --out bench/results/stands_ab.json
+    python experiments/domain_ab.py --a base --b RUN/pddl/lifted/test --out bench/results/stands_ab.json
 """
 from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from stock_fd import row  # noqa: E402  (one problem's record, as stock_fd.py writes it)
+from search.stock_planners import call_record
 
 
 def _problems(folder: Path) -> list[str]:
@@ -59,7 +56,7 @@ def main(argv: list[str] | None = None) -> int:
         for name in names:
             for form in (("a", "b") if rep % 2 == 0 else ("b", "a")):
                 folder = args.a if form == "a" else args.b
-                rec = row(solve_files(folder / "domain.pddl", folder / f"{name}.pddl", args.planner,
+                rec = call_record(solve_files(folder / "domain.pddl", folder / f"{name}.pddl", args.planner,
                                       timeout_s=args.timeout))
                 calls.append({"problem": name, "form": form, "repeat": rep, "objects": objects.get(name),
                               **{k: rec.get(k) for k in ("status", "translate_plus_search_s", "call_time_s")}})

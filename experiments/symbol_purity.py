@@ -8,7 +8,7 @@ the same arrangement always gets the same symbol. Also: how many codes change wh
 by 1-2 pixels (placement jitter), and, where the run has m(z), how often it gets the held object's next code
 right, against how often the most common next code for the same (code, release location) is the observed one.
 
-    python bench/symbol_purity.py --runs pretrained/quick-authors12k,RUN2 --data data/paper_a --out bench/results/symbol_purity.json
+    python experiments/symbol_purity.py --runs pretrained/quick-authors12k,RUN2 --data data/paper_a --out bench/results/symbol_purity.json
 """
 from __future__ import annotations
 

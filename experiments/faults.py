@@ -6,7 +6,7 @@ docs/RELIABILITY.md: a one-line refusal naming the problem and the file, or a cl
 process, temp file or half-written output left. This script runs them (pytest, JUnit XML) and
 writes the tally per suite: tried, held, failed.
 
-    python bench/faults.py --out bench/results/faults.json
+    python experiments/faults.py --out bench/results/faults.json
 """
 from __future__ import annotations
 
@@ -17,8 +17,7 @@ import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from symlearn.provenance import atomic_write_json, bench_context  # noqa: E402
+from symlearn.provenance import atomic_write_json, bench_context
 
 ROOT = Path(__file__).resolve().parents[1]
 

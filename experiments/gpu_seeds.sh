@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The runs behind docs/RESULTS.md: the paper-size data set with the authors' protocol, then the paper and quick
 # presets over seeds (and their no-attention baselines) trained in parallel on one GPU machine, each evaluated.
-# Usage: DEST=out bash bench/gpu_seeds.sh      (N, EPOCHS_PAPER, EPOCHS_QUICK, WORKERS, TRAIN_LIMIT override)
+# Usage: DEST=out bash experiments/gpu_seeds.sh      (N, EPOCHS_PAPER, EPOCHS_QUICK, WORKERS, TRAIN_LIMIT override)
 set -u
 DEST=${DEST:?set DEST to the output folder}
 N=${N:-12000}; WORKERS=${WORKERS:-16}; TRAIN_LIMIT=${TRAIN_LIMIT:-420}
