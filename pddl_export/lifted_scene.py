@@ -1,12 +1,12 @@
 """Located codes read as a scene of pieces: which object stands where, on what, and what is on top of each location.
 
-A located code (`symlearn train-transition --location-bits 9`) is the effect model's learned bits followed by
-three fields read from geometry: the nearest table location (3 bits; 7 when nothing of the object is visible),
-its place (3 bits; 0 when it stands on the location, else which way and how far off), and the height of its top
-above the table in 5 cm layers (3 bits). Of the learned bits, some track where the crop lies in the image (the
-encoder sees each pixel's image x and y) and so repeat the location; the others say what the object is and
-how it stands. A `CodeLayout` names the learned bits a lifted domain keeps (`kept`: those that do not track the
-location, chosen from data by `position_bits`).
+A located code (9 location bits: `symlearn train-transition --preset recommended`, the default) is the effect
+model's learned bits followed by three fields read from geometry: the nearest table location (3 bits; 7 when
+nothing of the object is visible), its place (3 bits; 0 when it stands on the location, else which way and how far
+off), and the height of its top above the table in 5 cm layers (3 bits). Of the learned bits, some track where the
+crop lies in the image (the encoder sees each pixel's image x and y) and so repeat the location; the others say
+what the object is and how it stands. A `CodeLayout` names the learned bits a lifted domain keeps (`kept`: those
+that do not track the location, chosen from data by `position_bits`).
 
 `read_scene` turns one state's codes into `Piece`s and the relations a lifted domain plans with: the top of
 every location (a far-row stick's ends cover its row neighbours) and what each on-location piece stands on.
@@ -24,11 +24,11 @@ from typing import Sequence
 
 import numpy as np
 
+from pddl_export.location_codec import FIELD_BITS, decode_location
+
 N_LOCATIONS = 6
 FAR_ROW = (0, 1, 2)
 NEAR_ROW = (3, 4, 5)
-FIELD_BITS = 9  # the location bits a lifted domain reads: location (3), place (3), level (3)
-UNSEEN = 7  # the location field of an object with no visible pixel
 SIZE_LAYERS = {False: 2, True: 1}  # a cube is two 5 cm layers tall, a stick lying flat one
 
 
@@ -59,7 +59,7 @@ class CodeLayout:
 
     def learned(self, code: int) -> int:
         """The learned part of a located code."""
-        return int(code) >> FIELD_BITS
+        return decode_location(int(code))[0]
 
     def kind(self, code: int) -> int:
         """The kept learned bits of a code, packed in `kept` order (the first kept bit most significant)."""
@@ -85,8 +85,8 @@ class CodeLayout:
         code = int(code)
         if not 0 <= code < (1 << self.bits):
             raise ValueError(f"code {code} does not fit in {self.bits} bits")
-        return Piece(kind=self.kind(code), stick=bool(stick), loc=(code >> 6) & 7, place=(code >> 3) & 7,
-                     level=code & 7)
+        _, (loc, place, level) = decode_location(code)
+        return Piece(kind=self.kind(code), stick=bool(stick), loc=loc, place=place, level=level)
 
 
 @dataclass(frozen=True)
@@ -95,7 +95,7 @@ class Piece:
 
     kind: int
     stick: bool
-    loc: int  # 0-5, or UNSEEN
+    loc: int  # 0-5, or location_codec.UNSEEN
     place: int  # 0: on the location; else off it
     level: int  # top above the table, 5 cm layers
 

@@ -151,8 +151,8 @@ def test_a_failed_write_leaves_the_old_domain_and_lifted_json_together(run, tiny
     assert leftovers == []
     monkeypatch.setattr(os, "fsync", real_fsync)
     export_lifted(run, tiny_data.path, cfg=LiftedConfig(min_count=1))  # the same export, written whole
-    from pddl_export.lifted_rules import load_lifted
-    from pddl_export.lifted_writer import domain_pddl
+    from pddl_export.lifted_rules_io import load_lifted
+    from pddl_export.lifted_domain import domain_pddl
     assert files[0].read_text() == domain_pddl(load_lifted(files[1])) and files[0].read_bytes() != before[0]
 
 
@@ -206,8 +206,8 @@ def _first(d: dict, riders: bool = False) -> dict:
                                             "support": 7, "share": 0.7, "cases": []}]), "end_rules[0].place"),
 ])
 def test_out_of_range_lifted_json_values_are_refused_naming_the_file_and_field(tmp_path, change, field):
-    from pddl_export.lifted_rules import load_lifted
-    from pddl_export.lifted_writer import domain_pddl
+    from pddl_export.lifted_rules_io import load_lifted
+    from pddl_export.lifted_domain import domain_pddl
 
     path = _mutated(tmp_path / "lifted.json", change)
     with pytest.raises(ValueError) as e:
@@ -218,7 +218,7 @@ def test_out_of_range_lifted_json_values_are_refused_naming_the_file_and_field(t
 
 def _small_rules():
     """The shipped rules cut to a few, so that the pddl package parses each domain in a moment."""
-    from pddl_export.lifted_rules import load_lifted
+    from pddl_export.lifted_rules_io import load_lifted
     rules = load_lifted(LIFTED)
     return dataclasses.replace(rules, rules=tuple(r for r in rules.rules if r.pool is None)[:6], end_rules=())
 
@@ -258,21 +258,21 @@ def _parsed_or_refused(make, n_actions: int | None = None) -> str:
 
 @pytest.mark.parametrize("hostile", HOSTILE, ids=range(len(HOSTILE)))
 def test_hostile_strings_are_refused_or_written_as_valid_names(tmp_path, hostile):
-    from pddl_export import lifted_writer, pddl_writer
-    from pddl_export.lifted_rules import load_lifted
+    from pddl_export import lifted_domain, lifted_problem, lifted_vocabulary, pddl_writer
+    from pddl_export.lifted_rules_io import load_lifted
     from pddl_export.rules import Rule, RuleSet
 
     rules = _small_rules()
     start, goal = _scene(rules)
-    n = len(lifted_writer.schemas(rules))
+    n = len(lifted_domain.schemas(rules))
     # lifted: the model hash (in memory, and from lifted.json), the problem name, an object's index
     evil = dataclasses.replace(rules, model_hash=hostile)
     outcomes = {
-        "hash": _parsed_or_refused(lambda: (lifted_writer.domain_pddl(evil),
-                                            lifted_writer.problem_pddl(evil, start, goal, "p01")), n),
-        "problem": _parsed_or_refused(lambda: (lifted_writer.problem_pddl(rules, start, goal, hostile),)),
+        "hash": _parsed_or_refused(lambda: (lifted_domain.domain_pddl(evil),
+                                            lifted_problem.problem_pddl(evil, start, goal, "p01")), n),
+        "problem": _parsed_or_refused(lambda: (lifted_problem.problem_pddl(rules, start, goal, hostile),)),
         "object": _parsed_or_refused(lambda: (f"(define (problem p) (:domain d) (:objects "
-                                              f"{lifted_writer.object_name(hostile)}) (:init) (:goal (and)))",)),
+                                              f"{lifted_vocabulary.object_name(hostile)}) (:init) (:goal (and)))",)),
     }
     for field, change in (("model_hash", lambda d: d.__setitem__("model_hash", hostile)),
                           ("cls", lambda d: _first(d)["key"][0].__setitem__(1, hostile)),
@@ -282,7 +282,7 @@ def test_hostile_strings_are_refused_or_written_as_valid_names(tmp_path, hostile
 
         def from_file():
             loaded = dataclasses.replace(load_lifted(path), rules=rules.rules)
-            return lifted_writer.domain_pddl(loaded), lifted_writer.problem_pddl(loaded, start, goal, "p01")
+            return lifted_domain.domain_pddl(loaded), lifted_problem.problem_pddl(loaded, start, goal, "p01")
         outcomes[f"lifted.json {field}"] = _parsed_or_refused(from_file, n)
     # rules over whole codes: the model hash (a comment), the domain and problem names, an object's index
     rs = RuleSet(bits=2, vocabulary=(1, 2), max_objects=2, n_rules_before_generalization=1,

@@ -15,12 +15,14 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from pddl_export.lifted_rules import REFINEMENTS, LiftedRules, distil_lifted, key_of, load_lifted, observed_moves, \
-    participants, stick_reader
+from pddl_export.lifted_distil import distil_lifted
+from pddl_export.lifted_domain import PICK_CUBE, domain_pddl, schemas
+from pddl_export.lifted_plans import plan_actions, plan_decoder
+from pddl_export.lifted_problem import _rests_fact, problem_pddl
+from pddl_export.lifted_rules import REFINEMENTS, LiftedRules, key_of, observed_moves, participants, stick_reader
+from pddl_export.lifted_rules_io import load_lifted
 from pddl_export.lifted_scene import CodeLayout, Piece, kept_bits, read_scene
-from pddl_export.lifted_writer import PICK_CUBE, domain_pddl, layer_names, negated_bits, object_name, plan_actions, \
-    plan_decoder, problem_pddl, schemas
-from pddl_export.lifted_writer import _rests_fact
+from pddl_export.lifted_vocabulary import layer_names, negated_bits, object_name
 from pddl_export.symbolic import SymbolicGoal
 from symlearn.problems.stacking import act, drop_all
 from symlearn.world import ObjectType
@@ -181,7 +183,8 @@ def test_the_domain_is_small_plain_strips(world_rules):
 def test_far_row_moves_that_differ_only_in_their_locations_are_one_schema(world_rules, costs):
     """merged_pairs: each pair move stands in exactly one schema (its own, or a merged one whose static facts name
     its pick and release locations), and the plan decoder reads a merged step's locations back."""
-    from pddl_export.lifted_writer import PAIR_MOVE, merged_pairs, moves, static_facts
+    from pddl_export.lifted_domain import PAIR_MOVE, merged_pairs, static_facts
+    from pddl_export.lifted_moves import moves
     whole = moves(world_rules, costs)
     merged = merged_pairs(whole)
     joined = [s for s in merged if s.name.startswith(PAIR_MOVE)]
@@ -204,7 +207,7 @@ def test_far_row_moves_that_differ_only_in_their_locations_are_one_schema(world_
 
 def test_rules_that_write_the_same_action_write_it_once(world_rules):
     """Rules whose keys differ only in what the PDDL leaves unsaid give one schema, which names the others."""
-    from pddl_export.lifted_writer import moves, rule_schema
+    from pddl_export.lifted_moves import moves, rule_schema
     written = moves(world_rules)
     bodies = [(s.params, s.pre, s.eff) for s in written]
     assert len(set(bodies)) == len(bodies)
@@ -532,7 +535,8 @@ def test_a_whole_goal_says_what_each_block_rests_on_and_a_top_no_move_reaches_is
 def test_a_move_that_cannot_state_occupancy_leaves_it_out_of_the_whole_domain(pre, eff):
     """Where a move may leave two blocks at one place, or keep a block where it stood, `vacant` would forbid what
     the rules allow: that move states none (_occupancy gives None) and `schemas` writes no occupancy at all."""
-    from pddl_export.lifted_writer import Schema, _occupancy
+    from pddl_export.lifted_domain import _occupancy
+    from pddl_export.lifted_vocabulary import Schema
     params = (("?o", "block"), ("?to", "location"), ("?r0", "block"), ("?h", "layer"), ("?new", "layer"))
     assert _occupancy(Schema("m", None, None, "  ; m\n  (:action m\n", params, pre, eff)) is None
     plain = _occupancy(Schema("m", None, None, "  ; m\n  (:action m\n", params,
@@ -652,7 +656,7 @@ def test_export_lifted_and_plan_with_stock_fast_downward_on_a_tiny_run(tiny_run_
                                              str(tmp_path / "cost_tasks" / "problem.pddl"),
                                              str(tmp_path / "cost_plan.txt"))
     assert verdict.status == "VALID"
-    # one reading of the training moves (bench/preset_sweep.py distils several settings from it), distilled under
+    # one reading of the training moves (experiments/preset_sweep.py distils several settings from it), distilled under
     # the export's setting, gives the exported rules; a setting of another source cannot reuse it
     from symlearn.export.lifted_export import LiftedConfig, distil_rules, training_moves
     reader, transition = planning_models(run)
@@ -710,7 +714,7 @@ def test_a_rule_keeps_its_outcome_share_and_the_cost_form_plans_on_its_alternati
     goal and the alternative where only it does; the planner's predictions follow the outcome each step chose."""
     import pyval
 
-    from pddl_export.lifted_writer import outcome_cost
+    from pddl_export.lifted_moves import outcome_cost
     from search.stock_planners import solve_texts
     from symlearn.planning.lifted_planner import LiftedPlanner
     before, actions, after, mask, stick = _arrays(world_moves(300, seed=0))
@@ -870,7 +874,8 @@ def test_rarer_structures_take_their_pools_change_and_reproduce_the_world(tmp_pa
     ends 2 levels above it, a stick 1): exact on held-out moves of the world, one schema per pool whose static
     facts list its structures, and back through JSON; a pool whose rules disagree is refused."""
     import json
-    from pddl_export.lifted_writer import moves, static_facts
+    from pddl_export.lifted_domain import static_facts
+    from pddl_export.lifted_moves import moves
     rules = _distil(world_moves(1500, seed=0), min_count=60, pool_min_count=10, pool_structure_min=2)
     plain = _distil(world_moves(1500, seed=0), min_count=60)
     pooled = [r for r in rules.rules if r.pool is not None]

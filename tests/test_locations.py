@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 from conftest import cli, cli_json, recomputed_transition_accuracy, write_config
+from pddl_export.location_codec import UNSEEN
 from pddl_export.symbolic import bits_from_codes
 from symlearn.sim.camera import CameraConfig, crop_centres_xy, crop_tops_z
-from symlearn.symbolic.locations import UNSEEN, location_bits
+from symlearn.symbolic.locations import location_bits
 from symlearn.world import LOCATIONS, TABLE_TOP_Z, ObjectState, ObjectType, Scene
 
 CUBE_Z = TABLE_TOP_Z + 0.05

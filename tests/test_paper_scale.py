@@ -33,11 +33,11 @@ def test_paper_preset_pipeline_meets_the_papers_figures(tmp_path):
     documented (test bit accuracy 0.96-0.97, one-step scene accuracy 0.64-0.73), rules exact on every enumerated
     case of up to 3 objects, and the learned-net A* solving most of the 20 benchmark problems in simulation
     (0.82-0.86 open loop in docs/BENCHMARKS.md, on 100 problems)."""
-    from symlearn.pipeline import STAGE_NAMES
+    from symlearn.pipeline_presets import PRESETS
 
     out = tmp_path / "pipe"
     text = _paper_pipeline(out)
-    for name in STAGE_NAMES:
+    for name in PRESETS["paper"].stage_names:
         assert f"{name} ... done in" in text, name
     data, run = out / "data", out / "run"
 

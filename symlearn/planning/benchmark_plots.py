@@ -13,8 +13,8 @@ import math
 from pathlib import Path
 
 from pddl_export.bounded_json import JsonFileError, MiB, read_json_file
-from symlearn.planning.benchmark import (LENGTH_BUCKETS, LOOPS, SHORTEST_BUCKETS, summary_failure_causes,
-                                         summary_grid, summary_shortest_grid, summary_tasks)
+from symlearn.planning.benchmark_summary import (LENGTH_BUCKETS, LOOPS, SHORTEST_BUCKETS, summary_failure_causes,
+                                                 summary_grid, summary_shortest_grid, summary_tasks)
 from symlearn.planning.execution import ProblemRun
 from symlearn.provenance import atomic_write_png
 

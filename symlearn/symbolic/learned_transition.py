@@ -5,7 +5,7 @@
     array([[ 3, 19]])
 
 A* (search.learned_astar) and the PDDL export call it; `scored` adds how likely each prediction is
-(the most-likely-plan planner, `astar-likely`, charges it), and `bit_probabilities` gives every bit's
+(the outcome planners, `astar-outcomes`, charge it), and `bit_probabilities` gives every bit's
 probability, from which `astar-outcomes` draws the other likely outcomes of an action; a mixture m(z)
 (`modes` > 1) gives them whole through `mode_outcomes`.
 """

@@ -11,6 +11,7 @@ from pathlib import Path
 import torch
 
 from pddl_export.bounded_json import loads_bounded
+from symlearn.learning.checkpoint import BlobKind, guarded_blob
 from symlearn.provenance import atomic_write_bytes
 from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet
 
@@ -21,6 +22,10 @@ TRANSITION_FILE = "transition.pt"
 
 class TransitionError(ValueError):
     """A transition checkpoint that is missing, foreign, of another format or another effect model."""
+
+
+TRANSITION_MODEL = BlobKind(TRANSITION_KIND, TRANSITION_FORMAT, "transition-model", "transition",
+                            "no transition model at {path}; run 'symlearn train-transition' first", TransitionError)
 
 
 def save_transition(path: Path, net: TransitionNet, meta: dict) -> None:
@@ -35,20 +40,7 @@ def save_transition(path: Path, net: TransitionNet, meta: dict) -> None:
 def load_transition(path: Path, expect_config: TransitionConfig | None = None) -> tuple[TransitionNet, dict]:
     """The transition network (eval mode) and its meta record; refuses foreign or mismatched files."""
     path = Path(path)
-    if not path.exists():
-        raise TransitionError(f"no transition model at {path}; run 'symlearn train-transition' first")
-    if not path.is_file():  # a FIFO would block torch.load, a device would be read without end
-        raise TransitionError(f"{path} is not a regular file")
-    try:
-        blob = torch.load(path, map_location="cpu", weights_only=True)
-    except Exception as e:  # torch raises several types for foreign or truncated files
-        raise TransitionError(f"{path} is not a readable checkpoint "
-                              f"({type(e).__name__}: {str(e).splitlines()[0][:120] if str(e) else ''})") from None
-    if not isinstance(blob, dict) or blob.get("kind") != TRANSITION_KIND:
-        raise TransitionError(f"{path} is not a symlearn transition-model checkpoint")
-    if blob.get("format_version") != TRANSITION_FORMAT:
-        raise TransitionError(f"{path} has transition format {blob.get('format_version')!r}, "
-                              f"expected {TRANSITION_FORMAT}")
+    blob = guarded_blob(path, TRANSITION_MODEL)
     try:
         cfg = TransitionConfig.from_json(loads_bounded(blob["config"], "field 'config'"))
         meta = loads_bounded(blob["meta"], "field 'meta'")

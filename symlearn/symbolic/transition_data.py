@@ -13,12 +13,13 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
+from pddl_export.location_codec import LOCATION_BITS
 from pddl_export.symbolic import codes_from_bits
 from symlearn.data.dataset import InteractionData
 from symlearn.data.model_input import model_inputs
 from symlearn.learning.models import AttentiveDeepSym
 from symlearn.sim.camera import CameraConfig, crop_centres_xy, crop_tops_z
-from symlearn.symbolic.locations import HEIGHTED_BITS, LOCATION_BITS, location_bits
+from symlearn.symbolic.locations import HEIGHTED_BITS, location_bits
 
 
 @dataclass(frozen=True)
@@ -84,7 +85,7 @@ class SymbolReader:
 
     model: AttentiveDeepSym
     camera: CameraConfig | None = None  # the camera the crops were rendered with; needed with location bits
-    location_bits: int = 0  # 0: the learned code alone; else one of locations.LOCATION_BITS
+    location_bits: int = 0  # 0: the learned code alone; else one of location_codec.LOCATION_BITS
 
     def __post_init__(self) -> None:
         if self.location_bits not in (0, *LOCATION_BITS) or (self.location_bits > 0) != (self.camera is not None):

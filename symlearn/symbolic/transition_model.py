@@ -24,9 +24,9 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
-from symlearn.config_file import Bound, check_bounds
+from pddl_export.location_codec import LOCATION_BITS
+from symlearn.config_file import RECIPE, Bound, check_bounds
 from symlearn.learning.models import MAX_CODE_BITS
-from symlearn.symbolic.locations import LOCATION_BITS
 from symlearn.world import N_ACTIONS
 
 # An 8-bit learned code and 9 location bits make 17; the rule searches hold (objects, 2**bits) tables, 8 MB at 20.
@@ -79,8 +79,9 @@ class TransitionConfig:
         return self.code_bits + self.location_bits
 
     @staticmethod
-    def from_preset(name: str, **overrides) -> "TransitionConfig":
-        """A named preset with optional field overrides."""
+    def from_preset(name: str = RECIPE, **overrides) -> "TransitionConfig":
+        """A named preset (TRANSITION_PRESETS; by default the recipe's, what `symlearn train-transition` and the
+        recommended pipeline train) with optional field overrides."""
         if name not in TRANSITION_PRESETS:
             raise ValueError(f"unknown preset {name!r}; known: {', '.join(TRANSITION_PRESETS)}")
         return dataclasses.replace(TRANSITION_PRESETS[name], **overrides)
