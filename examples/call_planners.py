@@ -12,26 +12,22 @@ import argparse
 import tempfile
 from pathlib import Path
 
-from pddl_export.rules_io import RULES_FILE
 from pddl_export.symbolic import SymbolicGoal, code_str
 from symlearn.planning.execution import safe_plan
-from symlearn.export.lifted_export import LIFTED_FILE
-from symlearn.planning.planner_catalogue import FAMILIES
 from symlearn.planning.planners import PLANNERS, make_planners
+from symlearn.planning.run_folder import Run
 from symlearn.problems.problem import load_problem
 from symlearn.symbolic.scenes import scene_codes, symbolic_goal
 from symlearn.sim.simulator import TabletopSimulator
-from symlearn.symbolic.learned_transition import planning_models
 from symlearn.world import decode_action
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def supported(run: Path) -> list[str]:
-    """The planners whose inputs the run holds, in the order of their families."""
-    has_rules, has_lifted = (run / "pddl" / RULES_FILE).is_file(), (run / "pddl" / LIFTED_FILE).is_file()
-    names = [n for _, family, _ in FAMILIES for n in family]
-    return [n for n in names if (has_rules or not PLANNERS[n].needs_rules) and (has_lifted or not PLANNERS[n].needs_lifted)]
+    """The planners whose inputs the run holds, in the registry's order (by family)."""
+    has_rules, has_lifted = Run(run).rules_file.is_file(), Run(run).lifted_file.is_file()
+    return [n for n in PLANNERS if (has_rules or not PLANNERS[n].needs_rules) and (has_lifted or not PLANNERS[n].needs_lifted)]
 
 
 def main() -> None:
@@ -43,7 +39,7 @@ def main() -> None:
     run = Path(args.run)
     problem = load_problem(Path(args.problem) if args.problem else run / "problems" / "tower_of_two.json")
     names = supported(run)
-    reader, transition = planning_models(run)
+    reader, transition = Run(run).planning_models()
     with TabletopSimulator() as sim:
         goal = symbolic_goal(sim, reader, problem)
         start = scene_codes(sim, reader, problem.initial)

@@ -4,14 +4,14 @@
     python examples/compare_planners.py --run RUN --problems DIR --out OUT --planners P,Q [--timeout S]
 
 By default: the learned-net searches and stock Fast Downward on the lifted domain, on the shipped run of the
-recommended recipe and its four example problems (about a minute on 2 cores). The run is copied into OUT first:
-planners write their task files into the run they plan with.
+recommended recipe and its four example problems (about a minute on 2 cores). The run is only read: OUT holds
+everything written.
 """
 import argparse
-import shutil
 from pathlib import Path
 
-from symlearn.planning.benchmark import benchmark, format_table
+from symlearn.planning.benchmark import benchmark
+from symlearn.planning.benchmark_summary import format_table
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_PLANNERS = "astar-outcomes,astar,fast-downward-lifted,fast-downward-lifted-opt"
@@ -21,16 +21,13 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--run", default=str(ROOT / "pretrained" / "recommended"))
     ap.add_argument("--problems", help="problem folder (default RUN/problems)")
-    ap.add_argument("--out", default="compare", help="output folder: run copy, benchmark.json, table.txt, plot")
+    ap.add_argument("--out", default="compare", help="output folder: benchmark.json, table.txt, plot")
     ap.add_argument("--planners", default=DEFAULT_PLANNERS)
     ap.add_argument("--timeout", type=float, default=10.0)
     args = ap.parse_args()
-    src, out = Path(args.run), Path(args.out)
-    problems = Path(args.problems) if args.problems else src / "problems"
+    run, out = Path(args.run), Path(args.out)
+    problems = Path(args.problems) if args.problems else run / "problems"
     out.mkdir(parents=True, exist_ok=True)
-    run = out / "run"
-    if not run.exists():
-        shutil.copytree(src, run)
     planners = args.planners.split(",")
     res = benchmark(run, problems, planners, out / "benchmark.json", closed_loop=True, timeout_s=args.timeout,
                     show_progress=False)

@@ -12,7 +12,7 @@ import re
 from pathlib import Path
 
 from symlearn.export.lifted_export import COST_FORM_DIR, check_problem_folder, write_problem_folder
-from symlearn.planning.planners import load_run_lifted
+from symlearn.planning.run_folder import Run
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -35,7 +35,7 @@ def write_and_show() -> None:
     run, out = Path(args.run), Path(args.out)
     problems = Path(args.problems) if args.problems else run / "problems"
     check_problem_folder(out, "--out")  # before any work: a folder of other files is refused
-    rules = load_run_lifted(run)  # refused if exported from another transition.pt than the run's
+    rules = Run(run).lifted()  # refused if exported from another transition.pt than the run's
     index = write_problem_folder(run, problems, out, rules=rules)
     domain = (out / "domain.pddl").read_text()
     print(f"domain {out / 'domain.pddl'}: {len(domain) / 1000:.0f} KB, {domain.count('(:action ')} typed STRIPS "

@@ -24,8 +24,8 @@ def test_generate_domain_writes_the_runs_lifted_domain_and_problems_a_parser_loa
     folder = tmp_path / "lifted_domain"
     assert (folder / "domain.pddl").read_text() == (RECOMMENDED / "pddl" / "lifted" / "domain.pddl").read_text()
     domain = parse_domain(folder / "domain.pddl")
-    from pddl_export.lifted_rules import load_lifted
-    from pddl_export.lifted_writer import schemas
+    from pddl_export.lifted_rules_io import load_lifted
+    from pddl_export.lifted_domain import schemas
     n = len(schemas(load_lifted(RECOMMENDED / "pddl" / "lifted.json")))  # one per distinct action of the rules
     assert n == json.loads((RECOMMENDED / "pddl" / "lifted.json").read_text())["stats"]["n_schemas"]
     assert len(domain.actions) == n and f"{n} typed STRIPS schemas" in out
@@ -39,7 +39,7 @@ def test_generate_domain_writes_the_runs_lifted_domain_and_problems_a_parser_loa
     costed = parse_domain(folder / index["cost_form"])  # the all-outcomes cost form: one action per outcome
     alternatives = sum(len(r["alternatives"]) for r in json.loads((RECOMMENDED / "pddl" / "lifted.json").read_text())[
         "rules"])
-    from pddl_export.lifted_writer import moves
+    from pddl_export.lifted_moves import moves
     rules = load_lifted(RECOMMENDED / "pddl" / "lifted.json")  # each outcome one action at most; merged far-row
     assert len(costed.actions) == len(schemas(rules, costs=True))  # moves of one cost are one schema in either form
     assert n < len(costed.actions) <= 1 + len(moves(rules)) + alternatives
@@ -55,7 +55,7 @@ def test_call_planners_solves_the_tower_with_every_planner_the_run_supports(tmp_
     out = _example("call_planners.py", tmp_path)
     rows = {line.split()[0]: line.split() for line in out.splitlines()[4:] if line.strip()}
     # the shipped run has m(z) and the lifted domain, no rules.json: the learned net and stock Fast Downward
-    assert set(rows) == {"astar-outcomes", "astar", "astar-likely", "astar-ucs", "fast-downward-lifted",
+    assert set(rows) == {"astar-outcomes", "astar", "astar-ucs", "fast-downward-lifted",
                          "fast-downward-lifted-opt", "fast-downward-lifted-outcomes"}
     for name, cells in rows.items():  # every planner plans it; none in fewer actions than the tower's shortest, 2
         assert cells[1] == "solved" and int(cells[3]) >= 2, (name, cells)

@@ -59,21 +59,48 @@ def save_checkpoint(path: Path, *, model, optimizer=None, epoch: int = 0, best_v
     atomic_write_bytes(Path(path), buf.getvalue())
 
 
-def load_checkpoint(path: Path, expect_config: ModelConfig | None = None) -> Checkpoint:
-    """A checkpoint file's record; refuses missing, foreign, other-format, malformed or other-config files."""
+@dataclass(frozen=True)
+class BlobKind:
+    """One kind of checkpoint file a run holds, as guarded_blob checks it and names it in its one-line refusals."""
+
+    tag: str  # the file's "kind" field, e.g. "symlearn-effect-model"
+    version: int  # the one "format_version" read
+    noun: str  # what a foreign file is said not to be, e.g. "effect-model"
+    format_name: str  # "checkpoint format 2, expected 1"
+    missing: str  # the refusal of a missing file, with {path}
+    error: type[ValueError]
+
+
+EFFECT_MODEL = BlobKind(CHECKPOINT_KIND, CHECKPOINT_FORMAT, "effect-model", "checkpoint",
+                        "no checkpoint at {path}; train a model first ('symlearn train')", CheckpointError)
+
+
+def guarded_blob(path: Path, kind: BlobKind) -> dict:
+    """The dict a run's checkpoint file holds (best.pt, last.pt, transition.pt), read with weights_only=True (no
+    pickle) after the checks every such file gets: a missing file, one that is not a regular file (a FIFO would
+    block torch.load), a foreign, truncated or other-format file are each refused with one line of kind.error.
+    The one loader of them: each kind only reads its fields from the blob."""
     path = Path(path)
     if not path.exists():
-        raise CheckpointError(f"no checkpoint at {path}; train a model first ('symlearn train')")
-    if not path.is_file():  # a FIFO would block torch.load, a device would be read without end
-        raise CheckpointError(f"{path} is not a regular file")
+        raise kind.error(kind.missing.format(path=path))
+    if not path.is_file():
+        raise kind.error(f"{path} is not a regular file")
     try:
         blob = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as e:  # torch raises several types for foreign, empty or truncated files
-        raise CheckpointError(f"{path} is not a readable checkpoint ({_first_line(e)})") from None
-    if not isinstance(blob, dict) or blob.get("kind") != CHECKPOINT_KIND:
-        raise CheckpointError(f"{path} is not a symlearn effect-model checkpoint")
-    if blob.get("format_version") != CHECKPOINT_FORMAT:
-        raise CheckpointError(f"{path} has checkpoint format {blob.get('format_version')!r}, expected {CHECKPOINT_FORMAT}")
+        raise kind.error(f"{path} is not a readable checkpoint ({_first_line(e)})") from None
+    if not isinstance(blob, dict) or blob.get("kind") != kind.tag:
+        raise kind.error(f"{path} is not a symlearn {kind.noun} checkpoint")
+    if blob.get("format_version") != kind.version:
+        raise kind.error(f"{path} has {kind.format_name} format {blob.get('format_version')!r}, "
+                         f"expected {kind.version}")
+    return blob
+
+
+def load_checkpoint(path: Path, expect_config: ModelConfig | None = None) -> Checkpoint:
+    """A checkpoint file's record; refuses missing, foreign, other-format, malformed or other-config files."""
+    path = Path(path)
+    blob = guarded_blob(path, EFFECT_MODEL)
     try:
         ck = _record(blob)
     except (KeyError, TypeError, ValueError, AttributeError, json.JSONDecodeError) as e:

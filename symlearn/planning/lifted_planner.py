@@ -1,13 +1,13 @@
 """Stock planners on the lifted domain (RUN/pddl/lifted/domain.pddl), as planner functions of the registry.
 
-Each call writes the problem for the start and goal codes (pddl_export.lifted_writer.problem_pddl) and runs the
+Each call writes the problem for the start and goal codes (pddl_export.lifted_problem.problem_pddl) and runs the
 stock Fast Downward driver on domain.pddl and problem.pddl with its own translator (search.stock_planners), as a
 user outside the project would; the ground plan is read back as robot actions. Its predictions are the lifted
 rules rolled along the plan (pddl_export.lifted_rules.LiftedRules.step_codes), so closed-loop execution sees
 departures as it does for the other planners; where an object's predicted fields are its goal's, its predicted
 code is the goal's code.
 
-With `costs`, the planner reads the domain's cost form (pddl_export.lifted_writer: one action per outcome of each
+With `costs`, the planner reads the domain's cost form (pddl_export.lifted_moves: one action per outcome of each
 rule, costing by how often m(z) answered it) and its predictions follow the outcome each step of the plan chose.
 
     >>> plan = LiftedPlanner(load_lifted(run / "pddl/lifted.json"), "fast-downward-lifted", "fd-lama-first")  # doctest: +SKIP
@@ -21,8 +21,11 @@ from pathlib import Path
 import numpy as np
 
 from pddl_export.files import atomic_write_text
+from pddl_export.lifted_domain import domain_pddl, static_facts
+from pddl_export.lifted_moves import moves
+from pddl_export.lifted_plans import plan_decoder
+from pddl_export.lifted_problem import problem_pddl
 from pddl_export.lifted_rules import LiftedRules, LiftedTransition
-from pddl_export.lifted_writer import domain_pddl, moves, plan_decoder, problem_pddl, static_facts
 from pddl_export.symbolic import SymbolicGoal, TransitionFn
 from search.result import PlanResult, PlanStatus, failed
 from search.stock_planners import solve_texts
