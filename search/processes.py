@@ -311,5 +311,19 @@ def within(fn: Callable[[], Any], seconds: float) -> Any:
     return result
 
 
+MEMORY_LIMIT_MB = 4096  # a planner process's address space, by default
+
+
+def limit_memory(pid: int, mb: int) -> None:
+    """Cap the address space of a started process (after the start, so Python can vfork); a no-op off Linux or
+    once it has ended."""
+    try:
+        import resource
+
+        resource.prlimit(pid, resource.RLIMIT_AS, (mb << 20, mb << 20))
+    except (ImportError, AttributeError, OSError, ProcessLookupError):  # not Linux, or it already ended
+        pass
+
+
 atexit.register(cleanup)
 os.register_at_fork(after_in_child=_drop_inherited_watchdog)

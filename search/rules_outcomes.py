@@ -91,7 +91,7 @@ def plan_rules_outcomes(
     """A* from start codes (K,) to goal over the rules' step and one-object second outcomes (module doc).
 
     costs: the extra -log P of each alternative (OutcomeRules.alternative_costs).
-    batch: states popped per successor call, as in rules-astar; with batch > 1 a costlier plan popped in
+    batch: states popped per successor call, as in plan_rules' A*; with batch > 1 a costlier plan popped in
     the same batch as a cheaper one's last state may be returned (batch=1: plain A*, one state per pop).
     """
     t0 = time.perf_counter()

@@ -1,6 +1,6 @@
 """Search over the exported rules in process: batched A* and layered breadth-first search.
 
-The classical planners read the rules as a PDDL or SAS+ task in a new process per call, and on
+The classical planners read the rules as a PDDL task in a new process per call, and on
 4-5-object scenes that start and the task's 10^4-10^5 conditional effects cost more than the
 search. Here the rules are compiled once (pddl_export.rule_successors.RuleSuccessors) and
 expanded in batches: "astar" is the generic A* (search.astar), popping `batch` states per

@@ -12,7 +12,7 @@ in a symlearn-stock-* folder that holds the planner's files (output.sas, sas_pla
 pyperplan needs); the wall-clock limit covers the whole call, translation or grounding
 included. At the limit the group is killed and the folder removed, and both go on a kill of
 this process, SIGKILL included (search.processes and its watchdog). The address space is capped at
-MEMORY_LIMIT_MB as for the SAS+ planners: through the driver's own --overall-memory-limit for
+MEMORY_LIMIT_MB (search.processes): through the driver's own --overall-memory-limit for
 Fast Downward, on the process for pyperplan; the driver also gets its own --overall-time-limit
 (CPU time, a second past the call's limit), so it stops even with nobody left to kill it.
 
@@ -41,9 +41,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence
 
-from search.processes import external_signal, planner_guard, run_group, temp_dir
+from search.processes import MEMORY_LIMIT_MB, external_signal, limit_memory, planner_guard, run_group, temp_dir
 from search.result import PlanResult, PlanStatus, failed
-from search.sas_planners import MEMORY_LIMIT_MB, _limit_memory
 
 MAX_INPUT_BYTES = 64 << 20  # a domain or problem file larger than this is refused before any work
 MAX_PLAN_BYTES = 16 << 20  # a plan file larger than this is an ERROR (bounded read)
@@ -295,7 +294,7 @@ def _solve_in(tmp: Path, domain: Path, problem: Path, planner: str, timeout_s: f
         return failed(planner, PlanStatus.ERROR, t0, args)
     if left <= 0:
         return failed(planner, PlanStatus.TIMEOUT, t0, f"time limit of {timeout_s:g} s reached before planning")
-    limit = None if spec.tool == "fast-downward" or not memory_mb else (lambda pid: _limit_memory(pid, memory_mb))
+    limit = None if spec.tool == "fast-downward" or not memory_mb else (lambda pid: limit_memory(pid, memory_mb))
     t1 = time.perf_counter()
     try:
         code, out, err, timed_out = run_group(args, "", left, cwd=tmp, after_start=limit)
@@ -365,4 +364,23 @@ def solve_texts(domain_text: str, problem_text: str, planner: str, timeout_s: fl
                          memory_mb)
 
 
-__all__ = ["STOCK_PLANNERS", "StockPlanner", "fast_downward_driver", "solve_files", "solve_texts"]
+_RECORD_KEYS = ("fd_translate_time_s", "fd_search_time_s", "fd_total_time_s", "fd_driver_time_s", "planner_time_s",
+                "translator_variables", "translator_derived_variables", "translator_uncovered_facts",
+                "translator_operators", "translator_axioms")
+
+
+def call_record(result: PlanResult) -> dict:
+    """One stock call as a flat JSON record: status, plan length and cost, expansions, the whole call's time, Fast
+    Downward's own clocks and task sizes where it reported them, and translate + search (what bench/stock_fd.py and
+    the domain studies in experiments/ compare)."""
+    extra = dict(result.extra)
+    rec = {"status": result.status.value, "plan_length": len(result.steps) if result.found else None,
+           "plan_cost": extra.get("plan_cost"), "expansions": result.expansions, "message": result.message,
+           "call_time_s": round(result.planning_time_s, 4)}
+    rec.update({k: extra[k] for k in _RECORD_KEYS if k in extra})
+    if "fd_translate_time_s" in extra and "fd_total_time_s" in extra:
+        rec["translate_plus_search_s"] = round(extra["fd_translate_time_s"] + extra["fd_total_time_s"], 4)
+    return rec
+
+
+__all__ = ["STOCK_PLANNERS", "StockPlanner", "call_record", "fast_downward_driver", "solve_files", "solve_texts"]

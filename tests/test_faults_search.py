@@ -23,7 +23,6 @@ import pytest
 from pddl_export.rules_io import load_rules
 from search.classical import PLANNERS, solve_pddl
 from search.result import PlanStatus
-from search.sas_planners import search_binary, solve_sas
 from test_classical import STICK_CARRIES_RIDER, UNCOVER_TWICE, _conditional, _strips, rules  # noqa: F401 - fixture
 
 REPO = Path(__file__).resolve().parent.parent
@@ -85,22 +84,6 @@ def _fake_planner(tmp: Path) -> Path:
 
 
 # ------------------------------------------------------------------------------- driver scripts
-
-SAS_DRIVER = """
-import sys
-sys.path[:0] = [{repo!r}, {tests!r}]
-import signal
-signal.signal(signal.SIGINT, signal.default_int_handler)  # as in a foreground shell: a background one ignores SIGINT
-from pathlib import Path
-import search.sas_planners as sp
-from pddl_export.enumeration import enumerate_transitions
-from pddl_export.distil import distil_rules
-from pddl_export.sas_writer import SASEncoder
-from test_pddl_export import FAR, NEAR, UNDER, TOY_VOCAB, ToyRobot
-rules = distil_rules(enumerate_transitions(ToyRobot(), TOY_VOCAB, max_objects=2))
-sp.search_binary = lambda package="": Path({fake!r})
-print(sp.solve_sas(SASEncoder(rules), [UNDER, FAR], [NEAR, NEAR], "symk-sas", {timeout}).to_json(), flush=True)
-"""
 
 UP_DRIVER = """
 import sys
@@ -168,14 +151,6 @@ def _kill_and_check(proc: subprocess.Popen, pids_file: Path, tmpdir: Path, sig: 
 # ------------------------------------------------------------------------------- 1. kills
 
 
-@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
-def test_killed_sas_call_leaves_no_planner_and_no_temp_folder(tmp_path, sig):
-    fake = _fake_planner(tmp_path)
-    src = SAS_DRIVER.format(repo=str(REPO), tests=str(REPO / "tests"), fake=str(fake), timeout=60)
-    proc, pids, tmpdir = _start_driver(src, tmp_path)
-    _kill_and_check(proc, pids, tmpdir, sig)
-
-
 @pytest.mark.parametrize("planner, sig", [("fast-downward", signal.SIGTERM), ("symk", signal.SIGTERM),
                                           ("fast-downward", signal.SIGINT)])
 def test_killed_up_call_leaves_no_planner_and_no_temp_folder(tmp_path, planner, sig):
@@ -206,22 +181,6 @@ def test_killed_pyperplan_call_leaves_no_worker(tmp_path):
 
 
 # ------------------------------------------------------------------------------- 1./2. time limits
-
-
-def test_sas_timeout_kills_the_whole_group(tmp_path, monkeypatch, rules):  # noqa: F811
-    from pddl_export.sas_writer import SASEncoder
-
-    fake = _fake_planner(tmp_path)
-    monkeypatch.setenv("FAKE_PIDS", str(tmp_path / "pids"))
-    monkeypatch.setattr("search.sas_planners.search_binary", lambda package="": fake)
-    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
-    t0 = time.perf_counter()
-    res = solve_sas(SASEncoder(rules), UNCOVER_TWICE.init, UNCOVER_TWICE.goal, "symk-sas", 1.0)
-    elapsed = time.perf_counter() - t0
-    assert res.status is PlanStatus.TIMEOUT and "time limit" in res.message
-    assert elapsed < 1.0 + 2.0
-    assert _wait_dead([int(x) for x in (tmp_path / "pids").read_text().split()][::2]) == []
-    assert not list(tmp_path.glob("symlearn-fd-*"))
 
 
 def _up_installed(planner: str) -> bool:
@@ -322,4 +281,3 @@ def test_search_subprocess_calls_take_argument_lists_and_limits():
                 if owner in ("os", "subprocess"):
                     allowed = {("processes.py", "Popen"), ("classical.py", "Popen")}
                     assert (py.name, node.attr) in allowed, f"{py.name}:{node.lineno} calls {owner}.{node.attr}"
-    assert search_binary("no_such_package") is None

@@ -2,7 +2,7 @@
 
 Checked by enumeration: every state of K objects over a small vocabulary, every action with rules,
 before and after overriding random rule sets with random observations; and by planning on the
-overridden rules (SAS+ task and conditional PDDL) around a disproven step.
+overridden rules (conditional PDDL, blind A*: shortest plans) around a disproven step.
 """
 from __future__ import annotations
 
@@ -15,11 +15,9 @@ import pytest
 from pddl_export.overrides import box_difference, observed_cases, override_rules, override_rules_info
 from pddl_export.pddl_writer import conditional_domain, problem_pddl
 from pddl_export.rules import INF, Rule, RuleSet, apply_rules, apply_rules_batch
-from pddl_export.sas_writer import SASEncoder
 from pddl_export.symbolic import SymbolicGoal
 from search.classical import solve_pddl
 from search.result import PlanStatus
-from search.sas_planners import search_binary, solve_sas
 
 VOCAB = (0, 1, 2, 3)
 ACTIONS = (4, 17)
@@ -124,20 +122,21 @@ def _replay(rules, init, plan):
     return states
 
 
-@pytest.mark.skipif(search_binary("up_fast_downward") is None, reason="up-fast-downward is not installed")
-def test_sas_and_pddl_plans_follow_the_overrides():
+def _solve(rules: RuleSet, init: list[int], goal: SymbolicGoal):
+    return solve_pddl(conditional_domain(rules, "h"), problem_pddl(rules, init, goal, "h"), "fast-downward-blind",
+                      timeout_s=20)
+
+
+def test_pddl_plans_follow_the_overrides():
     fixed = override_rules(DETOUR, DISPROVEN)
     goal = SymbolicGoal((3, None))
     assert apply_rules(fixed, (1, 0), 4).tolist() == [1, 0] and apply_rules(fixed, (1, 2), 4).tolist() == [3, 2]
-    before = solve_sas(SASEncoder(DETOUR), [1, 0], goal, "fast-downward-sas-opt", timeout_s=20)
+    before = _solve(DETOUR, [1, 0], goal)
     assert before.status is PlanStatus.SOLVED and before.plan == (4,)
-    sas = solve_sas(SASEncoder(fixed), [1, 0], goal, "fast-downward-sas-opt", timeout_s=20)
-    assert sas.status is PlanStatus.SOLVED and sas.plan == (17, 17), sas.message
-    assert sas.predicted_states == tuple(_replay(fixed, (1, 0), sas.plan))
-    pddl = solve_pddl(conditional_domain(fixed, "h"), problem_pddl(fixed, [1, 0], goal, "h"), "fast-downward-blind",
-                      timeout_s=20)
+    pddl = _solve(fixed, [1, 0], goal)
     assert pddl.status is PlanStatus.SOLVED and pddl.plan == (17, 17), pddl.message
     states = _replay(fixed, (1, 0), pddl.plan)
     assert goal.satisfied(np.array(states[-1]))[0] and (4 not in pddl.plan)
-    elsewhere = solve_sas(SASEncoder(fixed), [1, 2], goal, "fast-downward-sas-opt", timeout_s=20)
+    assert pddl.predicted_states == tuple(states)
+    elsewhere = _solve(fixed, [1, 2], goal)
     assert elsewhere.plan == (4,)  # with a 2 beside it, action 4 was never disproven

@@ -187,7 +187,7 @@ def test_astar_batches_and_drops_dead_ends():
         astar("a", lambda s: s == "c", graph.__getitem__, lambda s: 0.0, max_expansions=10, timeout_s=1, batch=2)
 
 
-@pytest.mark.parametrize("name", ["rules-astar", "rules-bfs"])
+@pytest.mark.parametrize("name", ["rules-bfs"])
 def test_in_process_planners_follow_observed_overrides(name):
     plan = make_planner(name, PlannerContext(rules=DETOUR, model_hash="h"))
     goal = SymbolicGoal((3, None))
