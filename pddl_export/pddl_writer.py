@@ -31,7 +31,7 @@ says which planner takes which):
   `pick-P-release-R-sN` (N = the state's index) whose precondition is the full joint
   assignment and whose effect changes exactly the objects that change. Objects are domain
   constants; only :strips and :typing are needed, so every planner (pyperplan,
-  fast-downward-opt) takes it. Its size grows with the reachable state space. The task also
+  Fast Downward) takes it. Its size grows with the reachable state space. The task also
   carries its states and edges, from which search.up_problem.strips_problem builds the same
   problem for unified-planning without its PDDL reader.
 

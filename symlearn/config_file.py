@@ -48,9 +48,13 @@ TABLES: Mapping[str, str] = types.MappingProxyType({
     "lifted": "symlearn.export.lifted_export:LiftedConfig",
     "problems": "symlearn.problems.problem_generation:ProblemConfig",
     "execution": "symlearn.planning.execution:ExecutionConfig",
+    "planner": "symlearn.planning.planner_catalogue:PlannerConfig",
 })
 # fields a file may not set: what the command line or the stage itself decides (the preset names the base config)
 NOT_SETTABLE = frozenset({"preset"})
+# the recipe's name in every stage's preset table that has one (TRAIN_PRESETS, TRANSITION_PRESETS,
+# EXECUTION_PRESETS, the pipeline's PRESETS): what the commands, the library and the pipeline use by default
+RECIPE = "recommended"
 
 Settings = dict[str, dict[str, Any]]
 
@@ -209,7 +213,7 @@ def flat_overrides(values: Mapping[str, Any]) -> dict[str, Any]:
 # What a number setting may hold, shared by the configs' own checks (`__post_init__`) and the flags that set the same
 # field, so that a flag and a key are refused alike.
 
-MAX_TIMEOUT_S = 86_400.0  # one day: larger values are typos, and the SAS+ planners need a finite limit
+MAX_TIMEOUT_S = 86_400.0  # one day: larger values are typos, and every planner process needs a finite limit
 
 
 @dataclass(frozen=True)

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from conftest import cli
-from symlearn.planning.benchmark import (length_bucket, load_sets, problem_sets, summary_failure_causes,
-                                         summary_grid, summary_tasks)
+from symlearn.planning.benchmark_rows import load_sets, problem_sets
+from symlearn.planning.benchmark_summary import length_bucket, summary_failure_causes, summary_grid, summary_tasks
 from symlearn.planning.benchmark_plots import (DPI, PANEL_IN, PLOT_FILES, format_grid, grid_of,
                                                markdown_grid, write_plots)
 from symlearn.planning.execution import ProblemRun
@@ -49,8 +49,8 @@ ROWS = [
     _row("astar", 2, 3, success=False, t=0.2, length=3, cause=None, task="tower-2"),
     _row("astar", 2, 4, success=True, t=0.4, length=4, task="tower-2"),
     # another planner, one cell
-    _row("symk-sas", 4, 7, success=False, t=20.0, length=7, cause="departure"),
-    _row("symk-sas", 4, 8, success=True, t=30.0, length=8),
+    _row("fast-downward-lifted", 4, 7, success=False, t=20.0, length=7, cause="departure"),
+    _row("fast-downward-lifted", 4, 8, success=True, t=30.0, length=8),
 ]
 
 
@@ -62,7 +62,7 @@ def test_length_buckets():
 
 def test_grid_cells_hold_the_hand_computed_rates_medians_and_means():
     grid = summary_grid(ROWS)
-    assert list(grid) == ["astar", "symk-sas"]
+    assert list(grid) == ["astar", "fast-downward-lifted"]
     cell = grid["astar"]["open"]["4"]["5-6"]
     assert cell["n"] == 3
     assert cell["success_rate"] == pytest.approx(1 / 3, abs=1e-4) and cell["found_rate"] == pytest.approx(2 / 3, abs=1e-4)
@@ -74,9 +74,9 @@ def test_grid_cells_hold_the_hand_computed_rates_medians_and_means():
     assert set(grid["astar"]["open"]) == {"1", "2", "4", "5"} and set(grid["astar"]["closed"]) == {"4"}
     assert list(grid["astar"]["open"]["5"]) == ["9+"] and list(grid["astar"]["open"]["1"]) == ["?"]
     assert grid["astar"]["open"]["2"]["3-4"]["success_rate"] == pytest.approx(0.5)
-    sym = grid["symk-sas"]["open"]["4"]["7-8"]
+    sym = grid["fast-downward-lifted"]["open"]["4"]["7-8"]
     assert (sym["n"], sym["success_rate"], sym["median_time_s"], sym["mean_reference_length"]) == (2, 0.5, 25.0, 7.5)
-    assert "closed" not in grid["symk-sas"]
+    assert "closed" not in grid["fast-downward-lifted"]
     assert sum(c["n"] for loops in grid.values() for objs in loops.values() for cells in objs.values()
                for c in cells.values()) == len(ROWS)
 
@@ -88,7 +88,7 @@ def test_failure_causes_add_up_to_the_failures():
             failed = [r for r in ROWS if r.planner == planner and r.closed_loop == (loop == "closed") and not r.success]
             assert sum(counts.values()) == len(failed)
     assert causes["astar"]["open"] == {"departure": 1, "symbol_aliasing": 1, "timeout": 1, "unattributed": 1}
-    assert causes["astar"]["closed"] == {"timeout": 1} and causes["symk-sas"] == {"open": {"departure": 1}}
+    assert causes["astar"]["closed"] == {"timeout": 1} and causes["fast-downward-lifted"] == {"open": {"departure": 1}}
 
 
 def test_task_summary_covers_structure_tasks_only():
@@ -107,8 +107,8 @@ def test_text_and_markdown_renderings_show_the_cells():
     md = markdown_grid({"grid": grid, "failure_causes": summary_failure_causes(ROWS), "tasks": summary_tasks(ROWS)})
     assert "| objects | 1-2 | 3-4 | 5-6 | 7-8 | 9+ | ? |" in md  # astar reaches the extra buckets
     assert "| 4 | - | - | 0.33 / 0.67 (3) | - | - | - |" in md
-    assert "| 4 | - | - | - | 0.50 / - (2) |" in md  # symk-sas: open loop only
-    assert "| astar | open | 1 | 1 | 1 | 1 |" in md and "| symk-sas | open | 1 | 0 | 0 | 0 |" in md
+    assert "| 4 | - | - | - | 0.50 / - (2) |" in md  # fast-downward-lifted: open loop only
+    assert "| astar | open | 1 | 1 | 1 | 1 |" in md and "| fast-downward-lifted | open | 1 | 0 | 0 | 0 |" in md
     assert "| astar | open | tower-2 | 2 | 0.50 | 1.00 | 0.300 |" in md
 
 
@@ -150,18 +150,18 @@ def test_results_split_by_planner_merge_into_one(tmp_path, capsys):
     settings = {"run": "r", "problems": ["a", "b"], "problems_sha256": "h", "transition_sha256": "t",
                 "timeout_s": 10, "max_replans": 3, "closed_loop": True}
     astar = [r.to_json() for r in ROWS if r.planner == "astar"]
-    symk = [r.to_json() for r in ROWS if r.planner == "symk-sas"]
+    lifted = [r.to_json() for r in ROWS if r.planner == "fast-downward-lifted"]
     a, b = tmp_path / "a.json", tmp_path / "b.json"
     a.write_text(json.dumps({**settings, "planners": ["astar"], "rows": astar}))
-    b.write_text(json.dumps({**settings, "planners": ["symk-sas"], "rows": symk}))
+    b.write_text(json.dumps({**settings, "planners": ["fast-downward-lifted"], "rows": lifted}))
     merged = tmp_path / "merged.json"
     rc, printed = cli("plots", a, b, "--out", tmp_path / "plots", "--merged", merged)
     assert rc == 0
     m = json.loads(merged.read_text())
-    assert m["planners"] == ["astar", "symk-sas"] and len(m["rows"]) == len(ROWS)
+    assert m["planners"] == ["astar", "fast-downward-lifted"] and len(m["rows"]) == len(ROWS)
     assert m["grid"] == json.loads(json.dumps(summary_grid(ROWS)))
     assert markdown_grid(grid_of(m)) in printed
-    b.write_text(json.dumps({**settings, "timeout_s": 30, "planners": ["symk-sas"], "rows": symk}))
+    b.write_text(json.dumps({**settings, "timeout_s": 30, "planners": ["fast-downward-lifted"], "rows": lifted}))
     assert cli("plots", a, b, "--out", tmp_path / "p2")[0] == 2
     assert re.search("other settings .*timeout_s", capsys.readouterr().err)
     b.write_text(json.dumps({**settings, "planners": ["astar"], "rows": astar[:1]}))
@@ -245,7 +245,7 @@ SHORT_ROWS = [
 
 
 def test_shortest_grid_cells_hold_rates_ratios_and_causes():
-    from symlearn.planning.benchmark import shortest_bucket, summary_shortest_grid
+    from symlearn.planning.benchmark_summary import shortest_bucket, summary_shortest_grid
 
     assert [shortest_bucket(r) for r in SHORT_ROWS[:9]] == ["5-6", "5-6", "5-6", "5-6", "1-2", "off", "?", "9-12",
                                                             "9-12"]
@@ -262,7 +262,7 @@ def test_shortest_grid_cells_hold_rates_ratios_and_causes():
 def test_shortest_grid_text_markdown_plots_and_report(tmp_path):
     from PIL import Image
 
-    from symlearn.planning.benchmark import summary_shortest_grid
+    from symlearn.planning.benchmark_summary import summary_shortest_grid
     from symlearn.planning.benchmark_plots import SHORTEST_PLOT_FILES, format_shortest_grid
     from symlearn.report.gather import benchmark_section
 
@@ -299,7 +299,7 @@ def test_every_row_field_is_one_the_row_log_reads():
     import dataclasses
 
     from pddl_export.bounded_json import check
-    from symlearn.planning.benchmark import ROW_SCHEMA
+    from symlearn.planning.benchmark_rows import ROW_SCHEMA
 
     names = {f.name for f in dataclasses.fields(ProblemRun)}
     assert names == set(ROW_SCHEMA.required) | set(ROW_SCHEMA.optional)

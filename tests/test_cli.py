@@ -246,7 +246,7 @@ def test_problems_files(problems, tmp_path):
     assert rc == 0 and all(f.read_bytes() == (tmp_path / "again" / f.name).read_bytes() for f in files)  # seeded
 
 
-def test_plan_with_astar_and_sas_planner(tiny_run_copy, problems, tmp_path):
+def test_plan_with_astar_and_a_pddl_planner(tiny_run_copy, problems, tmp_path):
     problem = problems / "problem_0000.json"
     gen = len(json.loads(problem.read_text())["actions"])
     row = _plan(tiny_run_copy, problem, "astar")
@@ -254,9 +254,10 @@ def test_plan_with_astar_and_sas_planner(tiny_run_copy, problems, tmp_path):
     assert (row["success"] == "True") == (row["failure"] is None)
     assert (row["found"] == "True") == (row["length"] is not None) == (row["failure"] not in ("no_plan", "timeout"))
     one_replan = write_config(tmp_path / "replan1.toml", {"execution": {"max_replans": 1}})
-    row = _plan(tiny_run_copy, problem, "fast-downward-sas", "--config", one_replan)
+    row = _plan(tiny_run_copy, problem, "fast-downward", "--config", one_replan, "--record", tmp_path / "plan.gif")
     assert row["closed"] and int(row["replans"]) <= 1 and row["failure"] != "rules_vs_net"  # the rules are exact
-    written = tiny_run_copy / "pddl" / "problems" / "problem_0000"
+    written = tmp_path / "plan_tasks"  # beside the recording, not in the run
+    assert not (tiny_run_copy / "pddl" / "problems").exists()
     model_hash = json.loads((tiny_run_copy / "pddl" / "rules.json").read_text())["model_hash"]
     assert model_hash in (written / "problem.pddl").read_text()
 
@@ -264,7 +265,7 @@ def test_plan_with_astar_and_sas_planner(tiny_run_copy, problems, tmp_path):
 def test_benchmark_rows_and_summary(tiny_run_copy, problems, tmp_path):
     out = tmp_path / "bench.json"
     one_replan = write_config(tmp_path / "replan1.toml", {"execution": {"max_replans": 1}})
-    rc, text = cli("benchmark", "--run", tiny_run_copy, "--problems", problems, "--planners", "astar,fast-downward-sas",
+    rc, text = cli("benchmark", "--run", tiny_run_copy, "--problems", problems, "--planners", "astar,rules-bfs",
                    "--config", one_replan, "--timeout", 10, "--out", out)
     assert rc == 0 and f"wrote {out}" in text
     b = json.loads(out.read_text())
@@ -273,7 +274,7 @@ def test_benchmark_rows_and_summary(tiny_run_copy, problems, tmp_path):
     assert b["transition_sha256"] == json.loads((tiny_run_copy / "pddl" / "rules.json").read_text())["model_hash"]
     digest = hashlib.sha256(b"".join(hashlib.sha256(f.read_bytes()).hexdigest().encode() for f in files)).hexdigest()
     assert b["problems_sha256"] == digest[:16]
-    for name in ("astar", "fast-downward-sas"):
+    for name in ("astar", "rules-bfs"):
         rows = [r for r in b["rows"] if r["planner"] == name and not r["closed_loop"]]
         s = b["summary"][name]
         assert s["n_problems"] == len(rows) == 3
@@ -314,7 +315,7 @@ def test_plan_from_tampered_rules_fails_at_rules_vs_net(tiny_run_copy, tmp_path)
     stages = []
     for problem in sorted((tmp_path / "p").glob("*.json")):
         _bit_flip_rules(tiny_run_copy / "pddl" / "rules.json", problem)
-        row = _plan(tiny_run_copy, problem, "fast-downward-sas")
+        row = _plan(tiny_run_copy, problem, "rules-bfs")
         assert row["found"] == "True" and row["success"] == "False"
         # a plan of flips is executed, moves nothing and departs from the network's predictions: rules_vs_net;
         # an empty plan (start codes already the goal's) cannot disagree with the network
@@ -337,10 +338,11 @@ def test_plan_from_tampered_rules_fails_at_rules_vs_net(tiny_run_copy, tmp_path)
     (["plan", "--run", "{run}", "--problem", "{problem}", "--config", "{wrongtype}"],
      "wrongtype.toml: [execution] closed_loop must be a bool, not 'yes'"),
     (["train", "--data", "{data}", "--out", "{empty}/r", "--config", "{table}"],
-     "table.toml: unknown table [planner]; tables: collect, train, transition, export, lifted, problems, execution"),
+     "table.toml: unknown table [planners]; tables: collect, train, transition, export, lifted, problems, execution, "
+     "planner"),
     (["benchmark", "--run", "{empty}", "--problems", "{problems}", "--planners", "rules-outcomes", "--out", "{empty}/b.json"],
      "no exported rules at"),
-    (["benchmark", "--run", "{empty}", "--problems", "{problems}", "--planners", "fast-downward-sas", "--out", "{empty}/b.json"],
+    (["benchmark", "--run", "{empty}", "--problems", "{problems}", "--planners", "fast-downward", "--out", "{empty}/b.json"],
      "no exported rules at"),
 ])
 def test_refusals_exit_2_with_one_line(args, message, tiny_data, tiny_run, problems, tmp_path, capsys):
@@ -348,7 +350,7 @@ def test_refusals_exit_2_with_one_line(args, message, tiny_data, tiny_run, probl
     empty.mkdir()
     files = {"max9": "[export]\nmax_objects = 9\n", "ratio0": "[export]\noutcome_min_ratio = 0\n",
              "typo": "[lifted]\nmin_cont = 3\n", "wrongtype": "[execution]\nclosed_loop = 'yes'\n",
-             "table": "[planner]\nname = 'astar'\n"}
+             "table": "[planners]\nname = 'astar'\n"}
     for name, text in files.items():
         (tmp_path / f"{name}.toml").write_text(text)
     fill = dict(run=tiny_run.path, data=tiny_data.path, problems=problems, problem=problems / "problem_0000.json",

@@ -93,12 +93,15 @@ def test_settings_reach_the_saved_config_and_flags_win(tiny_data, tmp_path):
 
 
 def test_the_presets_the_cli_lists_are_the_configs_presets():
-    from symlearn.cli.args import TRAIN_PRESET_NAMES
+    from symlearn.cli.main import build_parser
     from symlearn.learning.models import PRESETS
     from symlearn.learning.training import TRAIN_PRESETS, TrainConfig
     from symlearn.symbolic.transition_model import TRANSITION_PRESETS
 
-    assert set(TRAIN_PRESET_NAMES) == set(TRAIN_PRESETS) == set(TRANSITION_PRESETS) == set(PRESETS)
+    sub = next(a for a in build_parser()._actions if a.dest == "command").choices
+    train, transition = (next(a for a in sub[c]._actions if a.dest == "preset") for c in ("train", "train-transition"))
+    assert list(train.choices) == list(TRAIN_PRESETS) and list(transition.choices) == list(TRANSITION_PRESETS)
+    assert set(TRAIN_PRESETS) == set(TRANSITION_PRESETS) == set(PRESETS)
     rec = TrainConfig.from_preset("recommended")
     quick = TrainConfig.from_preset("quick")
     # the recipe: the stability loss, the action on the held object, rider scenes three times an epoch, float32

@@ -15,13 +15,14 @@ import torch
 
 from search.result import PlanResult, PlanStatus
 from symlearn.planning import benchmark as bench
+from symlearn.planning import benchmark_rows, benchmark_summary
 from symlearn.learning.checkpoint import save_checkpoint
 from symlearn.cli.planning import add_planning_commands
 from symlearn.planning.execution import (FAILURE_CAUSES, ExecutionConfig, FailureStage, ObservedTransitions, ProblemRun,
                                         execute_plan, failure_cause, failure_causes, run_problem)
-from symlearn.planning.planners import PLANNERS, PlannerContext, make_planner
+from symlearn.planning.planners import PLANNERS, PlannerConfig, PlannerContext, make_planner
 from pddl_export.rules import Rule, RuleSet
-from pddl_export.sas_writer import SASEncoder
+from pddl_export.pddl_writer import conditional_domain, problem_pddl
 from pddl_export.symbolic import SymbolicGoal
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig
 from symlearn.problems.problem import GOAL_TOLERANCE_M, load_problem, load_problems
@@ -32,6 +33,8 @@ from symlearn.symbolic.learned_transition import LearnedTransition
 from symlearn.symbolic.transition_checkpoint import TRANSITION_FILE, save_transition
 from symlearn.symbolic.transition_model import TransitionConfig, TransitionNet
 from symlearn.world import action_id
+
+OPEN_LOOP = ExecutionConfig(closed_loop=False)  # each plan run as planned (ExecutionConfig() is closed loop)
 
 
 def _seeded(make, seed: int):
@@ -285,7 +288,7 @@ def _fixed(result_of):
 def test_no_plan_stages(sim, encoder, run_dir, problems, status, stage):
     fn = _fixed(lambda s, g: PlanResult(planner="t", status=status, plan=(), predicted_states=(), expansions=None,
                                         planning_time_s=0.0))
-    row = run_problem(sim, encoder, LearnedTransition.from_run(run_dir), problems[0], "t", fn)
+    row = run_problem(sim, encoder, LearnedTransition.from_run(run_dir), problems[0], "t", fn, OPEN_LOOP)
     assert not row.found and row.failure_stage == stage and row.plan_length is None
     assert row.failure_cause == stage and row.attribution["first_departure_step"] is None
     assert row.attribution["rules_net_disagree"] is None and row.attribution["replans"] == 0
@@ -304,7 +307,7 @@ def test_raising_planner_becomes_an_error_row(sim, encoder, run_dir, problems):
     def boom(*args):
         raise RuntimeError("engine crashed\nwith two lines")
 
-    row = run_problem(sim, encoder, LearnedTransition.from_run(run_dir), problems[0], "boom", boom)
+    row = run_problem(sim, encoder, LearnedTransition.from_run(run_dir), problems[0], "boom", boom, OPEN_LOOP)
     assert row.status == "error" and row.failure_stage == "no_plan" and "engine crashed" in row.message
     assert "\n" not in row.message
 
@@ -314,14 +317,14 @@ def test_execution_and_goal_mismatch_stages(sim, encoder, run_dir, problems):
     tr = LearnedTransition.from_run(run_dir)
     a = _empty_pick(pr)
     departs = _fixed(lambda s, g: _plan([a], [s, _wrong(s)]))  # predicts a change that never happens
-    row = run_problem(sim, encoder, tr, pr, "departs", departs)
+    row = run_problem(sim, encoder, tr, pr, "departs", departs, OPEN_LOOP)
     assert row.found and not row.success and row.failure_stage == "execution"
     stays = _fixed(lambda s, g: _plan([a], [s, s]))  # correct prediction, but the scene is far from the goal
-    row = run_problem(sim, encoder, tr, pr, "stays", stays)
+    row = run_problem(sim, encoder, tr, pr, "stays", stays, OPEN_LOOP)
     assert row.found and not row.success and row.failure_stage == "goal_mismatch"
     generator = _fixed(lambda s, g: PlanResult(planner="gen", status=PlanStatus.SOLVED, plan=pr.actions,
                                                predicted_states=(), expansions=None, planning_time_s=0.0))
-    row = run_problem(sim, encoder, tr, pr, "gen", generator)
+    row = run_problem(sim, encoder, tr, pr, "gen", generator, OPEN_LOOP)
     assert row.success and row.failure_stage is None and row.plan_length == pr.generator_length
 
 
@@ -379,7 +382,7 @@ def test_benchmark_writes_summary_and_rows(tmp_path, sim, run_dir, problems):
         lengths = [r["plan_length"] for r in open_rows if r["found"]]
         assert s["mean_plan_length"] == (pytest.approx(np.mean(lengths), abs=1e-3) if lengths else None)
     assert {r["closed_loop"] for r in saved["rows"]} == {False, True}
-    assert "astar-ucs" in bench.format_table(res)
+    assert "astar-ucs" in benchmark_summary.format_table(res)
     assert "risk_weight" not in saved  # no planner here depends on it
     # every row knows how many goal objects lie off the locations; the split adds up to the problems
     offs = {r["problem"]: r["goal_off_locations"] for r in saved["rows"]}
@@ -392,45 +395,43 @@ def test_benchmark_writes_summary_and_rows(tmp_path, sim, run_dir, problems):
                     and (r["goal_off_locations"] > 0) == (key == "off_locations")]
             assert c["success_rate_closed_loop"] == pytest.approx(np.mean([r["success"] for r in mine]), abs=1e-4)
             assert sum(c["closed_loop_failure_causes"].values()) == sum(not r["success"] for r in mine)
-    assert bench.format_goal_placement(res).startswith("astar: success open/closed, goals o")
+    assert benchmark_summary.format_goal_placement(res).startswith("astar: success open/closed, goals o")
 
 
-def test_benchmark_records_the_risk_weight_of_astar_likely(tmp_path, sim, run_dir):
+def test_benchmark_records_the_risk_weight_of_astar_outcomes(tmp_path, sim, run_dir):
     pdir = tmp_path / "problems"
     generate_problems(pdir, 2, objects=(1, 2), length=(1, 2), seed=12, sim=sim)
-    res = bench.benchmark(run_dir, pdir, ["astar-likely"], tmp_path / "b.json", timeout_s=2.0,
-                          show_progress=False, risk_weight=2.5)
+    res = bench.benchmark(run_dir, pdir, ["astar-outcomes"], tmp_path / "b.json", timeout_s=2.0, closed_loop=False,
+                          show_progress=False, planner_config=PlannerConfig(risk_weight=2.5))
     assert res["risk_weight"] == 2.5 and len(res["rows"]) == 2
-    assert all(r["planner"] == "astar-likely" for r in res["rows"])
+    assert all(r["planner"] == "astar-outcomes" for r in res["rows"])
     # an interrupted run resumes only under the same weight: the weight is part of the settings
-    problems = bench.load_sets([pdir])
+    problems = benchmark_rows.load_sets([pdir])
     ex = ExecutionConfig(timeout_s=2.0)
-    settings = [bench._settings(run_dir, [pdir], problems, ["astar-likely"], dataclasses.replace(ex, risk_weight=w))
+    settings = [bench._settings(run_dir, [pdir], problems, ["astar-outcomes"], ex, PlannerConfig(risk_weight=w))
                 for w in (1.0, 2.5)]
     assert settings[0]["risk_weight"] == 1.0 and settings[0] != settings[1]
-    weighted = dataclasses.replace(ex, risk_weight=2.5)
-    assert bench._settings(run_dir, [pdir], problems, ["astar-outcomes"], weighted)["risk_weight"] == 2.5
-    assert "risk_weight" not in bench._settings(run_dir, [pdir], problems, ["astar"], weighted)
+    weighted = PlannerConfig(risk_weight=2.5)
+    assert bench._settings(run_dir, [pdir], problems, ["astar", "astar-outcomes"], ex, weighted)["risk_weight"] == 2.5
+    assert "risk_weight" not in bench._settings(run_dir, [pdir], problems, ["astar"], ex, weighted)
 
 
 def test_unknown_planner_lists_every_planner(tmp_path, run_dir):
-    with pytest.raises(ValueError, match="unknown planner 'ghost'; known: astar, astar-ucs, astar-likely, astar-outcomes, ") as info:
+    with pytest.raises(ValueError, match="unknown planner 'ghost'; known: astar-outcomes, astar, astar-ucs, ") as info:
         bench.benchmark(run_dir, tmp_path, ["astar", "ghost"], tmp_path / "b.json")
     msg = str(info.value)
     assert "\n" not in msg and all(name in msg for name in PLANNERS)
 
 
 def test_registry_holds_every_planner_and_is_immutable():
-    assert list(PLANNERS) == ["astar", "astar-ucs", "astar-likely", "astar-outcomes", "fast-downward", "symk", "pyperplan", "fast-downward-opt",
-                              "fast-downward-blind", "fast-downward-sas", "fast-downward-sas-opt", "symk-sas",
-                              "symk-sas-topk", "fast-downward-sas-ms", "fast-downward-sas-lama",
-                              "rules-astar", "rules-bfs", "rules-outcomes", "fast-downward-lifted",
-                              "fast-downward-lifted-opt", "fast-downward-lifted-outcomes"]
+    assert list(PLANNERS) == ["astar-outcomes", "astar", "astar-ucs", "fast-downward-lifted",
+                              "fast-downward-lifted-opt", "fast-downward-lifted-outcomes", "rules-outcomes",
+                              "rules-bfs", "fast-downward", "pyperplan"]
     assert [n for n, s in PLANNERS.items() if not s.needs_rules and not s.needs_lifted] == [
-        "astar", "astar-ucs", "astar-likely", "astar-outcomes"]
+        "astar-outcomes", "astar", "astar-ucs"]
     assert [n for n, s in PLANNERS.items() if s.needs_lifted] == ["fast-downward-lifted", "fast-downward-lifted-opt",
                                                                   "fast-downward-lifted-outcomes"]
-    assert all(s.name == n and s.description for n, s in PLANNERS.items())
+    assert all(s.name == n and s.purpose and s.reason for n, s in PLANNERS.items())
     with pytest.raises(TypeError):
         PLANNERS["mine"] = PLANNERS["astar"]  # type: ignore[index]
     with pytest.raises(dataclasses.FrozenInstanceError):
@@ -446,10 +447,6 @@ def test_make_planner_builds_and_refuses(tmp_path, run_dir):
     moved = np.flatnonzero((nxt != start).any(1))
     if len(moved):  # a goal one step away: the likely plan's log_p is that step's log P under the network
         goal = tuple(int(c) for c in nxt[moved[0]])
-        res = make_planner("astar-likely")(m, start, SymbolicGoal(goal), 5.0)
-        assert res.planner == "astar-likely" and res.found and res.predicted_states[-1] == goal
-        _, nll = m.scored(np.array(res.predicted_states[:-1]), np.array(res.plan))
-        assert res.extra["log_p"] == pytest.approx(-nll.sum(), abs=1e-5)
         # every outcome the all-outcomes planner may follow from the start, the likeliest first
         res = make_planner("astar-outcomes")(m, start, SymbolicGoal(goal), 5.0)
         assert res.planner == "astar-outcomes" and res.found and res.predicted_states[-1] == goal
@@ -460,12 +457,13 @@ def test_make_planner_builds_and_refuses(tmp_path, run_dir):
     with pytest.raises(ValueError, match="plans on the exported rules, and none were given"):
         make_planner("fast-downward", PlannerContext())
     with pytest.raises(ValueError, match="no exported rules"):  # rules are read only when a planner needs them
-        PlannerContext.for_run(tmp_path, ["astar", "symk-sas"])
+        PlannerContext.for_run(tmp_path, ["astar", "rules-bfs"])
     assert PlannerContext.for_run(tmp_path, ["astar", "astar-ucs"]).rules is None
-    assert PlannerContext.for_run(tmp_path, ["astar-likely"], risk_weight=3.0).risk_weight == 3.0
+    config = PlannerConfig(risk_weight=3.0)
+    assert PlannerContext.for_run(tmp_path, ["astar-outcomes"], config=config).config.risk_weight == 3.0
     for bad in (0.0, -1.0, float("nan"), float("inf")):
-        with pytest.raises(ValueError, match="risk weight"):
-            PlannerContext(risk_weight=bad)
+        with pytest.raises(ValueError, match="risk_weight="):
+            PlannerConfig(risk_weight=bad)
 
 
 def test_failure_stage_values_are_the_json_strings():
@@ -476,13 +474,12 @@ def test_failure_stage_values_are_the_json_strings():
     row = ProblemRun(**base, failure_stage="timeout")
     assert row.failure_stage is FailureStage.TIMEOUT and f"{row.failure_stage}" == "timeout"
     assert json.loads(json.dumps(row.to_json()))["failure_stage"] == "timeout"
-    assert bench.summarize_rows([row])["astar"]["failure_stages"] == {"timeout": 1}
+    assert benchmark_summary.summarize_rows([row])["astar"]["failure_stages"] == {"timeout": 1}
 
 
 def test_cli_parses_planning_commands(tmp_path):
-    from symlearn.cli.planning import execution_config
+    from symlearn.cli.planning import execution_config, planner_config
     from symlearn.config_file import ConfigFileError, read_config_file
-    from symlearn.planning.execution import RECOMMENDED_EXECUTION
     from symlearn.symbolic.transition_model import TransitionConfig
 
     p = argparse.ArgumentParser(prog="symlearn")
@@ -492,19 +489,20 @@ def test_cli_parses_planning_commands(tmp_path):
     assert (a.objects, a.length, a.n, a.kind) == ((4, 5), (2, 2), 3, None) and a.func.__name__ == "cmd_problems"
     a = p.parse_args(["benchmark", "--run", "r", "--problems", "d", "--planners", "astar,astar-ucs", "--out", "o"])
     assert a.planners == ["astar", "astar-ucs"] and a.func.__name__ == "cmd_benchmark"
-    assert execution_config(a) == RECOMMENDED_EXECUTION and RECOMMENDED_EXECUTION.closed_loop  # the recipe's
+    assert execution_config(a) == ExecutionConfig() and ExecutionConfig().closed_loop  # the recipe's
     a = p.parse_args(["plan", "--run", "r", "--problem", "f.json", "--planner", "astar-ucs", "--timeout", "5"])
     assert a.planner == "astar-ucs" and a.func.__name__ == "cmd_plan"
-    assert execution_config(a) == dataclasses.replace(RECOMMENDED_EXECUTION, timeout_s=5.0)
+    assert execution_config(a) == ExecutionConfig(timeout_s=5.0)
     config = tmp_path / "open.toml"
-    config.write_text("[execution]\nclosed_loop = false\nrisk_weight = 2\ntimeout_s = 30\n")
+    config.write_text("[execution]\nclosed_loop = false\ntimeout_s = 30\n[planner]\nrisk_weight = 2\n")
     a = p.parse_args(["plan", "--run", "r", "--problem", "f.json", "--config", str(config), "--timeout", "7"])
     got = execution_config(a)  # the file over the recipe, the flag over the file
-    assert (got.closed_loop, got.risk_weight, got.timeout_s, got.max_replans) == (False, 2.0, 7.0, 3)
+    assert (got.closed_loop, got.timeout_s, got.max_replans) == (False, 7.0, 3)
+    assert planner_config(a) == PlannerConfig(risk_weight=2.0)
     for bad in ("0", "-1", "nan"):
-        config.write_text(f"[execution]\nrisk_weight = {bad}\n")
+        config.write_text(f"[planner]\nrisk_weight = {bad}\n")
         with pytest.raises((ValueError, ConfigFileError)):
-            execution_config(p.parse_args(["plan", "--run", "r", "--problem", "f", "--config", str(config)]))
+            planner_config(p.parse_args(["plan", "--run", "r", "--problem", "f", "--config", str(config)]))
     a = p.parse_args(["train-transition", "--run", "r", "--data", "d", "--preset", "quick"])
     assert (a.preset, a.seed, a.config) == ("quick", 0, None) and a.func.__name__ == "cmd_train_transition"
     assert p.parse_args(["train-transition", "--run", "r", "--data", "d"]).preset == "recommended"
@@ -598,11 +596,12 @@ def _rows(sim, pr):
     rules = RuleSet(bits=3, vocabulary=tuple(range(8)), max_objects=3, n_rules_before_generalization=0,
                     rules=(Rule(action=a, code_from=s[0], code_to=s[0] ^ 1),))  # rules say a moves object 0
     departs = run_problem(sim, enc, _Still(), pr, "departs", _fixed(lambda s, g: _plan([a], [s, _wrong(s)])),
-                          rules=rules)
-    aliased = run_problem(sim, blind, _Still(), pr, "stays", _fixed(lambda s, g: _plan([a], [s, s])))
+                          OPEN_LOOP, rules=rules)
+    aliased = run_problem(sim, blind, _Still(), pr, "stays", _fixed(lambda s, g: _plan([a], [s, s])),
+                          OPEN_LOOP)
     none = run_problem(sim, enc, _Still(), pr, "none", _fixed(lambda s, g: PlanResult(
-        planner="none", status=PlanStatus.UNSOLVABLE, plan=(), predicted_states=(), expansions=0, planning_time_s=0)))
-    gen = run_problem(sim, enc, _Still(), pr, "gen", _fixed(lambda s, g: _plan(pr.actions, [])))
+        planner="none", status=PlanStatus.UNSOLVABLE, plan=(), predicted_states=(), expansions=0, planning_time_s=0)), OPEN_LOOP)
+    gen = run_problem(sim, enc, _Still(), pr, "gen", _fixed(lambda s, g: _plan(pr.actions, [])), OPEN_LOOP)
     return departs, aliased, none, gen
 
 
@@ -622,7 +621,8 @@ def test_failure_attribution_per_cause(sim, walks):
     enc = _PositionEncoder(sim)
     agree = RuleSet(bits=3, vocabulary=tuple(range(8)), max_objects=3, n_rules_before_generalization=0, rules=())
     for rules, want in ((agree, False), (None, None)):
-        row = run_problem(sim, enc, _Still(), pr, "d", _fixed(lambda s, g: _plan([a], [s, _wrong(s)])), rules=rules)
+        row = run_problem(sim, enc, _Still(), pr, "d", _fixed(lambda s, g: _plan([a], [s, _wrong(s)])), OPEN_LOOP,
+                          rules=rules)
         assert row.failure_cause == "departure" and row.attribution["rules_net_disagree"] is want
 
 
@@ -644,7 +644,7 @@ def test_rules_planner_replans_on_the_overridden_rules(tmp_path):
     rules = RuleSet(bits=2, vocabulary=(0, 1, 2, 3), max_objects=2, n_rules_before_generalization=0,
                     rules=(Rule(action=4, code_from=1, code_to=3), Rule(action=17, code_from=1, code_to=2),
                            Rule(action=17, code_from=2, code_to=3)))
-    plan = make_pddl_planner(rules, "h", "fast-downward-sas-opt", write_dir=tmp_path)
+    plan = make_pddl_planner(rules, "h", "fast-downward", write_dir=tmp_path)
     goal = SymbolicGoal((3, None))
     first = plan(RulesTransition(rules), np.array([1, 0]), goal, 20.0)
     assert first.plan == (4,) and not first.extra["rules_vs_net"]
@@ -653,5 +653,6 @@ def test_rules_planner_replans_on_the_overridden_rules(tmp_path):
     second = plan(memory, np.array([1, 0]), goal, 20.0)
     assert second.plan == (17, 17) and not second.extra["rules_vs_net"], second.message
     fixed = override_rules(rules, memory.seen)
-    assert (tmp_path / "task_2.sas").read_text() == SASEncoder(fixed).task([1, 0], goal).text
-    assert (tmp_path / "task.sas").read_text() == SASEncoder(rules).task([1, 0], goal).text
+    assert (tmp_path / "domain_2.pddl").read_text() == conditional_domain(fixed, "h")  # the rules it replanned on
+    assert (tmp_path / "problem.pddl").read_text() == problem_pddl(rules, [1, 0], goal, "h")
+    assert (tmp_path / "problem_2.pddl").read_text() == problem_pddl(fixed, [1, 0], goal, "h")

@@ -88,7 +88,7 @@ def test_plan_with_traversing_name_writes_nothing_outside_the_run(tiny_run_copy,
     d["name"] = name
     path = _write(tmp_path / "in" / "bad.json", d)
     before = _tree(tmp_path)
-    rc, out = cli("plan", "--run", tiny_run_copy, "--problem", path, "--planner", "fast-downward-sas-opt",
+    rc, out = cli("plan", "--run", tiny_run_copy, "--problem", path, "--planner", "fast-downward",
                   "--timeout", "10")
     assert rc == 2 and out == ""
     _one_line_error(capsys, "plan", "is not a safe name", str(path))
@@ -137,13 +137,13 @@ def test_rules_from_a_retrained_transition_are_refused(tiny_run, tiny_run_copy, 
     new_hash = hashlib.sha256((tiny_run_copy / "transition.pt").read_bytes()).hexdigest()[:16]
     assert new_hash != rules["model_hash"]
     problem = problems / "problem_0000.json"
-    rc, out = cli("plan", "--run", tiny_run_copy, "--problem", problem, "--planner", "fast-downward-sas",
+    rc, out = cli("plan", "--run", tiny_run_copy, "--problem", problem, "--planner", "fast-downward",
                   "--timeout", "10")
     assert rc == 2 and out == ""
     _one_line_error(capsys, "plan", "rules.json was exported from another transition.pt", "re-run 'symlearn export-pddl")
     assert not (tiny_run_copy / "pddl" / "problems").exists()
     out_file = tmp_path / "b.json"
-    rc, out = cli("benchmark", "--run", tiny_run_copy, "--problems", problems, "--planners", "astar,symk-sas",
+    rc, out = cli("benchmark", "--run", tiny_run_copy, "--problems", problems, "--planners", "astar,rules-bfs",
                   "--out", out_file)
     assert rc == 2 and not out_file.exists() and not (tmp_path / "b.json.rows.jsonl").exists()
     _one_line_error(capsys, "benchmark", "was exported from another transition.pt")
@@ -151,7 +151,7 @@ def test_rules_from_a_retrained_transition_are_refused(tiny_run, tiny_run_copy, 
     rc, _ = cli("plan", "--run", tiny_run_copy, "--problem", problem, "--planner", "astar", "--timeout", "10")
     assert rc == 0
     (tiny_run_copy / "pddl" / "rules.json").write_text(json.dumps(dict(rules, model_hash=new_hash)))
-    rc, _ = cli("plan", "--run", tiny_run_copy, "--problem", problem, "--planner", "fast-downward-sas",
+    rc, _ = cli("plan", "--run", tiny_run_copy, "--problem", problem, "--planner", "fast-downward",
                 "--timeout", "10")
     assert rc == 0
 
@@ -338,7 +338,7 @@ def test_strict_json_replaces_non_finite_floats():
 
 
 def test_row_log_cuts_a_torn_row_and_refuses_other_settings(tmp_path):
-    from symlearn.planning.benchmark import RowLog
+    from symlearn.planning.benchmark_rows import RowLog
 
     path = tmp_path / "b.json.rows.jsonl"
     log = RowLog(path, {"planners": ["astar"], "timeout_s": 10.0})

@@ -78,15 +78,10 @@ sys.path[:0] = [{repo!r}, {tests!r}]
 import signal
 signal.signal(signal.SIGHUP, signal.SIG_IGN)  # as under nohup
 from pathlib import Path
-import search.sas_planners as sp
-from pddl_export.enumeration import enumerate_transitions
-from pddl_export.distil import distil_rules
-from pddl_export.sas_writer import SASEncoder
-from test_pddl_export import FAR, NEAR, UNDER, TOY_VOCAB, ToyRobot
-rules = distil_rules(enumerate_transitions(ToyRobot(), TOY_VOCAB, max_objects=2))
-sp.search_binary = lambda package="": Path({fake!r})
-print(sp.solve_sas(SASEncoder(rules), [UNDER, FAR], [NEAR, NEAR], "symk-sas", {timeout}).to_json()["status"],
-      flush=True)
+import search.stock_planners as st
+st.fast_downward_driver = lambda: Path({fake!r})
+result = st.solve_texts("(define (domain d))", "(define (problem p) (:domain d))", "fd-lama-first", {timeout})
+print(result.status.value, flush=True)
 """
 
 
@@ -127,18 +122,13 @@ SELF_KILLING_PLANNER = "import os, signal; os.kill(os.getpid(), signal.SIGKILL)\
 
 
 def test_a_planner_killed_from_outside_is_marked_not_a_result(tmp_path, monkeypatch):
-    from pddl_export.distil import distil_rules
-    from pddl_export.enumeration import enumerate_transitions
-    from pddl_export.sas_writer import SASEncoder
-    from search.sas_planners import solve_sas
-    from test_pddl_export import FAR, NEAR, TOY_VOCAB, UNDER, ToyRobot
+    import search.stock_planners as st
 
     fake = tmp_path / "fake_planner"
     fake.write_text(f"#!{sys.executable}\n" + SELF_KILLING_PLANNER)
     fake.chmod(0o755)
-    monkeypatch.setattr("search.sas_planners.search_binary", lambda package="": fake)
-    rules = distil_rules(enumerate_transitions(ToyRobot(), TOY_VOCAB, max_objects=2))
-    res = solve_sas(SASEncoder(rules), [UNDER, FAR], [NEAR, NEAR], "symk-sas", 20.0)
+    monkeypatch.setattr(st, "fast_downward_driver", lambda: fake)
+    res = st.solve_texts("(define (domain d))", "(define (problem p) (:domain d))", "fd-lama-first", 20.0)
     assert res.status is PlanStatus.ERROR and res.extra["killed_by_signal"] == signal.SIGKILL, res
     assert "killed by SIGKILL" in res.message
 
@@ -146,6 +136,7 @@ def test_a_planner_killed_from_outside_is_marked_not_a_result(tmp_path, monkeypa
 def test_benchmark_never_records_a_planner_killed_by_a_signal(tiny_run, problems, tmp_path, monkeypatch):
     """The row is not saved: the benchmark stops, and the same command again redoes it."""
     import symlearn.planning.benchmark as bm
+    from symlearn.planning import benchmark_rows
 
     real = bm.make_planners
 
@@ -155,11 +146,13 @@ def test_benchmark_never_records_a_planner_killed_by_a_signal(tiny_run, problems
     out = tmp_path / "b.json"
     monkeypatch.setattr(bm, "make_planners", lambda names, run, **kw: {"astar": killed})
     with pytest.raises(PlannerInterrupted, match="astar was killed by SIGHUP"):
-        bm.benchmark(tiny_run.path, problems, ["astar"], out, timeout_s=10, show_progress=False)
-    log = bm.rows_path(out).read_text().splitlines()
-    assert len(log) == 1 and json.loads(log[0])["format"] == bm.ROWS_FORMAT  # the settings, no row
+        bm.benchmark(tiny_run.path, problems, ["astar"], out, closed_loop=False, timeout_s=10,
+                     show_progress=False)
+    log = benchmark_rows.rows_path(out).read_text().splitlines()
+    assert len(log) == 1 and json.loads(log[0])["format"] == benchmark_rows.ROWS_FORMAT  # the settings, no row
     monkeypatch.setattr(bm, "make_planners", real)
-    res = bm.benchmark(tiny_run.path, problems, ["astar"], out, timeout_s=10, show_progress=False)
+    res = bm.benchmark(tiny_run.path, problems, ["astar"], out, closed_loop=False, timeout_s=10,
+                       show_progress=False)
     assert [r["status"] for r in res["rows"]] != ["error", "error"] and len(res["rows"]) == 2
     assert all("killed" not in (r["message"] or "") for r in res["rows"])
 
@@ -180,7 +173,7 @@ def test_pipeline_bad_flag_is_one_line_and_leaves_nothing(tmp_path, capsys, flag
 
 @pytest.mark.parametrize("kw", [dict(workers=0), dict(epochs=0), dict(seed=-1), dict(workers=1.5), dict(n=0)])
 def test_pipeline_settings_refuse_bad_values_before_any_folder(tmp_path, kw):
-    from symlearn.pipeline import PipelineSettings
+    from symlearn.pipeline_presets import PipelineSettings
 
     with pytest.raises(ValueError, match="must be an integer of at least"):
         PipelineSettings(preset="demo", out=tmp_path / "pipe", **kw)
@@ -296,7 +289,8 @@ def test_a_second_pipeline_into_a_folder_is_refused_with_the_holders_pid(tmp_pat
 
 
 def test_a_second_benchmark_on_one_out_is_refused_before_any_row(tiny_run, problems, tmp_path, capsys, holder):
-    from symlearn.planning.benchmark import lock_path, rows_path
+    from symlearn.planning.benchmark import lock_path
+    from symlearn.planning.benchmark_rows import rows_path
 
     out = tmp_path / "b.json"
     pid = holder(lock_path(out))
@@ -372,7 +366,7 @@ def test_plan_record_paths_that_are_not_its_own_are_refused(tiny_run, problems, 
 
 
 def test_plan_record_may_replace_its_own_gif_and_png(tmp_path):
-    from symlearn.planning.single import record_paths
+    from symlearn.planning.plan_one import record_paths
 
     gif = tmp_path / "plan.gif"
     gif.write_bytes(b"GIF89a" + bytes(20))
@@ -389,8 +383,9 @@ def _bench(tiny_run, problems, out, *extra):
                                   "row log is a folder"])
 def test_benchmark_outputs_are_refused_before_any_row(tiny_run, problems, tmp_path, capsys, monkeypatch, case):
     import symlearn.planning.benchmark as bm
+    from symlearn.planning import benchmark_rows
 
-    monkeypatch.setattr(bm, "_run_rows", lambda *a, **k: pytest.fail("a row ran before the outputs were checked"))
+    monkeypatch.setattr(bm, "run_rows", lambda *a, **k: pytest.fail("a row ran before the outputs were checked"))
     out, record = tmp_path / "b.json", None  # the failed plans' GIFs: benchmark(record_dir=...), the pipeline's
     if case == "out is a folder":
         out.mkdir()
@@ -403,7 +398,7 @@ def test_benchmark_outputs_are_refused_before_any_row(tiny_run, problems, tmp_pa
     elif case == "record is out":
         record = out
     else:
-        bm.rows_path(out).mkdir()
+        benchmark_rows.rows_path(out).mkdir()
     before = {p.name: (p.read_bytes() if p.is_file() else None) for p in tmp_path.iterdir()}
     if record is None:
         rc, _ = _bench(tiny_run, problems, out)
@@ -467,20 +462,21 @@ def test_a_goal_problem_is_not_written_into_a_generated_set(sim, tmp_path, capsy
 # ------------------------------------------------------------------------------- 7. plan's failures reach the terminal
 
 
-def test_plan_refuses_a_task_folder_it_cannot_write_before_any_work(tiny_run_copy, problems, capsys):
-    (tiny_run_copy / "pddl" / "problems").write_text("in the way")  # as a read-only folder: nothing can go there
-    rc, _ = cli("plan", "--run", tiny_run_copy, "--problem", problems / "problem_0000.json",
-                "--planner", "fast-downward-sas")
-    _one_line_error(capsys, "plan", "cannot write the planner's tasks to", "is not a writable folder")
-    assert rc == 2
+def test_plan_refuses_a_task_folder_it_cannot_write_before_any_work(tiny_run, problems, tmp_path, capsys):
+    (tmp_path / "plan_tasks").write_text("in the way")  # where --record's task folder goes: nothing can go there
+    rc, _ = cli("plan", "--run", tiny_run.path, "--problem", problems / "problem_0000.json",
+                "--planner", "fast-downward", "--record", tmp_path / "plan.gif")
+    _one_line_error(capsys, "plan", "--record's task folder", "is a file; give a folder")
+    assert rc == 2 and not (tmp_path / "plan.gif").exists()
 
 
 def test_plan_exits_non_zero_with_the_reason_when_the_planner_cannot_run(tiny_run_copy, problems, capsys,
                                                                          monkeypatch):
-    monkeypatch.setattr("search.sas_planners.search_binary", lambda package="": None)
+    monkeypatch.setattr("symlearn.planning.planners.solve_pddl", lambda *args, **kwargs: failed(
+        "fast-downward", PlanStatus.ERROR, time.perf_counter(), "the planner engine is not installed"))
     rc, out = cli("plan", "--run", tiny_run_copy, "--problem", problems / "problem_0000.json",
-                  "--planner", "fast-downward-sas")
-    _one_line_error(capsys, "plan", "fast-downward-sas could not plan", "the search binary of")
+                  "--planner", "fast-downward")
+    _one_line_error(capsys, "plan", "fast-downward could not plan", "the planner engine is not installed")
     assert rc == 1 and "found False (error)" in out
 
 
@@ -599,12 +595,12 @@ def _recording_planner(path: Path) -> Path:
 
 def _caller_source(route: str, fake: Path, timeout: float) -> str:
     """A script that makes one planner call on `route` (the stand-in in place of the planner) and prints its result."""
-    from test_faults_search import SAS_DRIVER, UP_DRIVER
+    from test_faults_search import UP_DRIVER
 
     kw = dict(repo=str(ROOT), tests=str(ROOT / "tests"), fake=str(fake), timeout=timeout)
     if route == "up":
         return UP_DRIVER.format(planner="fast-downward", compile_ce=False, **kw)
-    return (SAS_DRIVER if route == "sas" else STOCK_DRIVER).format(**kw)
+    return STOCK_DRIVER.format(**kw)
 
 
 def _left_within(what: Callable[[], list], within_s: float = 5.0) -> list:
@@ -619,7 +615,7 @@ def _symlearn_temps(tmpdir: Path) -> list[str]:
     return sorted(p.name for p in tmpdir.iterdir() if p.name.startswith("symlearn-"))
 
 
-@pytest.mark.parametrize("route", ["sas", "stock", "up"])
+@pytest.mark.parametrize("route", ["stock", "up"])
 def test_a_sigkilled_caller_leaves_no_planner_and_no_temp_folder(tmp_path, route):
     """SIGKILL cannot be caught: the planner's group (its own children too) and its folder still go at once."""
     from test_faults_search import _alive, _procs_mentioning, _start_driver, _wait_dead, _wait_for
@@ -667,25 +663,27 @@ INTERRUPTED_LINE = "symlearn benchmark: interrupted; re-run the same command to 
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
-def test_an_interrupted_ray_benchmark_ends_like_a_local_one(tiny_run, problems, tmp_path, sig):
+def test_an_interrupted_ray_benchmark_ends_like_a_local_one(tmp_path, sig):
     """`benchmark --ray` stopped during a planner call (a Ray worker's) ends with 128 + the signal's number (it was
     134 or 130) and the one line, as the local engine; no planner process and no symlearn-* folder is left. The
-    stand-in planner is SymK's binary, in a stand-in up_symk package first on the path that Ray's workers inherit."""
+    stand-in planner is the stock fast-downward.py driver (fast-downward-lifted on the shipped run), in a stand-in
+    up_fast_downward package first on the path that Ray's workers inherit."""
     import tempfile
 
     from test_faults_search import _procs_mentioning, _wait_dead, _wait_for
 
     packages = tmp_path / "packages"
-    (packages / "up_symk").mkdir(parents=True)
-    (packages / "up_symk" / "__init__.py").write_text("")
-    _recording_planner(packages / "up_symk" / "symk" / "builds" / "release" / "bin" / "downward")
+    (packages / "up_fast_downward").mkdir(parents=True)
+    (packages / "up_fast_downward" / "__init__.py").write_text("")
+    _recording_planner(packages / "up_fast_downward" / "downward" / "fast-downward.py")
+    shipped = ROOT / "pretrained" / "recommended"
     tmpdir, pids_file = tmp_path / "tmpdir", tmp_path / "pids"
     tmpdir.mkdir()
     ray_tmp = tempfile.mkdtemp(prefix="ray-", dir="/tmp")  # short: Ray's socket paths must fit 107 bytes
     env = dict(os.environ, TMPDIR=str(tmpdir), RAY_TMPDIR=ray_tmp, FAKE_PIDS=str(pids_file), OMP_NUM_THREADS="1",
                PYTHONPATH=os.pathsep.join([str(packages), str(ROOT)]))
-    cmd = [sys.executable, "-c", RAY_CLI, "benchmark", "--run", str(tiny_run.path), "--problems", str(problems),
-           "--planners", "symk-sas", "--timeout", "120", "--out", str(tmp_path / "b.json"), "--ray"]
+    cmd = [sys.executable, "-c", RAY_CLI, "benchmark", "--run", str(shipped), "--problems", str(shipped / "problems"),
+           "--planners", "fast-downward-lifted", "--timeout", "120", "--out", str(tmp_path / "b.json"), "--ray"]
     proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)
     pids: list[int] = []

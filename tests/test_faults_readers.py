@@ -324,7 +324,7 @@ ROW = {"problem": "p0", "planner": "astar", "found": True, "status": "solved", "
     ([1, 2], ["line 3", "expected an object"]),
 ])
 def test_wrong_shaped_row_is_refused_naming_file_and_line(tmp_path, bad, words):
-    from symlearn.planning.benchmark import RowLog
+    from symlearn.planning.benchmark_rows import RowLog
 
     path = tmp_path / "b.json.rows.jsonl"
     settings = {"planners": ["astar"], "timeout_s": 10.0}
@@ -343,7 +343,9 @@ def test_wrong_shaped_row_is_refused_naming_file_and_line(tmp_path, bad, words):
 
 
 def test_benchmark_refuses_a_wrong_shaped_row_before_running_any(tiny_run, tmp_path, capsys):
-    from symlearn.planning.benchmark import ExecutionConfig, RowLog, _settings, load_sets, problem_sets
+    from symlearn.planning.benchmark import _settings
+    from symlearn.planning.benchmark_rows import RowLog, load_sets, problem_sets
+    from symlearn.planning.execution import ExecutionConfig
 
     problems = tmp_path / "problems"
     problems.mkdir()
@@ -583,7 +585,7 @@ def _small_rules(fname: str) -> dict:
 
 def _open_row_log(path: Path) -> None:
     """The document at `path` as the one row of a benchmark log there (after the settings line), opened."""
-    from symlearn.planning.benchmark import ROWS_FORMAT, RowLog
+    from symlearn.planning.benchmark_rows import ROWS_FORMAT, RowLog
 
     settings = {"planners": ["astar"]}
     entry = path.read_text()
@@ -687,7 +689,7 @@ def test_checkpoint_that_is_a_fifo_or_device_is_refused_at_once(tmp_path, which)
     (None, ["FIFO"]),
 ])
 def test_lifted_rules_file_goes_through_the_bounded_reader(tmp_path, text, words):
-    from pddl_export.lifted_rules import load_lifted
+    from pddl_export.lifted_rules_io import load_lifted
 
     path = tmp_path / "lifted.json"
     if text is None:

@@ -41,9 +41,13 @@ TIME_COLUMN = "median time (s)"
 @pytest.fixture
 def tiny_preset(monkeypatch):
     """`--preset tiny`: the demo preset with 1-object problems and a short planner timeout, for this file only."""
-    from symlearn.pipeline import PRESETS
+    from symlearn.pipeline_presets import PRESETS
 
-    tiny = dataclasses.replace(PRESETS["demo"], problem_objects=(1, 1), timeout_s=2.0)
+    from symlearn.planning.execution import EXECUTION_PRESETS
+
+    short = dataclasses.replace(EXECUTION_PRESETS[PRESETS["demo"].execution], timeout_s=2.0)
+    monkeypatch.setitem(EXECUTION_PRESETS, "tiny", short)
+    tiny = dataclasses.replace(PRESETS["demo"], problem_objects=(1, 1), execution="tiny")
     monkeypatch.setitem(PRESETS, "tiny", tiny)
     return tiny
 
@@ -190,7 +194,8 @@ def test_a_rerun_with_other_settings_redoes_what_changed_and_equals_a_fresh_run(
 
 def test_collect_seed_of_the_settings_file_is_the_data_sets_seed(tmp_path, tiny_preset):
     from symlearn.config_file import read_config_file
-    from symlearn.pipeline import PipelineSettings, config_json, stage_configs
+    from symlearn.pipeline import config_json, stage_configs
+    from symlearn.pipeline_presets import PipelineSettings
 
     seeded = tmp_path / "seed5.toml"
     seeded.write_text(PIPE_CONFIG.read_text().replace("[collect]\n", "[collect]\nseed = 5\n"))
@@ -213,7 +218,9 @@ def test_collect_seed_of_the_settings_file_is_the_data_sets_seed(tmp_path, tiny_
 
 
 def test_a_stage_starting_over_removes_only_its_own_files_inside_out(tmp_path):
-    from symlearn.pipeline import PRESETS, clear_stage, pipeline_stages
+    from symlearn.pipeline import clear_stage
+    from symlearn.pipeline_presets import PRESETS
+    from symlearn.pipeline_stages import pipeline_stages
 
     train = next(stage for stage in pipeline_stages(PRESETS["demo"]) if stage.name == "train")
     out, elsewhere = tmp_path / "pipe", tmp_path / "elsewhere"

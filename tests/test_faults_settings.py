@@ -237,16 +237,17 @@ def test_every_key_refuses_bad_values_in_one_line_naming_file_and_key(tmp_path, 
 
 
 EVERY_EXECUTION_KEY = {"tolerance_m": 0.035, "closed_loop": True, "max_replans": 2, "max_fallbacks": 1,
-                       "keep_plan_on_failed_replan": False, "timeout_s": 7.5, "risk_weight": 2.5}
+                       "keep_plan_on_failed_replan": False, "timeout_s": 7.5}
 
 
 def test_every_execution_key_is_non_default_here():
-    from symlearn.planning.execution import RECOMMENDED_EXECUTION, ExecutionConfig
+    from symlearn.planning.execution import ExecutionConfig
 
     fields = {f.name for f in dataclasses.fields(ExecutionConfig)}
     assert set(EVERY_EXECUTION_KEY) == fields
-    assert all(getattr(RECOMMENDED_EXECUTION, k) != v for k, v in EVERY_EXECUTION_KEY.items() if k != "closed_loop")
-    assert ExecutionConfig().closed_loop != EVERY_EXECUTION_KEY["closed_loop"]
+    assert all(getattr(ExecutionConfig(), k) != v for k, v in EVERY_EXECUTION_KEY.items() if k != "closed_loop")
+    # closed loop is the default (the recipe's); the file sets it so that both loops' rows run
+    assert ExecutionConfig().closed_loop and EVERY_EXECUTION_KEY["closed_loop"]
 
 
 def _every_key_file(tmp_path: Path) -> Path:
@@ -257,15 +258,15 @@ def _every_key_file(tmp_path: Path) -> Path:
 
 def _spy_run_problem(monkeypatch) -> list:
     """Every ExecutionConfig a benchmark row runs with (the real run_problem still runs the row)."""
-    import symlearn.planning.benchmark as bench
+    import symlearn.planning.benchmark_runner as runner
 
-    seen, real = [], bench.run_problem
+    seen, real = [], runner.run_problem
 
     def spy(sim, encoder, transition, problem, name, planner, cfg, **kw):
         seen.append(cfg)
         return real(sim, encoder, transition, problem, name, planner, cfg, **kw)
 
-    monkeypatch.setattr(bench, "run_problem", spy)
+    monkeypatch.setattr(runner, "run_problem", spy)
     return seen
 
 
@@ -291,19 +292,21 @@ def test_a_ray_task_runs_its_rows_with_the_whole_execution_config(tiny_run, one_
     """_ray_pair, the body of a Ray task, run here in-process: the rows get the config they were sent."""
     import torch
 
-    import symlearn.planning.benchmark as bench
+    import symlearn.planning.benchmark_runner as runner
+    from symlearn.planning.benchmark_rows import load_sets
     from symlearn.planning.execution import ExecutionConfig
 
     want = ExecutionConfig(**EVERY_EXECUTION_KEY)
     seen = _spy_run_problem(monkeypatch)
-    p = bench.load_sets([one_problem])[0]
+    p = load_sets([one_problem])[0]
     threads = torch.get_num_threads()
     try:
-        rows = bench._ray_pair("probe", str(tiny_run.path), ["astar"], p, "astar", [False, True], want, None)
+        rows = runner._ray_pair(json.dumps({"probe": True}), str(tiny_run.path), ["astar"], p, "astar", [False, True],
+                               want, None)
     finally:
         torch.set_num_threads(threads)
-        sim = bench._worker_state.pop("sim", None)
-        bench._worker_state.clear()
+        sim = runner._worker_state.pop("sim", None)
+        runner._worker_state.clear()
         if sim is not None:
             sim.close()
     assert [key for key, _ in rows] == [(p.key, "astar", False), (p.key, "astar", True)]
@@ -312,25 +315,32 @@ def test_a_ray_task_runs_its_rows_with_the_whole_execution_config(tiny_run, one_
 
 def test_a_row_log_of_other_execution_settings_is_refused(tiny_run, one_problem, tmp_path):
     import symlearn.planning.benchmark as bench
+    from symlearn.planning.benchmark_rows import RowLog, load_sets
     from symlearn.planning.execution import ExecutionConfig
 
     sets = [one_problem]
-    problems = bench.load_sets(sets)
+    problems = load_sets(sets)
     base = ExecutionConfig(closed_loop=True, timeout_s=10.0)
     log = tmp_path / "b.json.rows.jsonl"
-    bench.RowLog(log, bench._settings(tiny_run.path, sets, problems, ["astar-likely"], base)).open()
+    RowLog(log, bench._settings(tiny_run.path, sets, problems, ["astar-outcomes"], base)).open()
     for key, value in EVERY_EXECUTION_KEY.items():
         if key == "closed_loop":
             value = False
-        other = bench._settings(tiny_run.path, sets, problems, ["astar-likely"],
+        other = bench._settings(tiny_run.path, sets, problems, ["astar-outcomes"],
                                 dataclasses.replace(base, **{key: value}))
         with pytest.raises(ValueError) as info:
-            bench.RowLog(log, other).open()
+            RowLog(log, other).open()
         _one_line(info.value, "other settings", key)
+    # the planner config's risk_weight too ([planner]): astar-outcomes plans with it
+    from symlearn.planning.planner_catalogue import PlannerConfig
+    other = bench._settings(tiny_run.path, sets, problems, ["astar-outcomes"], base, PlannerConfig(risk_weight=2.5))
+    with pytest.raises(ValueError) as info:
+        RowLog(log, other).open()
+    _one_line(info.value, "other settings", "risk_weight")
     # and through benchmark(): the whole config is the key, whichever way it is given
     before = log.read_bytes()
     with pytest.raises(ValueError, match="differing: tolerance_m"):
-        bench.benchmark(tiny_run.path, one_problem, ["astar-likely"], tmp_path / "b.json", show_progress=False,
+        bench.benchmark(tiny_run.path, one_problem, ["astar-outcomes"], tmp_path / "b.json", show_progress=False,
                         execution=dataclasses.replace(base, tolerance_m=0.05))
     assert log.read_bytes() == before
 
@@ -467,7 +477,8 @@ def test_every_key_of_a_table_reaches_the_config_its_command_runs(tmp_path, monk
 
 @pytest.mark.parametrize("preset", ["paper", "recommended"])
 def test_every_key_of_every_table_reaches_the_pipeline_stage_configs(tmp_path, preset):
-    from symlearn.pipeline import PipelineSettings, stage_configs
+    from symlearn.pipeline import stage_configs
+    from symlearn.pipeline_presets import PipelineSettings
 
     path = tmp_path / "all.toml"
     for n in range(max(len(tables) for tables in NON_DEFAULT.values())):
@@ -479,7 +490,8 @@ def test_every_key_of_every_table_reaches_the_pipeline_stage_configs(tmp_path, p
         settings = PipelineSettings(out=tmp_path / "out", preset=preset, overrides=read_config_file(path))
         configs = stage_configs(settings)
         where = {"collect": configs["collect"], "train": configs["train"],
-                 "transition": configs["train-transition"].transition, "execution": configs["benchmark"].execution}
+                 "transition": configs["train-transition"].transition, "execution": configs["benchmark"].execution,
+                 "planner": configs["benchmark"].planner}
         if preset == "paper":
             where.update(export=configs["export-pddl"], problems=configs["problems"].problem)
         else:

@@ -14,6 +14,8 @@ from symlearn.cli.main import main
 from symlearn.cluster import EngineError, as_finished, check_engine
 from symlearn.data.dataset import load_manifest
 from symlearn.planning import benchmark as bench
+from symlearn.planning import benchmark_rows
+from symlearn.planning.execution import ExecutionConfig
 from symlearn.sim.collect import CollectConfig, collect, shard_name
 
 CFG = CollectConfig(n=12, seed=7, shard_size=1)  # 12 one-sample shards: 10 train, 1 val, 1 test
@@ -126,14 +128,14 @@ def test_ray_benchmark_gives_the_local_rows_and_resumes(ray_cluster, tiny_run, t
     out = tmp_path / "ray.json"
     remote = bench.benchmark(tiny_run.path, two_problems, planners, out, engine="ray", workers=2, **kw)
     assert len(remote["rows"]) == 2 * 2 * 2 and _without_timings(remote) == _without_timings(local)
-    assert not bench.rows_path(out).exists()
+    assert not benchmark_rows.rows_path(out).exists()
     # a killed run: its log holds some rows; the Ray engine runs only the others and ends with the same result
-    log = bench.rows_path(out)
-    settings = bench._settings(tiny_run.path, [two_problems], bench.load_sets([two_problems]), planners,
-                               bench.ExecutionConfig(closed_loop=True, timeout_s=5.0))
-    first = bench.RowLog(log, settings)
+    log = benchmark_rows.rows_path(out)
+    settings = bench._settings(tiny_run.path, [two_problems], benchmark_rows.load_sets([two_problems]), planners,
+                               ExecutionConfig(closed_loop=True, timeout_s=5.0))
+    first = benchmark_rows.RowLog(log, settings)
     first.open()
-    keys = {p.label: p.key for p in bench.load_sets([two_problems])}
+    keys = {p.label: p.key for p in benchmark_rows.load_sets([two_problems])}
     for r in local["rows"]:
         if r["planner"] == "astar":
             first.append((keys[r["problem"]], r["planner"], r["closed_loop"]), dict(r, message="kept from the first run"))

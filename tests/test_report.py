@@ -100,7 +100,8 @@ def full_run(tiny_run, tmp_path_factory) -> Path:
     # open loop, each failed plan recorded as a GIF (the pipeline's benchmark stage records them so)
     from symlearn.planning.benchmark import benchmark
 
-    benchmark(run, probs, ["astar"], run / "benchmark.json", record_dir=run / "recordings", show_progress=False)
+    benchmark(run, probs, ["astar"], run / "benchmark.json", closed_loop=False, record_dir=run / "recordings",
+              show_progress=False)
     return run
 
 
@@ -280,9 +281,13 @@ def tiny_preset(monkeypatch):
     """`--preset tiny`: the demo preset with 1-object problems and a short planner timeout, for this file only."""
     import dataclasses
 
-    from symlearn.pipeline import PRESETS
+    from symlearn.pipeline_presets import PRESETS
 
-    tiny = dataclasses.replace(PRESETS["demo"], problem_objects=(1, 1), timeout_s=2.0)
+    from symlearn.planning.execution import EXECUTION_PRESETS
+
+    short = dataclasses.replace(EXECUTION_PRESETS[PRESETS["demo"].execution], timeout_s=2.0)
+    monkeypatch.setitem(EXECUTION_PRESETS, "tiny", short)
+    tiny = dataclasses.replace(PRESETS["demo"], problem_objects=(1, 1), execution="tiny")
     monkeypatch.setitem(PRESETS, "tiny", tiny)
     return tiny
 
@@ -341,7 +346,8 @@ def test_the_default_preset_is_the_recommended_recipe(tmp_path):
     import dataclasses
 
     from symlearn.cli.main import build_parser
-    from symlearn.pipeline import PRESETS, PipelineSettings, config_json, stage_configs
+    from symlearn.pipeline import config_json, stage_configs
+    from symlearn.pipeline_presets import PRESETS, PipelineSettings
 
     assert build_parser().parse_args(["pipeline", "--out", "x"]).preset == "recommended"
     s = PipelineSettings(out=tmp_path / "pipe")
@@ -366,12 +372,13 @@ def test_the_default_preset_is_the_recommended_recipe(tmp_path):
     bench = configs["benchmark"]
     assert bench["planners"] == ["astar-outcomes", "fast-downward-lifted"] and bench["threads"] == 1
     assert (bench["execution"]["closed_loop"], bench["execution"]["timeout_s"]) == (True, 10.0)
-    from symlearn.planning.execution import RECOMMENDED_EXECUTION  # what plan and benchmark do by default
+    from symlearn.planning.execution import ExecutionConfig  # what plan and benchmark do by default
 
-    assert bench["execution"] == dataclasses.asdict(RECOMMENDED_EXECUTION)
-    sizes = dict.fromkeys(("samples", "extra_samples", "epochs", "transition_epochs", "min_count", "lifted_min_count",
-                           "problem_objects", "problems"))
-    assert dataclasses.replace(PRESETS["demo"], **sizes) == PRESETS["recommended"]  # the recipe, smaller
+    assert bench["execution"] == dataclasses.asdict(ExecutionConfig())
+    sizes = dict.fromkeys(("samples", "extra_samples", "epochs", "transition_epochs", "min_count", "problem_objects",
+                           "problems"))
+    # the recipe, smaller: its lifted rules need fewer moves (LIFTED_PRESETS["small"])
+    assert dataclasses.replace(PRESETS["demo"], lifted="fast", **sizes) == PRESETS["recommended"]
     paper = PipelineSettings(out=tmp_path / "paper", preset="paper")
     assert "collect-extra" not in paper.preset_values.stage_names
     assert config_json(stage_configs(paper)["train-transition"])["transition"]["location_bits"] == 0

@@ -2,7 +2,10 @@
 from __future__ import annotations
 
 import argparse
+import functools
+import importlib
 import os
+from typing import Sequence
 
 
 
@@ -84,9 +87,37 @@ def ray_engine(args: argparse.Namespace) -> tuple[str, str | None]:
     return ("local", None) if args.ray is None else ("ray", args.ray or None)
 
 
-# TrainConfig's and TransitionConfig's presets (training.TRAIN_PRESETS, transition_model.TRANSITION_PRESETS; a test
-# keeps the three equal), named here so that --help needs no torch
-TRAIN_PRESET_NAMES = ("recommended", "quick", "paper")
+class PresetNames(Sequence[str]):
+    """The names of a preset table, for argparse's `choices`: read from the table itself (the one place presets are
+    defined, beside their config class) when first asked, so that building the parser, `symlearn --help` and a
+    refused flag need not import the table's module (the learning configs load torch).
+
+    `table` is "module:NAME", e.g. "symlearn.learning.training:TRAIN_PRESETS".
+    """
+
+    def __init__(self, table: str) -> None:
+        self.table = table
+
+    @functools.cached_property
+    def names(self) -> tuple[str, ...]:
+        """The table's keys, in its order."""
+        module, _, name = self.table.partition(":")
+        return tuple(getattr(importlib.import_module(module), name))
+
+    def __getitem__(self, i: int) -> str:
+        return self.names[i]
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def __contains__(self, value: object) -> bool:
+        return value in self.names
+
+
+def add_preset_flag(c: argparse.ArgumentParser, table: str, default: str, help: str) -> None:
+    """--preset NAME, its choices the names of the preset table `table` ("module:NAME", PresetNames); `help` may say
+    %(choices)s."""
+    c.add_argument("--preset", default=default, choices=PresetNames(table), metavar="NAME", help=help)
 
 
 def add_config_flag(c: argparse.ArgumentParser, tables: str) -> None:

@@ -1,7 +1,7 @@
 """The `symlearn` command line: each sub-command maps its flags onto a config and calls the library.
 
     symlearn collect --out data/paper --n 12000 --workers 2 --seed 0
-    symlearn collect --out /shared/data/big --n 1000000 --workers 64 --engine ray --address auto
+    symlearn collect --out /shared/data/big --n 1000000 --workers 64 --ray auto
     symlearn scenarios --json
 """
 from __future__ import annotations
@@ -12,28 +12,44 @@ import json
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from symlearn.cli.args import (THREADS_HELP, TRAIN_PRESET_NAMES, OneLineParser, add_config_flag, add_ray_flag,
-                               int_range, non_negative_int, positive_int, ray_engine, set_threads, thread_count)
+from symlearn.cli.args import (THREADS_HELP, OneLineParser, add_config_flag, add_preset_flag, add_ray_flag, int_range,
+                               non_negative_int, positive_int, ray_engine, set_threads, thread_count)
 from symlearn.cli.pipeline import add_pipeline_command
 from symlearn.cli.planning import add_planning_commands
 from symlearn.cli.report import add_plots_command, add_report_command
-from symlearn.config_file import read_config_file
+from symlearn.config_file import RECIPE, read_config_file
 from symlearn.outputs import folder_output
 
+if TYPE_CHECKING:  # the configs' modules load torch, numpy or the simulator: imported where a command runs
+    from symlearn.export.lifted_export import LiftedConfig
+    from symlearn.learning.training import TrainConfig
+    from symlearn.sim.collect import CollectConfig
 
-def cmd_collect(args: argparse.Namespace) -> int:
-    from symlearn.cluster import check_engine
+
+LIFTED_DEFAULT = "fast"  # export-pddl's preset: LiftedConfig()'s own values (lifted_export.LIFTED_PRESETS; a test)
+
+
+def collect_config(args: argparse.Namespace) -> CollectConfig:
+    """CollectConfig's defaults with --config's [collect] table and the flags over them."""
     from symlearn.config_file import built, replace_nested
-    from symlearn.data.dataset import summarize
-    from symlearn.sim.collect import CollectConfig, collect
+    from symlearn.sim.collect import CollectConfig
     from symlearn.sim.exploration import ExplorationConfig
 
     table = read_config_file(args.config).get("collect", {})  # [collect]
     cfg = built(args.config, "collect", table, lambda v: replace_nested(CollectConfig(), v))
     if args.objects is not None:
         cfg = dataclasses.replace(cfg, exploration=ExplorationConfig.with_k_range(*args.objects))
-    cfg = dataclasses.replace(cfg, **{k: v for k, v in dict(n=args.n, seed=args.seed).items() if v is not None})
+    return dataclasses.replace(cfg, **{k: v for k, v in dict(n=args.n, seed=args.seed).items() if v is not None})
+
+
+def cmd_collect(args: argparse.Namespace) -> int:
+    from symlearn.cluster import check_engine
+    from symlearn.data.dataset import summarize
+    from symlearn.sim.collect import collect
+
+    cfg = collect_config(args)
     engine, address = ray_engine(args)
     check_engine(engine, address)  # before any work: a missing Ray is refused in one line
     where = f" on Ray{f' at {address}' if address else ''}" if engine == "ray" else ""
@@ -79,16 +95,23 @@ def _init_distributed() -> None:
         dist.init_process_group("nccl" if torch.cuda.is_available() else "gloo")
 
 
-def cmd_train(args: argparse.Namespace) -> int:
+def train_config(args: argparse.Namespace) -> TrainConfig:
+    """The --preset's TrainConfig with --config's [train] table and the flags over it."""
     from symlearn.config_file import built, flat_overrides
-    from symlearn.learning.training import TrainConfig, train
+    from symlearn.learning.training import TrainConfig
 
     flags = {k: v for k, v in dict(epochs=args.epochs, seed=args.seed).items() if v is not None}
     if args.no_attention:
         flags["attention"] = False
     table = read_config_file(args.config).get("train", {})  # [train] and [train.model]
-    cfg = built(args.config, "train", table,
-                lambda v: TrainConfig.from_preset(args.preset, **{**flat_overrides(v), **flags}))
+    return built(args.config, "train", table,
+                 lambda v: TrainConfig.from_preset(args.preset, **{**flat_overrides(v), **flags}))
+
+
+def cmd_train(args: argparse.Namespace) -> int:
+    from symlearn.learning.training import train
+
+    cfg = train_config(args)
     folder_output(Path(args.out), "--out")
     set_threads(args.threads)
     _init_distributed()
@@ -122,7 +145,8 @@ def cmd_table1(args: argparse.Namespace) -> int:
 def cmd_symbols(args: argparse.Namespace) -> int:
     from symlearn.symbolic.symbols import analyse_symbols
 
-    res = analyse_symbols(Path(args.run), Path(args.data), symbol=args.symbol, min_count=args.min_count)
+    given = {} if args.min_count is None else {"min_count": args.min_count}  # else the library's default
+    res = analyse_symbols(Path(args.run), Path(args.data), symbol=args.symbol, **given)
     print(f"{res['n_objects']} training objects, {res['n_distinct']} distinct symbols, "
           f"{res['n_symbols_for_95pct']} cover 95%; weighted type purity {res['weighted_type_purity']}, "
           f"moved-when-picked purity {res.get('weighted_moved_purity')}")
@@ -135,14 +159,21 @@ def cmd_symbols(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_export_lifted(args: argparse.Namespace) -> int:
+def lifted_config(args: argparse.Namespace) -> LiftedConfig:
+    """The --preset's LiftedConfig with --config's [lifted] table over it."""
     from symlearn.config_file import built, replace_nested
-    from symlearn.export.lifted_export import (LIFTED_DIR, LIFTED_FILE, LIFTED_PRESETS, MAX_DATA_OBJECTS,
-                                                 export_lifted, export_paths, write_problem_folder)
-    from symlearn.problems.problem import load_problems
+    from symlearn.export.lifted_export import LIFTED_PRESETS
 
     table = read_config_file(args.config).get("lifted", {})  # [lifted]
-    cfg = built(args.config, "lifted", table, lambda v: replace_nested(LIFTED_PRESETS[args.preset], v))
+    return built(args.config, "lifted", table, lambda v: replace_nested(LIFTED_PRESETS[args.preset], v))
+
+
+def cmd_export_lifted(args: argparse.Namespace) -> int:
+    from symlearn.export.lifted_export import (LIFTED_DIR, LIFTED_FILE, MAX_DATA_OBJECTS, export_lifted,
+                                                 export_paths, write_problem_folder)
+    from symlearn.problems.problem import load_problems
+
+    cfg = lifted_config(args)
     out = Path(args.out) if args.out else None
     folders = export_paths(Path(args.run), out, [Path(d) for d in args.problems or []])  # every output, first
     for d in folders:
@@ -177,7 +208,7 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
         return cmd_export_lifted(args)
     if args.problems:
         raise ValueError("--problems writes problem folders of the lifted domain; --rules does not")
-    if args.preset != "fast":
+    if args.preset != LIFTED_DEFAULT:
         raise ValueError(f"--preset {args.preset} chooses the lifted domain's settings; --rules takes [export] ones")
     table = read_config_file(args.config).get("export", {})  # [export]
     cfg = built(args.config, "export", table, lambda v: replace_nested(ExportConfig(), v))
@@ -230,10 +261,10 @@ def add_train_command(sub) -> None:
     t = sub.add_parser("train", help="train the attentive effect model (runs under torchrun too)")
     t.add_argument("--data", required=True)
     t.add_argument("--out", required=True, help="run directory (resumed if it holds the same run)")
-    t.add_argument("--preset", default="recommended", choices=list(TRAIN_PRESET_NAMES),
-                   help="recommended (default): the quick sizes, the stability loss and the action on the held "
-                        "object's token, the recipe that plans best; quick: the small model alone; paper: the "
-                        "paper's sizes and schedule")
+    add_preset_flag(t, "symlearn.learning.training:TRAIN_PRESETS", RECIPE,
+                    "one of %(choices)s (symlearn/learning/training.py, TRAIN_PRESETS): recommended (default): the "
+                    "quick sizes, the stability loss and the action on the held object's token, the recipe that "
+                    "plans best; quick: the small model alone; paper: the paper's sizes and schedule")
     add_config_flag(t, "[train] (TrainConfig) and [train.model] (ModelConfig), e.g. batch_size, lr, bf16, "
                        "stability_weight, rider_weight, bits")
     t.add_argument("--epochs", type=positive_int)
@@ -262,7 +293,8 @@ def add_analysis_commands(sub) -> None:
     sy.add_argument("--run", required=True)
     sy.add_argument("--data", required=True)
     sy.add_argument("--symbol", help="bit string of the symbol to show examples of")
-    sy.add_argument("--min-count", type=int, default=100, help="a symbol is frequent from this many objects")
+    sy.add_argument("--min-count", type=positive_int,
+                    help="a symbol is frequent from this many objects (default symbols.FREQUENT_MIN_COUNT, 100)")
     sy.set_defaults(func=cmd_symbols)
 
 
@@ -277,18 +309,20 @@ def add_export_pddl_command(sub) -> None:
     x.add_argument("--out", help="output directory (default RUN/pddl)")
     x.add_argument("--rules", action="store_true",
                    help="the rules over whole codes (rules.json, outcomes.json, domain.pddl; read by the rules-* and "
-                        "SAS+ planners) instead of the lifted domain (lifted.json, lifted/domain.pddl: typed STRIPS "
+                        "unified-planning planners) instead of the lifted domain (lifted.json, lifted/domain.pddl: typed STRIPS "
                         "schemas; needs m(z) on 9 location bits, docs/DOMAIN.md)")
     x.add_argument("--problems", nargs="+", metavar="DIR",
                    help="lifted domain: also write each problem set as a standalone folder "
                         "(RUN/pddl/lifted/SET/domain.pddl, p01.pddl, ..., index.json)")
     add_config_flag(x, "[lifted] (LiftedConfig: min_count, rider_min_count) or, with --rules, [export] "
                        "(ExportConfig: max_objects, min_count, scenes, larger_scenes, pddl_fidelity_cases, ...)")
-    x.add_argument("--preset", default="fast", choices=("fast", "accurate"),
-                   help="lifted domain: fast (default: the rules Fast Downward translates fastest) or accurate (also "
-                        "rarer structures, rarer cube structures pooled, and picks at a stick's end: closer to what "
-                        "the robot saw than m(z) on 1-5-object scenes, about 2x Fast Downward's time; "
-                        "docs/DOMAIN.md); [lifted] settings apply on top")
+    add_preset_flag(x, "symlearn.export.lifted_export:LIFTED_PRESETS", LIFTED_DEFAULT,
+                    "lifted domain, one of %(choices)s (symlearn/export/lifted_export.py, LIFTED_PRESETS): fast "
+                    "(default: LiftedConfig's own values, the rules Fast Downward translates fastest), accurate "
+                    "(also rarer structures, rarer cube structures pooled, and picks at a stick's end: closer to "
+                    "what the robot saw than m(z) on 1-5-object scenes, about 2x Fast Downward's time; "
+                    "docs/DOMAIN.md) or small (fast for a data set of a few thousand samples, as the demo's: a "
+                    "structure seen 3 times becomes a rule); [lifted] settings apply on top")
     x.add_argument("--threads", type=thread_count, help=THREADS_HELP)
     x.set_defaults(func=cmd_export_pddl)
 

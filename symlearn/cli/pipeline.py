@@ -12,14 +12,16 @@ from pathlib import Path
 
 from symlearn.cli.args import add_config_flag, non_negative_int, positive_int
 from symlearn.config_file import read_config_file
-from symlearn.pipeline import DEFAULT_PRESET, PRESETS, PipelineSettings, run_pipeline
+from symlearn.pipeline import run_pipeline
+from symlearn.pipeline_presets import DEFAULT_PRESET, PRESETS, PipelineSettings
 
 PRESETS_HELP = ("recommended (default): the recipe that plans best, at full scale (a paper-style data set and a "
                 "1-5-object one, the stability-trained quick effect model, m(z) on 9 location bits, the lifted PDDL "
                 "domain, problems by shortest-plan length, astar-outcomes and fast-downward-lifted closed loop); "
                 "demo: the same recipe at a small scale, minutes on 2 cores (make demo); paper: the paper-faithful "
                 "setup (its model sizes, learned codes only, the rules export, random-walk problems, open loop). "
-                "symlearn/pipeline.py holds each preset's values")
+                "symlearn/pipeline_presets.py names each stage's preset, defined beside its config class "
+                "(docs/CONFIG.md)")
 
 
 def cmd_pipeline(args: argparse.Namespace) -> int:

@@ -27,11 +27,16 @@ import dataclasses
 import json
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from symlearn.cli.args import (THREADS_HELP, TRAIN_PRESET_NAMES, add_config_flag, add_ray_flag, int_range,
+from symlearn.cli.args import (THREADS_HELP, add_config_flag, add_preset_flag, add_ray_flag, int_range,
                                non_negative_int, planner_list, positive_int, ray_engine, set_threads, thread_count)
-from symlearn.config_file import MAX_TIMEOUT_S, TIMEOUT_S, built, read_config_file
+from symlearn.config_file import MAX_TIMEOUT_S, RECIPE, TIMEOUT_S, built, read_config_file
 from symlearn.planning.planner_catalogue import DEFAULT_PLANNER, planners_help
+
+if TYPE_CHECKING:  # the configs' modules load torch: imported where a command runs
+    from symlearn.planning.execution import ExecutionConfig
+    from symlearn.symbolic.transition_model import TransitionConfig
 
 
 def timeout_seconds(text: str) -> float:
@@ -46,12 +51,18 @@ def timeout_seconds(text: str) -> float:
     return v
 
 
-def cmd_train_transition(args: argparse.Namespace) -> int:
+def transition_config(args: argparse.Namespace) -> TransitionConfig:
+    """The --preset's TransitionConfig with --config's [transition] table over it."""
     from symlearn.symbolic.transition_model import TransitionConfig
-    from symlearn.symbolic.transition_training import train_transition
 
     table = read_config_file(args.config).get("transition", {})  # [transition]
-    cfg = built(args.config, "transition", table, lambda v: TransitionConfig.from_preset(args.preset, **v))
+    return built(args.config, "transition", table, lambda v: TransitionConfig.from_preset(args.preset, **v))
+
+
+def cmd_train_transition(args: argparse.Namespace) -> int:
+    from symlearn.symbolic.transition_training import train_transition
+
+    cfg = transition_config(args)
     set_threads(args.threads)
     located = f", {cfg.location_bits} location bits" if cfg.location_bits else ""
     modes = f", {cfg.modes} outcome modes" if cfg.modes > 1 else ""
@@ -172,42 +183,48 @@ def _cmd_structure_problems(args: argparse.Namespace) -> int:
 def note_rule_loading(run: Path, planners: list[str]) -> None:
     """Say on stderr which big rule files the planners read first: rules of 1-5-object scenes take 390 MB and 20 s
     on 2 cores, a silence a user could take for a hang."""
-    from pddl_export.outcome_rules import OUTCOMES_FILE
-    from pddl_export.rules_io import PDDL_DIR, RULES_FILE
-    from symlearn.planning.planners import OUTCOME_RULES_PLANNER, planner_spec
+    from symlearn.planning.planner_catalogue import OUTCOMES, RULES, planner_entry
 
-    if not any(planner_spec(p).needs_rules for p in planners):
-        return
-    files = [RULES_FILE] + ([OUTCOMES_FILE] if OUTCOME_RULES_PLANNER in planners else [])
-    paths = [run / PDDL_DIR / f for f in files if (run / PDDL_DIR / f).is_file()]
+    files = sorted({f for p in planners for f in planner_entry(p).needs if f in (RULES, OUTCOMES)}, key=len)
+    paths = [run / f for f in files if (run / f).is_file()]
     megabytes = sum(p.stat().st_size for p in paths) / 1e6
     if megabytes >= 50:
         print(f"loading {' and '.join(str(p) for p in paths)} ({megabytes:.0f} MB)", file=sys.stderr)
 
 
-def execution_config(args: argparse.Namespace):
-    """The recipe's execution (closed loop, 10 s a call: execution.RECOMMENDED_EXECUTION) with --config's
+def execution_config(args: argparse.Namespace) -> ExecutionConfig:
+    """The recipe's execution (ExecutionConfig(): closed loop, 10 s a call) with --config's
     [execution] table and --timeout over it."""
     from symlearn.config_file import replace_nested
-    from symlearn.planning.execution import RECOMMENDED_EXECUTION
+    from symlearn.planning.execution import ExecutionConfig
 
     table = read_config_file(args.config).get("execution", {})
-    cfg = built(args.config, "execution", table, lambda v: replace_nested(RECOMMENDED_EXECUTION, v))
+    cfg = built(args.config, "execution", table, lambda v: replace_nested(ExecutionConfig(), v))
     return cfg if args.timeout is None else dataclasses.replace(cfg, timeout_s=args.timeout)
 
 
-def cmd_plan(args: argparse.Namespace) -> int:
-    from symlearn.planning.single import plan_problem
+def planner_config(args: argparse.Namespace):
+    """The planners' settings (PlannerConfig): --config's [planner] table over the defaults."""
+    from symlearn.config_file import replace_nested
+    from symlearn.planning.planner_catalogue import PlannerConfig
 
-    cfg = execution_config(args)
+    table = read_config_file(args.config).get("planner", {})
+    return built(args.config, "planner", table, lambda v: replace_nested(PlannerConfig(), v))
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    from symlearn.planning.plan_one import plan_problem
+
+    cfg, planners = execution_config(args), planner_config(args)
     set_threads(args.threads)
     note_rule_loading(Path(args.run), [args.planner])
     done = plan_problem(Path(args.run), Path(args.problem), args.planner, cfg,
-                        record=Path(args.record) if args.record else None, record_size=args.record_size)
+                        record=Path(args.record) if args.record else None, record_size=args.record_size,
+                        planner_config=planners)
     problem, row = done.problem, done.row
     if done.gif is not None:
         print(f"wrote {done.gif} ({done.frames} frames) and {done.filmstrip}")
-    if done.write_dir.exists():
+    if done.write_dir is not None:  # kept beside the recording; without one they went to a removed work folder
         print(f"wrote {done.write_dir / 'problem.pddl'}")
     print(f"{problem.name} [{args.planner}{', closed loop' if row.closed_loop else ''}]: found {row.found} "
           f"({row.status}), length {row.plan_length} (generator {row.generator_length}), "
@@ -222,10 +239,11 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 def cmd_benchmark(args: argparse.Namespace) -> int:
     from symlearn.cluster import check_engine
-    from symlearn.planning.benchmark import benchmark, format_goal_placement, format_table
+    from symlearn.planning.benchmark import benchmark
+    from symlearn.planning.benchmark_summary import format_goal_placement, format_table
     from symlearn.planning.benchmark_plots import format_grid, format_shortest_grid
 
-    cfg = execution_config(args)
+    cfg, planners = execution_config(args), planner_config(args)
     engine, address = ray_engine(args)
     check_engine(engine, address)  # before any work: a missing Ray is refused in one line
     if args.workers > 1 and engine != "ray":
@@ -235,7 +253,7 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
     set_threads(1)
     note_rule_loading(Path(args.run), list(args.planners))
     res = benchmark(Path(args.run), args.problems, args.planners, Path(args.out), execution=cfg, show_progress=True,
-                    engine=engine, workers=args.workers, address=address)
+                    engine=engine, workers=args.workers, address=address, planner_config=planners)
     print(format_table(res))
     print(format_goal_placement(res))
     print()
@@ -265,9 +283,10 @@ def add_train_transition_command(sub) -> None:
     t.add_argument("--data", required=True, nargs="+", metavar="DIR",
                    help="the data sets to encode: the first is the main set, the others' train and val splits join "
                         "m(z)'s (their test splits are reported apart)")
-    t.add_argument("--preset", default="recommended", choices=list(TRAIN_PRESET_NAMES),
-                   help="recommended (default): the quick network on codes ending with 9 location bits, which the "
-                        "lifted domain reads; quick: learned codes only; paper: the paper's layers")
+    add_preset_flag(t, "symlearn.symbolic.transition_model:TRANSITION_PRESETS", RECIPE,
+                    "one of %(choices)s (symlearn/symbolic/transition_model.py, TRANSITION_PRESETS): recommended "
+                    "(default): the quick network on codes ending with 9 location bits, which the lifted domain "
+                    "reads; quick: learned codes only; paper: the paper's layers")
     add_config_flag(t, "[transition] (TransitionConfig: epochs, copy_prior, attention_rounds, modes, "
                        "location_bits, ...; docs/DESIGN.md)")
     t.add_argument("--seed", type=non_negative_int, default=0)
@@ -300,10 +319,11 @@ def add_problems_command(sub) -> None:
 def _add_execution_flags(c: argparse.ArgumentParser) -> None:
     """The execution flags `plan` and `benchmark` share."""
     c.add_argument("--timeout", type=timeout_seconds,
-                   help=f"seconds per planner call, finite and in (0, {MAX_TIMEOUT_S:g}] (default 10)")
-    add_config_flag(c, "[execution] (ExecutionConfig: closed_loop, default true; max_replans; risk_weight, the "
-                       "weight W of astar-likely, astar-outcomes and rules-outcomes, each action costing 1 + W * "
-                       "(-log P))")
+                   help=f"seconds per planner call, finite and in (0, {MAX_TIMEOUT_S:g}] (default: [execution] "
+                        "timeout_s, else ExecutionConfig's, 10)")
+    add_config_flag(c, "[execution] (ExecutionConfig: closed_loop, default true; max_replans; ...) and [planner] "
+                       "(PlannerConfig: risk_weight, the weight W of astar-outcomes and rules-outcomes, an outcome "
+                       "costing 1 + W * (-log P))")
 
 
 def add_plan_command(sub) -> None:
@@ -314,7 +334,8 @@ def add_plan_command(sub) -> None:
     c.add_argument("--problem", required=True, help="problem JSON file")
     c.add_argument("--planner", default=DEFAULT_PLANNER,
                    help=f"one planner of the list below (default {DEFAULT_PLANNER})")
-    c.add_argument("--record", help="save the executed plan as this animated GIF (and a filmstrip .png beside it)")
+    c.add_argument("--record", help="save the executed plan as this animated GIF (a filmstrip .png and the "
+                   "planner's task files, NAME_tasks/, beside it)")
     c.add_argument("--record-size", type=_size, default=(320, 240), help="recorded frame size WxH (default 320x240)")
     _add_execution_flags(c)
     # search-time inference runs the networks on small batches, many times slower on 2 threads than on 1 when

@@ -8,9 +8,9 @@ held-out test splits: against m(z)'s own likeliest step (fidelity) and against w
 (accuracy, beside m(z)'s own), whole scenes compared on what the domain states (kept learned bits, location,
 place, level).
 
-Needs an m(z) on 9 location bits (`train-transition --location-bits 9`): location, place and level are the
-relations of the domain. Writes RUN/pddl/lifted.json (the rules, the layout, the type reader, the checks)
-and RUN/pddl/lifted/domain.pddl.
+Needs an m(z) on 9 location bits (`train-transition --preset recommended`, its default): location, place and
+level are the relations of the domain. Writes RUN/pddl/lifted.json (the rules, the layout, the type reader, the
+checks) and RUN/pddl/lifted/domain.pddl.
 """
 from __future__ import annotations
 
@@ -25,11 +25,12 @@ import numpy as np
 
 from pddl_export.end_moves import distil_end_rules
 from pddl_export.files import atomic_write_files, atomic_write_folder, json_text, sha256_file
-from pddl_export.lifted_rules import MIN_GAIN, POOL_MIN_COUNT, POOL_STRUCTURE_MIN, POOLED_CLASSES, LiftedRules, \
-    build_codebook, distil_lifted, observed_end_moves, observed_moves, participants, stick_reader, \
-    with_network_answers
-from pddl_export.lifted_scene import FIELD_BITS, CodeLayout, kept_bits, read_scene
-from pddl_export.lifted_writer import domain_pddl, schemas
+from pddl_export.lifted_distil import MIN_GAIN, POOL_MIN_COUNT, POOL_STRUCTURE_MIN, distil_lifted, with_network_answers
+from pddl_export.lifted_domain import domain_pddl, schemas
+from pddl_export.lifted_rules import POOLED_CLASSES, LiftedRules, build_codebook, observed_end_moves, observed_moves, \
+    participants, stick_reader
+from pddl_export.lifted_scene import CodeLayout, kept_bits, read_scene
+from pddl_export.location_codec import FIELD_BITS, decode_location
 from pddl_export.rules_io import PDDL_DIR
 from pddl_export.symbolic import bits_from_codes
 from symlearn.outputs import file_output, folder_output
@@ -58,7 +59,7 @@ class LiftedConfig:
     source: str = "observed"
     # a move structure becomes a rule once it was seen this often: each rule's release grounds once per cube and
     # location, so this sets Fast Downward's translator time; 20 was chosen on a fresh 1-5-object data set
-    # (bench/heldout_accuracy.py on data/k15h) as the setting furthest above m(z)'s accuracy between 50 and 20,
+    # (experiments/heldout_accuracy.py on data/k15h) as the setting furthest above m(z)'s accuracy between 50 and 20,
     # and passes m(z) on a second one read once (docs/DOMAIN.md, "The rules against m(z) on 12,000 fresh steps")
     min_count: int = 20
     # a move that carries riders needs only this many: riders are 1.5% of objects, and without these rules the
@@ -110,13 +111,17 @@ class LiftedConfig:
 # seen min_count times, no pools and no end rules, which Fast Downward translates fastest. "accurate": rules of
 # structures seen 30 times (rider moves 3), far-row pairs seen 10 times, the cube structures seen 12 times pooled,
 # and picks at a far-row stick's end, chosen as the cheapest setting whose rules beat m(z) by at least 0.025 on
-# the 1-5-object validation split (bench/preset_sweep.py on problems/dev, against the earlier default of min count
+# the 1-5-object validation split (experiments/preset_sweep.py on problems/dev, against the earlier default of min count
 # 50); it predicts what the robot saw next more often still, and Fast Downward takes about twice as long
 # (docs/DOMAIN.md, "Two presets")
+# "small": "fast" for a data set of a few thousand samples (the demo pipeline's), where a structure is seen a
+# few times at most: it becomes a rule from 3 moves. This table is the one place the presets are defined
+# (`export-pddl --preset` and the pipeline's presets name them).
 LIFTED_PRESETS = {"fast": LiftedConfig(),
                   "accurate": LiftedConfig(min_count=30, rider_min_count=3, pair_min_count=10,
                                            pool_min_count=POOL_MIN_COUNT, pool_classes=("cube",),
-                                           pool_structure_min=12, end_min_count=6)}
+                                           pool_structure_min=12, end_min_count=6),
+                  "small": LiftedConfig(min_count=3)}
 
 
 @dataclass(frozen=True)
@@ -228,7 +233,7 @@ class TrainingMoves:
     """What the training splits of a run's data sets show, read once: the code layout, the type reader, every
     move with its outcome (LiftedConfig.source), m(z)'s answers on the same moves, the picks at a stick's end, and
     why the other steps are no move. distil_rules makes rules of it under any LiftedConfig of the same source and
-    min_info (bench/preset_sweep.py compares settings on one reading)."""
+    min_info (experiments/preset_sweep.py compares settings on one reading)."""
 
     layout: CodeLayout
     stick_of: object
@@ -246,8 +251,8 @@ def training_moves(reader, transition, sets: Sequence[Path], cfg: LiftedConfig) 
     train = [split_codes(reader, d, "train") for d in sets]
     code_bits = reader.bits - FIELD_BITS
     objects = np.concatenate([s.before[s.mask] for s in train])
-    learned = bits_from_codes(objects >> FIELD_BITS, code_bits)
-    locations = (objects >> 6) & 7
+    learned_codes, (locations, _, _) = decode_location(objects)
+    learned = bits_from_codes(learned_codes, code_bits)
     layout = CodeLayout(code_bits, kept_bits(learned, locations, cfg.min_info))
     width = max(s.mask.shape[1] for s in train)
     stick_of = stick_reader(np.concatenate([_pad(s.before, width) for s in train]),
@@ -296,7 +301,8 @@ def export_lifted(run_dir: Path, data_dir: Path, extra_data: tuple[Path, ...] = 
     reader, transition = planning_models(run_dir)
     if reader.location_bits != FIELD_BITS:
         raise ValueError(f"{run_dir / TRANSITION_FILE}: a lifted domain needs m(z) on {FIELD_BITS} location bits "
-                         f"(train-transition --location-bits {FIELD_BITS}); this one has {reader.location_bits}")
+                         f"(train-transition --preset recommended, or [transition] location_bits = {FIELD_BITS} "
+                         f"in its --config); this one has {reader.location_bits}")
     model_hash = sha256_file(run_dir / TRANSITION_FILE)[:16]
     extra_data = distinct_extra_data(data_dir, extra_data)
     t0 = time.perf_counter()
@@ -401,8 +407,10 @@ def write_problem_folder(run_dir: Path, problems_dir: Path, out_dir: Path | None
     with no stale file left), and only where check_problem_folder allows it, which is checked first.
     Returns the index; problems with more objects than the data ever showed are listed under `zero_shot`.
     """
-    from pddl_export.lifted_rules import load_lifted
-    from pddl_export.lifted_writer import moves, problem_pddl, static_facts
+    from pddl_export.lifted_rules_io import load_lifted
+    from pddl_export.lifted_domain import static_facts
+    from pddl_export.lifted_moves import moves
+    from pddl_export.lifted_problem import problem_pddl
     from symlearn.problems.problem import load_problems
     from symlearn.symbolic.scenes import scene_codes, symbolic_goal
     from symlearn.sim.simulator import TabletopSimulator

@@ -23,6 +23,7 @@ import torch
 import torch.distributed as dist
 
 from pddl_export.bounded_json import read_json_file
+from symlearn.config_file import RECIPE
 from symlearn.learning.checkpoint import load_checkpoint, load_weights, save_checkpoint
 from symlearn.data.dataset import InteractionData, data_fingerprint, load_split
 from symlearn.data.model_input import model_inputs
@@ -86,8 +87,9 @@ class TrainConfig:
             raise ValueError(f"train config: {problem}")
 
     @staticmethod
-    def from_preset(name: str, **overrides) -> "TrainConfig":
-        """A named preset (TRAIN_PRESETS); model fields among the overrides go to the model config.
+    def from_preset(name: str = RECIPE, **overrides) -> "TrainConfig":
+        """A named preset (TRAIN_PRESETS; by default the recipe's, what `symlearn train` and the recommended
+        pipeline train); model fields among the overrides go to the model config.
 
         A positive dynamics_weight switches the model's dynamics head on.
         """

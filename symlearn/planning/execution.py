@@ -64,10 +64,12 @@ class FailureStage(str, Enum):
 
 @dataclass(frozen=True)
 class ExecutionConfig:
-    """How plans are executed and judged."""
+    """How plans are executed and judged. The defaults are the recipe's (docs/RESULTS.md), what `symlearn plan`,
+    `symlearn benchmark`, the library calls and the recommended pipeline all run: closed loop, 10 s a planner call.
+    """
 
     tolerance_m: float = GOAL_TOLERANCE_M  # every object within 2 cm of its goal position
-    closed_loop: bool = False  # replan when the observed codes depart from the prediction
+    closed_loop: bool = True  # recover (keep, fall back, replan) when the observed codes depart from the prediction
     max_replans: int = 3  # bound on replanning calls per problem
     max_fallbacks: int = 3  # bound on switches to another plan's suffix (top-k fallback) per problem
     # a replan after a departure that finds no plan (none exists in the planner's model, or none in time) leaves
@@ -75,10 +77,7 @@ class ExecutionConfig:
     # where the model has no plan from the observed codes (test set, Fast Downward on the lifted domain: 7 of 8
     # such stops reached the goal open loop)
     keep_plan_on_failed_replan: bool = True
-    timeout_s: float = 30.0  # per planner call
-    # astar-likely, astar-outcomes and rules-outcomes: each action costs 1 + risk_weight * (-log P(its predicted next
-    # state)) (rules-outcomes: risk_weight times a second outcome's extra -log P); symlearn.planning.planners
-    risk_weight: float = 1.0
+    timeout_s: float = 10.0  # per planner call
 
     def __post_init__(self) -> None:
         """Refuse what no execution can use (the checks of [execution] in a settings file, and of --timeout)."""
@@ -95,13 +94,16 @@ EXECUTION_BOUNDS = {
     "tolerance_m": Bound(0.0, 1.0, lo_open=True),  # metres: the table is about a metre across
     "max_replans": Bound(0, 1000, integer=True),
     "max_fallbacks": Bound(0, 1000, integer=True),
-    "risk_weight": Bound(0.0, 1e6, lo_open=True),
 }
 
 
-# How plan and benchmark execute by default, the recipe's (docs/RESULTS.md): replan when the scene departs from the
-# prediction, up to 3 times, 10 s a planner call.
-RECOMMENDED_EXECUTION = ExecutionConfig(closed_loop=True, timeout_s=10.0)
+# ExecutionConfig's named presets, the one place they are defined (the pipeline's presets name them).
+# "recommended": the defaults, the recipe's; "paper": the paper's execution, each plan run open loop as planned,
+# 30 s a planner call.
+EXECUTION_PRESETS = {
+    "recommended": ExecutionConfig(),
+    "paper": ExecutionConfig(closed_loop=False, timeout_s=30.0),
+}
 
 
 @dataclass(frozen=True)
@@ -194,7 +196,7 @@ def _codes(sim, encoder) -> tuple[int, ...]:
 
 
 def execute_plan(sim, problem: Problem, plan: PlanResult, encoder, goal: SymbolicGoal | np.ndarray,
-                 config: ExecutionConfig = ExecutionConfig(),
+                 config: ExecutionConfig = ExecutionConfig(closed_loop=False),  # without `replan`: open loop only
                  replan: Callable[[np.ndarray], PlanResult] | None = None,
                  record: Callable[[tuple, int, tuple], None] | None = None, recorder=None,
                  models: Sequence[TransitionFn] = ()) -> ExecutionResult:

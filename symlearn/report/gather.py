@@ -275,7 +275,7 @@ def benchmark_section(bench: dict | None, why: str = "") -> Section:
     return Section("benchmark", title, text=text, tables=tables)
 
 
-SHORTEST_COLUMNS = ("1-2", "3-4", "5-6", "7-8", "9-12", "off", "?")  # symlearn.planning.benchmark.SHORTEST_BUCKETS
+SHORTEST_COLUMNS = ("1-2", "3-4", "5-6", "7-8", "9-12", "off", "?")  # benchmark_summary.SHORTEST_BUCKETS
 
 
 def _shortest_tables(shortest: dict) -> list[Table]:
@@ -317,8 +317,8 @@ def plan_section(filmstrip: Path | None, gif: Path | None, why: str = "") -> Sec
     """One executed plan as a filmstrip (start, then after each action); `why` a recording could not be read."""
     title = "An executed plan"
     if filmstrip is None:
-        return not_run("plan", title, why or "no recorded plan: run 'symlearn plan ... --record RUN/plan.gif' or "
-                                             "'symlearn benchmark ... --record RUN/recordings'")
+        return not_run("plan", title, why or "no recorded plan: run 'symlearn plan ... --record RUN/plan.gif', or "
+                                             "give a GIF with 'symlearn report --recording GIF'")
     return Section("plan", title, text=[f"recorded in {gif}: start, then the scene after each action "
                                         "(arrow: pick -> release)"],
                    images=[Image("plan_filmstrip", f"Filmstrip of {Path(gif).name}", filmstrip)])
