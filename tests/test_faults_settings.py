@@ -500,3 +500,15 @@ def test_every_key_of_every_table_reaches_the_pipeline_stage_configs(tmp_path, p
             # the pipeline's --seed sets the seeds of collect and train (symlearn.pipeline: another fix's subject)
             skip = ("seed",) if table in ("collect", "train") else ()
             _assert_carries(cfg, settings.table(table), table, skip=skip)
+
+
+def test_a_pipeline_value_only_the_preset_refuses_names_the_file_and_key(tmp_path, capsys):
+    """`[train.model] n_heads = 128` passes over the class defaults but not over the preset's d_model 64: the pipeline
+    refuses it before OUT is made, in one line naming the file, the table and the key."""
+    config = tmp_path / "heads.toml"
+    config.write_text("[train.model]\nn_heads = 128\n")
+    rc, out = cli("pipeline", "--preset", "demo", "--out", tmp_path / "pipe", "--config", config)
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1, err
+    assert f"{config}: [train.model] n_heads: d_model 64 is not divisible by n_heads 128" in err
+    assert not (tmp_path / "pipe").exists()

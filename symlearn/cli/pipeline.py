@@ -8,11 +8,12 @@ calls the library directly, never this command line).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from pathlib import Path
 
 from symlearn.cli.args import add_config_flag, non_negative_int, positive_int
-from symlearn.config_file import read_config_file
-from symlearn.pipeline import run_pipeline
+from symlearn.config_file import ConfigFileError, built, read_config_file
+from symlearn.pipeline import run_pipeline, stage_configs
 from symlearn.pipeline_presets import DEFAULT_PRESET, PRESETS, PipelineSettings
 
 PRESETS_HELP = ("recommended (default): the recipe that plans best, at full scale (a paper-style data set and a "
@@ -28,9 +29,25 @@ def cmd_pipeline(args: argparse.Namespace) -> int:
     s = PipelineSettings(preset=args.preset, out=Path(args.out), n=args.n, seed=args.seed, epochs=args.epochs,
                          problems=args.problems, workers=args.workers, overrides=read_config_file(args.config),
                          stop_after=args.stop_after)
+    check_against_preset(s, args.config)
     run_pipeline(s, echo=lambda line: print(line, flush=True))
     print(f"wrote {s.out / 'pipeline.json'}; report at {s.out / 'run' / 'report.html'}")
     return 0
+
+
+def check_against_preset(s: PipelineSettings, path: Path | str | None) -> None:
+    """Refuse, in one line naming the settings file, the table and the key, a value that read_config_file accepted
+    over a class's defaults but the preset's stage configs refuse (`[train.model] n_heads = 128` where the preset's
+    d_model is 64): each table is tried alone over the preset (config_file.built finds the key); a refusal only the
+    tables together make is named by the file."""
+    try:
+        stage_configs(s)
+        return
+    except (ValueError, TypeError) as e:
+        together = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+    for table, values in s.overrides.items():
+        built(path, table, values, lambda v, t=table: stage_configs(dataclasses.replace(s, overrides={t: v})))
+    raise ConfigFileError(f"{path}: {together}" if path else together)
 
 
 def add_pipeline_command(sub) -> None:
