@@ -26,7 +26,7 @@ $(VENV)/.installed: pyproject.toml | $(BIN)/python
 # The recommended recipe at the demo preset (symlearn/pipeline.py): a paper-style data set and a 1-5-object one,
 # the stability-trained effect model, m(z) on 9 location bits, the lifted PDDL domain, problems by shortest-plan
 # length, and astar-outcomes next to stock Fast Downward on the lifted domain, closed loop; it ends with
-# runs/demo/run/report.html. From a fresh clone after `make test` (2026-12-03 and -04, 2 cores): 2:02-3:07 (idle, or
+# runs/demo/run/report.html. From a fresh clone after `make test` (2026-12-03 to -06, 2 cores): 2:02-3:19 (idle, or
 # beside one other job); closed loop on 18 problems of 1-3 objects, astar-outcomes solved 0.33-0.50 (its search
 # is timed) and fast-downward-lifted 0.61 (small models: the demo shows the system, not its results). Run again, it skips what
 # is done (runs/demo/pipeline.json).
