@@ -115,6 +115,22 @@ class TinyRun:
     export_report: dict  # RUN/pddl/report.json
 
 
+@pytest.fixture
+def tiny_preset(monkeypatch):
+    """`--preset tiny`: the demo preset with 1-object problems and a short planner timeout, for the test that asks
+    for it (the pipeline tests of test_report and test_faults_resume)."""
+    import dataclasses
+
+    from symlearn.pipeline_presets import PRESETS
+    from symlearn.planning.execution import EXECUTION_PRESETS
+
+    short = dataclasses.replace(EXECUTION_PRESETS[PRESETS["demo"].execution], timeout_s=2.0)
+    monkeypatch.setitem(EXECUTION_PRESETS, "tiny", short)
+    tiny = dataclasses.replace(PRESETS["demo"], problem_objects=(1, 1), execution="tiny")
+    monkeypatch.setitem(PRESETS, "tiny", tiny)
+    return tiny
+
+
 @pytest.fixture(scope="session")
 def sim():
     """One simulator for the session: every scenario rebuilds its own scene."""

@@ -20,7 +20,6 @@ are byte-identical: training is seeded and deterministic at these sizes, and the
 """
 from __future__ import annotations
 
-import dataclasses
 import json
 import re
 from pathlib import Path
@@ -36,20 +35,6 @@ TIMED_JSON = ("data/manifest.json", "data_extra/manifest.json", "run/metrics.jso
 WALL_FIELDS = re.compile(r"^(updated|crops_per_s|seconds|distil_seconds)$|time_s")  # "timeout_s" is a setting
 REPORTS = ("run/report.md", "run/report.html")
 TIME_COLUMN = "median time (s)"
-
-
-@pytest.fixture
-def tiny_preset(monkeypatch):
-    """`--preset tiny`: the demo preset with 1-object problems and a short planner timeout, for this file only."""
-    from symlearn.pipeline_presets import PRESETS
-
-    from symlearn.planning.execution import EXECUTION_PRESETS
-
-    short = dataclasses.replace(EXECUTION_PRESETS[PRESETS["demo"].execution], timeout_s=2.0)
-    monkeypatch.setitem(EXECUTION_PRESETS, "tiny", short)
-    tiny = dataclasses.replace(PRESETS["demo"], problem_objects=(1, 1), execution="tiny")
-    monkeypatch.setitem(PRESETS, "tiny", tiny)
-    return tiny
 
 
 def _settings_file(path: Path, transition_epochs: int) -> Path:

@@ -276,22 +276,6 @@ PIPE_ARGS = ("--preset", "tiny", "--n", 48, "--epochs", 1, "--config", Path(__fi
 STAGE_LINE = re.compile(r"^\[(\d+)/(\d+)\] (\S+) \.\.\. (skipped \(done\)|done in [\d.]+ s)$", re.M)
 
 
-@pytest.fixture
-def tiny_preset(monkeypatch):
-    """`--preset tiny`: the demo preset with 1-object problems and a short planner timeout, for this file only."""
-    import dataclasses
-
-    from symlearn.pipeline_presets import PRESETS
-
-    from symlearn.planning.execution import EXECUTION_PRESETS
-
-    short = dataclasses.replace(EXECUTION_PRESETS[PRESETS["demo"].execution], timeout_s=2.0)
-    monkeypatch.setitem(EXECUTION_PRESETS, "tiny", short)
-    tiny = dataclasses.replace(PRESETS["demo"], problem_objects=(1, 1), execution="tiny")
-    monkeypatch.setitem(PRESETS, "tiny", tiny)
-    return tiny
-
-
 def _stages(out: str) -> dict[str, str]:
     return {m.group(3): "skipped" if m.group(4).startswith("skipped") else "done" for m in STAGE_LINE.finditer(out)}
 
