@@ -15,10 +15,11 @@ from typing import Sequence
 import numpy as np
 
 from pddl_export.bounded_json import JsonFileError, read_json_file
+from pddl_export.files import sha256_stream
 from symlearn.provenance import sha256_bytes
 # the format is the writer's (collect); re-exported here, where readers have always found it
 from symlearn.sim.data_format import (DATA_KIND, FORMAT_VERSION, SPLITS, DataError, check_shard_entries,  # noqa: F401
-                                      open_shard, stream_sha256)
+                                      open_shard)
 
 ARRAY_NAMES = ("pre_depth", "post_depth", "pre_origin", "post_origin", "pre_pixels", "post_pixels",
                "action", "effect", "n_objects", "obj_type", "pre_pose", "post_pose", "grasped",
@@ -89,7 +90,7 @@ def _load_shard(root: Path, entry: dict, verify: bool) -> dict[str, np.ndarray]:
         raise DataError(f"shard {entry['name']} listed in the manifest is missing from {root}")
     with open_shard(path) as f:
         if verify:
-            if stream_sha256(f) != entry["sha256"]:
+            if sha256_stream(f) != entry["sha256"]:
                 raise DataError(f"shard {entry['name']} is corrupted or truncated (checksum mismatch)")
             f.seek(0)
         try:

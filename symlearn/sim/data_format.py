@@ -7,11 +7,11 @@ the stage that produces the data never imports the stages that consume it. See d
 """
 from __future__ import annotations
 
-import hashlib
 from pathlib import Path
 from typing import BinaryIO
 
 from pddl_export.bounded_json import JsonFileError, open_regular_file
+from pddl_export.files import sha256_stream
 
 FORMAT_VERSION = 1
 DATA_KIND = "symlearn-interaction-data"
@@ -34,18 +34,10 @@ def open_shard(path: Path) -> BinaryIO:
         raise DataError(str(e)) from None
 
 
-def stream_sha256(f: BinaryIO) -> str:
-    """Hex SHA-256 of what is left to read of an open file, in 1 MiB chunks (the file stays open)."""
-    h = hashlib.sha256()
-    for chunk in iter(lambda: f.read(1 << 20), b""):
-        h.update(chunk)
-    return h.hexdigest()
-
-
 def shard_sha256(path: Path) -> str:
     """Hex SHA-256 of a shard file, opened by open_shard (DataError for anything but a regular file)."""
     with open_shard(path) as f:
-        return stream_sha256(f)
+        return sha256_stream(f)
 
 
 def check_shard_entries(path: Path, m: dict) -> None:
