@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from pddl_export.bounded_json import loads_bounded
+from pddl_export.bounded_json import JsonFileError, loads_bounded, open_regular_file
 from symlearn.learning.models import AttentiveDeepSym, ModelConfig
 from symlearn.provenance import atomic_write_bytes, sha256_file, versions
 
@@ -59,6 +59,9 @@ def save_checkpoint(path: Path, *, model, optimizer=None, epoch: int = 0, best_v
     atomic_write_bytes(Path(path), buf.getvalue())
 
 
+MAX_CHECKPOINT_BYTES = 4 << 30  # a checkpoint of any preset is megabytes; 4 GiB is far beyond one
+
+
 @dataclass(frozen=True)
 class BlobKind:
     """One kind of checkpoint file a run holds, as guarded_blob checks it and names it in its one-line refusals."""
@@ -83,10 +86,13 @@ def guarded_blob(path: Path, kind: BlobKind) -> dict:
     path = Path(path)
     if not path.exists():
         raise kind.error(kind.missing.format(path=path))
-    if not path.is_file():
-        raise kind.error(f"{path} is not a regular file")
+    try:  # the bounded reader's open-and-check: the file loaded is the one checked
+        f = open_regular_file(path, MAX_CHECKPOINT_BYTES, "file")
+    except JsonFileError as e:
+        raise kind.error(str(e)) from None
     try:
-        blob = torch.load(path, map_location="cpu", weights_only=True)
+        with f:
+            blob = torch.load(f, map_location="cpu", weights_only=True)
     except Exception as e:  # torch raises several types for foreign, empty or truncated files
         raise kind.error(f"{path} is not a readable checkpoint ({_first_line(e)})") from None
     if not isinstance(blob, dict) or blob.get("kind") != kind.tag:
