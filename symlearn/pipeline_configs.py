@@ -8,6 +8,7 @@ import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from symlearn.config_file import flat_overrides, replace_nested
 from symlearn.pipeline_presets import DATA_EXTRA, PipelineSettings
 from symlearn.planning.planner_catalogue import PlannerConfig
 
@@ -111,7 +112,6 @@ def _extra_data(s: PipelineSettings) -> tuple[str, ...]:
 
 
 def collect_config(s: PipelineSettings) -> CollectConfig:
-    from symlearn.config_file import replace_nested
     from symlearn.sim.collect import CollectConfig
 
     cfg = replace_nested(CollectConfig(**_given(n=s.preset_values.samples)), s.table("collect"))
@@ -122,8 +122,6 @@ def collect_extra_config(s: PipelineSettings) -> CollectConfig:
     from symlearn.sim.collect import CollectConfig
     from symlearn.sim.exploration import ExplorationConfig
 
-    from symlearn.config_file import replace_nested
-
     p = s.preset_values
     cfg = replace_nested(CollectConfig(**_given(n=p.extra_samples)), s.table("collect"))
     return dataclasses.replace(cfg, seed=_seed(s, "collect") + EXTRA_SEED_OFFSET, **_given(n=s.n),
@@ -133,7 +131,6 @@ def collect_extra_config(s: PipelineSettings) -> CollectConfig:
 def train_config(s: PipelineSettings) -> TrainConfig:
     import torch
 
-    from symlearn.config_file import flat_overrides
     from symlearn.learning.training import TrainConfig
 
     p = s.preset_values
@@ -160,15 +157,11 @@ def transition_config(s: PipelineSettings) -> TransitionStageConfig:
 def export_config(s: PipelineSettings) -> ExportConfig:
     from symlearn.export.rules_export import ExportConfig
 
-    from symlearn.config_file import replace_nested
-
     return dataclasses.replace(replace_nested(ExportConfig(), s.table("export")), seed=_seed(s, "export"))
 
 
 def lifted_config(s: PipelineSettings) -> LiftedStageConfig:
     from symlearn.export.lifted_export import LIFTED_PRESETS
-
-    from symlearn.config_file import replace_nested
 
     cfg = replace_nested(LIFTED_PRESETS[s.preset_values.lifted], s.table("lifted"))
     return LiftedStageConfig(cfg, extra_data=_extra_data(s))
@@ -176,8 +169,6 @@ def lifted_config(s: PipelineSettings) -> LiftedStageConfig:
 
 def problems_config(s: PipelineSettings) -> ProblemsStageConfig:
     from symlearn.problems.problem_generation import N_PROBLEMS, ProblemConfig
-
-    from symlearn.config_file import replace_nested
 
     n = _first(s.problems, s.preset_values.problems, N_PROBLEMS)
     return ProblemsStageConfig(n=n, seed=_seed(s), problem=replace_nested(ProblemConfig(), s.table("problems")))
@@ -193,8 +184,6 @@ def stratified_config(s: PipelineSettings) -> StratifiedStageConfig:
 
 def benchmark_config(s: PipelineSettings) -> BenchmarkStageConfig:
     from symlearn.planning.execution import EXECUTION_PRESETS
-
-    from symlearn.config_file import replace_nested
 
     p = s.preset_values
     ex = EXECUTION_PRESETS[p.execution]

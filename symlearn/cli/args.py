@@ -5,7 +5,11 @@ import argparse
 import functools
 import importlib
 import os
-from typing import Sequence
+from typing import Any, Callable, Mapping, Sequence, TypeVar
+
+from symlearn.config_file import built, read_config_file
+
+T = TypeVar("T")
 
 
 
@@ -118,6 +122,12 @@ def add_preset_flag(c: argparse.ArgumentParser, table: str, default: str, help: 
     """--preset NAME, its choices the names of the preset table `table` ("module:NAME", PresetNames); `help` may say
     %(choices)s."""
     c.add_argument("--preset", default=default, choices=PresetNames(table), metavar="NAME", help=help)
+
+
+def config_from_file(args: argparse.Namespace, table: str, make: Callable[[Mapping[str, Any]], T]) -> T:
+    """make(values) with `values` the --config file's table `table` ({} without a file or that table): the config a
+    command runs with; what the config refuses is named by file, table and key (config_file.built)."""
+    return built(args.config, table, read_config_file(args.config).get(table, {}), make)
 
 
 def add_config_flag(c: argparse.ArgumentParser, tables: str) -> None:

@@ -14,12 +14,12 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from symlearn.cli.args import (THREADS_HELP, OneLineParser, add_config_flag, add_preset_flag, add_ray_flag, int_range,
-                               non_negative_int, positive_int, ray_engine, set_threads, thread_count)
+from symlearn.cli.args import (THREADS_HELP, OneLineParser, add_config_flag, add_preset_flag, add_ray_flag,
+                               config_from_file, int_range, non_negative_int, positive_int, ray_engine, set_threads, thread_count)
 from symlearn.cli.pipeline import add_pipeline_command
 from symlearn.cli.planning import add_planning_commands
 from symlearn.cli.report import add_plots_command, add_report_command
-from symlearn.config_file import RECIPE, read_config_file
+from symlearn.config_file import RECIPE
 from symlearn.outputs import folder_output
 
 if TYPE_CHECKING:  # the configs' modules load torch, numpy or the simulator: imported where a command runs
@@ -33,12 +33,11 @@ LIFTED_DEFAULT = "fast"  # export-pddl's preset: LiftedConfig()'s own values (li
 
 def collect_config(args: argparse.Namespace) -> CollectConfig:
     """CollectConfig's defaults with --config's [collect] table and the flags over them."""
-    from symlearn.config_file import built, replace_nested
+    from symlearn.config_file import replace_nested
     from symlearn.sim.collect import CollectConfig
     from symlearn.sim.exploration import ExplorationConfig
 
-    table = read_config_file(args.config).get("collect", {})  # [collect]
-    cfg = built(args.config, "collect", table, lambda v: replace_nested(CollectConfig(), v))
+    cfg = config_from_file(args, "collect", lambda v: replace_nested(CollectConfig(), v))
     if args.objects is not None:
         cfg = dataclasses.replace(cfg, exploration=ExplorationConfig.with_k_range(*args.objects))
     return dataclasses.replace(cfg, **{k: v for k, v in dict(n=args.n, seed=args.seed).items() if v is not None})
@@ -97,15 +96,14 @@ def _init_distributed() -> None:
 
 def train_config(args: argparse.Namespace) -> TrainConfig:
     """The --preset's TrainConfig with --config's [train] table and the flags over it."""
-    from symlearn.config_file import built, flat_overrides
+    from symlearn.config_file import flat_overrides
     from symlearn.learning.training import TrainConfig
 
     flags = {k: v for k, v in dict(epochs=args.epochs, seed=args.seed).items() if v is not None}
     if args.no_attention:
         flags["attention"] = False
-    table = read_config_file(args.config).get("train", {})  # [train] and [train.model]
-    return built(args.config, "train", table,
-                 lambda v: TrainConfig.from_preset(args.preset, **{**flat_overrides(v), **flags}))
+    return config_from_file(args, "train",  # [train] and [train.model]
+                            lambda v: TrainConfig.from_preset(args.preset, **{**flat_overrides(v), **flags}))
 
 
 def cmd_train(args: argparse.Namespace) -> int:
@@ -161,11 +159,10 @@ def cmd_symbols(args: argparse.Namespace) -> int:
 
 def lifted_config(args: argparse.Namespace) -> LiftedConfig:
     """The --preset's LiftedConfig with --config's [lifted] table over it."""
-    from symlearn.config_file import built, replace_nested
+    from symlearn.config_file import replace_nested
     from symlearn.export.lifted_export import LIFTED_PRESETS
 
-    table = read_config_file(args.config).get("lifted", {})  # [lifted]
-    return built(args.config, "lifted", table, lambda v: replace_nested(LIFTED_PRESETS[args.preset], v))
+    return config_from_file(args, "lifted", lambda v: replace_nested(LIFTED_PRESETS[args.preset], v))
 
 
 def cmd_export_lifted(args: argparse.Namespace) -> int:
@@ -201,7 +198,7 @@ def cmd_export_lifted(args: argparse.Namespace) -> int:
 
 
 def cmd_export_pddl(args: argparse.Namespace) -> int:
-    from symlearn.config_file import built, replace_nested
+    from symlearn.config_file import replace_nested
     from symlearn.export.rules_export import ExportConfig, export_pddl
 
     if not args.rules:
@@ -210,8 +207,7 @@ def cmd_export_pddl(args: argparse.Namespace) -> int:
         raise ValueError("--problems writes problem folders of the lifted domain; --rules does not")
     if args.preset != LIFTED_DEFAULT:
         raise ValueError(f"--preset {args.preset} chooses the lifted domain's settings; --rules takes [export] ones")
-    table = read_config_file(args.config).get("export", {})  # [export]
-    cfg = built(args.config, "export", table, lambda v: replace_nested(ExportConfig(), v))
+    cfg = config_from_file(args, "export", lambda v: replace_nested(ExportConfig(), v))
     out = folder_output(Path(args.out), "--out") if args.out else None  # before hours of enumeration
     set_threads(args.threads)
     rep = export_pddl(Path(args.run), Path(args.data[0]), cfg, out, extra_data=tuple(Path(d) for d in args.data[1:]))

@@ -29,9 +29,9 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from symlearn.cli.args import (THREADS_HELP, add_config_flag, add_preset_flag, add_ray_flag, int_range,
-                               non_negative_int, planner_list, positive_int, ray_engine, set_threads, thread_count)
-from symlearn.config_file import MAX_TIMEOUT_S, RECIPE, TIMEOUT_S, built, read_config_file
+from symlearn.cli.args import (THREADS_HELP, add_config_flag, add_preset_flag, add_ray_flag, config_from_file,
+                               int_range, non_negative_int, planner_list, positive_int, ray_engine, set_threads, thread_count)
+from symlearn.config_file import MAX_TIMEOUT_S, RECIPE, TIMEOUT_S
 from symlearn.planning.planner_catalogue import DEFAULT_PLANNER, planners_help
 
 if TYPE_CHECKING:  # the configs' modules load torch: imported where a command runs
@@ -55,8 +55,7 @@ def transition_config(args: argparse.Namespace) -> TransitionConfig:
     """The --preset's TransitionConfig with --config's [transition] table over it."""
     from symlearn.symbolic.transition_model import TransitionConfig
 
-    table = read_config_file(args.config).get("transition", {})  # [transition]
-    return built(args.config, "transition", table, lambda v: TransitionConfig.from_preset(args.preset, **v))
+    return config_from_file(args, "transition", lambda v: TransitionConfig.from_preset(args.preset, **v))
 
 
 def cmd_train_transition(args: argparse.Namespace) -> int:
@@ -198,8 +197,7 @@ def execution_config(args: argparse.Namespace) -> ExecutionConfig:
     from symlearn.config_file import replace_nested
     from symlearn.planning.execution import ExecutionConfig
 
-    table = read_config_file(args.config).get("execution", {})
-    cfg = built(args.config, "execution", table, lambda v: replace_nested(ExecutionConfig(), v))
+    cfg = config_from_file(args, "execution", lambda v: replace_nested(ExecutionConfig(), v))
     return cfg if args.timeout is None else dataclasses.replace(cfg, timeout_s=args.timeout)
 
 
@@ -208,8 +206,7 @@ def planner_config(args: argparse.Namespace):
     from symlearn.config_file import replace_nested
     from symlearn.planning.planner_catalogue import PlannerConfig
 
-    table = read_config_file(args.config).get("planner", {})
-    return built(args.config, "planner", table, lambda v: replace_nested(PlannerConfig(), v))
+    return config_from_file(args, "planner", lambda v: replace_nested(PlannerConfig(), v))
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
