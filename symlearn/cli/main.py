@@ -18,6 +18,7 @@ from symlearn.cli.args import (THREADS_HELP, OneLineParser, add_config_flag, add
                                config_from_file, int_range, non_negative_int, positive_int, ray_engine, set_threads, thread_count)
 from symlearn.cli.pipeline import add_pipeline_command
 from symlearn.cli.planning import add_planning_commands
+from symlearn.cli.relations import add_relations_commands
 from symlearn.cli.report import add_plots_command, add_report_command
 from symlearn.config_file import RECIPE
 from symlearn.outputs import folder_output
@@ -330,6 +331,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_collect_command(sub)
     add_scenarios_command(sub)
     add_train_command(sub)
+    add_relations_commands(sub)
     add_analysis_commands(sub)
     add_export_pddl_command(sub)
     add_planning_commands(sub)

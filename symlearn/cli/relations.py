@@ -1,0 +1,133 @@
+"""`symlearn train-relations` and `symlearn relations`: the learned relational model and its probe.
+
+    symlearn train-relations --data data/paper_a data/k15 --out RUN --epochs 20 --threads 2
+    symlearn relations --run RUN --data data/k15          # what each relation head was found to mean
+    symlearn carrying --run RUN                           # Table I and its variants, predicted and executed
+    symlearn export-learned --run RUN --data data/paper_a data/k15   # RUN/learned/domain.pddl
+    symlearn benchmark-learned --run RUN --problems DIR --out FILE  # closed loop with stock Fast Downward
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+from pathlib import Path
+
+from symlearn.cli.args import non_negative_int, positive_int, set_threads, thread_count
+from symlearn.outputs import folder_output
+
+
+def cmd_train_relations(args: argparse.Namespace) -> int:
+    from symlearn.learning.relational_training import RelationalTrainConfig, train_relations
+
+    overrides = {k: v for k, v in dict(epochs=args.epochs, seed=args.seed).items() if v is not None}
+    cfg = dataclasses.replace(RelationalTrainConfig(), **overrides)
+    for d in args.data:
+        if not (Path(d) / "manifest.json").is_file():
+            raise ValueError(f"{d}: not a data set folder (no manifest.json); make one with symlearn collect")
+    folder_output(Path(args.out), "--out")
+    set_threads(args.threads)
+    print(f"train-relations: {cfg.epochs} epochs, seed {cfg.seed} -> {args.out}", file=sys.stderr)
+    out = train_relations([Path(d) for d in args.data], Path(args.out), cfg, show=not args.quiet)
+    print(json.dumps({"run": args.out, "best_val_loss": out["best_val"], "last_epoch": out["history"][-1]}, indent=2))
+    return 0
+
+
+def cmd_relations(args: argparse.Namespace) -> int:
+    from symlearn.learning.relation_probe import format_probe, probe
+    from pddl_export.files import atomic_write_json
+
+    res = probe(Path(args.run), [Path(d) for d in args.data], args.split)
+    print(format_probe(res))
+    atomic_write_json(Path(args.run) / "relations_probe.json", res)
+    print(f"wrote {Path(args.run) / 'relations_probe.json'}")
+    return 0
+
+
+def cmd_carrying(args: argparse.Namespace) -> int:
+    from symlearn.learning.carrying import carrying
+    from pddl_export.files import atomic_write_json
+
+    res = carrying(Path(args.run))
+    if (Path(args.run) / "learned" / "operators.json").is_file():  # the carrying goals, planned and executed
+        from symlearn.planning.learned_benchmark import carry_goals
+
+        res["goals"] = carry_goals(Path(args.run), tuple(args.goal_relations or ()))
+        for g in res["goals"]:
+            print(f"goal {g['name']}: {'built' if g['success'] else 'not built'} with actions {g['actions']} "
+                  f"({g['stop']})")
+    for r in res["probes"]:
+        print(f"{r['name']:<18} " + "  ".join(f"{o['type']}: {'ok' if o['right'] else 'WRONG'} "
+                                              f"(pred {o['predicted_mm'][:2]}, truth {o['truth_mm'][:2]})"
+                                              for o in r["objects"]))
+    print(f"Table I objects right {res['table1_right']}; all {res['all_right']}; riders {res['riders_right']}")
+    atomic_write_json(Path(args.run) / "carrying.json", res)
+    return 0
+
+
+def cmd_export_learned(args: argparse.Namespace) -> int:
+    from symlearn.export.learned_export import export_learned
+
+    set_threads(args.threads)
+    given = {} if args.min_count is None else {"min_count": args.min_count}
+    rep = export_learned(Path(args.run), [Path(d) for d in args.data], **given)
+    print(json.dumps({k: rep[k] for k in ("operators", "min_count", "transitions")}))
+    return 0
+
+
+def cmd_benchmark_learned(args: argparse.Namespace) -> int:
+    from symlearn.planning.learned_benchmark import benchmark_learned
+
+    set_threads(args.threads)
+    res = benchmark_learned(Path(args.run), Path(args.problems), Path(args.out), args.timeout,
+                            tuple(args.goal_relations or ()), tuple(args.drop or ()))
+    print(json.dumps(res["summary"], indent=1))
+    return 0
+
+
+def add_relations_commands(sub) -> None:
+    """Add `train-relations` and `relations` to the CLI's sub-parsers."""
+    t = sub.add_parser("train-relations", help="train the relational effect model: unary and relational bits "
+                                               "over objects and table locations, learned by effect prediction")
+    t.add_argument("--data", required=True, nargs="+", help="one or more data sets (symlearn collect)")
+    t.add_argument("--out", required=True, help="run directory (resumed if it holds the same run)")
+    t.add_argument("--epochs", type=positive_int, help="default 30")
+    t.add_argument("--seed", type=non_negative_int, help="default 0")
+    t.add_argument("--threads", type=thread_count, help="CPU threads")
+    t.add_argument("--quiet", action="store_true")
+    t.set_defaults(func=cmd_train_relations)
+
+    r = sub.add_parser("relations", help="what each learned relation means: its bits against at/on read from "
+                                         "the data set's recorded poses (analysis only)")
+    r.add_argument("--run", required=True, help="a run of train-relations")
+    r.add_argument("--data", required=True, nargs="+")
+    r.add_argument("--split", default="val", choices=("train", "val", "test"))
+    r.set_defaults(func=cmd_relations)
+
+    c = sub.add_parser("carrying", help="Table I and carrying variants: the relational model's predictions "
+                                        "against the simulator's")
+    c.add_argument("--run", required=True)
+    c.add_argument("--goal-relations", nargs="*", help="with RUN/learned/: object-object heads the goals keep")
+    c.set_defaults(func=cmd_carrying)
+
+    x = sub.add_parser("export-learned", help="operators over the learned predicates, found from data, as PDDL "
+                                              "(RUN/learned/domain.pddl)")
+    x.add_argument("--run", required=True)
+    x.add_argument("--data", required=True, nargs="+")
+    x.add_argument("--min-count", type=positive_int, help="drop a lifted effect seen fewer times (default "
+                                                          "learned_export.MIN_COUNT)")
+    x.add_argument("--threads", type=thread_count)
+    x.set_defaults(func=cmd_export_learned)
+
+    b = sub.add_parser("benchmark-learned", help="the learned route closed loop in simulation: observe, learned "
+                                                 "state, stock Fast Downward, act, repeat")
+    b.add_argument("--run", required=True)
+    b.add_argument("--problems", required=True)
+    b.add_argument("--out", required=True, help="result JSON file (resumed: finished problems are kept)")
+    b.add_argument("--timeout", type=float, default=10.0, help="seconds per planner call (10)")
+    b.add_argument("--goal-relations", nargs="*", help="object-object heads the goal keeps, e.g. r1")
+    b.add_argument("--drop", nargs="*", help="the ablation: predicates removed from the domain, the states and the "
+                                             "goal, e.g. r1 nothing-r1")
+    b.add_argument("--threads", type=thread_count)
+    b.set_defaults(func=cmd_benchmark_learned)

@@ -1,0 +1,126 @@
+"""What each learned relation was found to mean: its bits against relations read from the simulator's poses.
+
+An analysis, never an input of the learned route: the probe computes, from the data set's true poses
+(`pre_pose`, `obj_type`, recorded for analysis only), two relations a person would name, and scores every
+relation head of a trained relational model against them over the pairs of a split:
+
+- `at(o, l)`: object o's centre lies within AT_M of table location l (horizontally); `nearest(o, l)`: l is the
+  table location nearest o's centre (every object has one, also one standing off the locations);
+- `on(a, b)`: object a rests on object b: a's bottom within CONTACT_M of b's top and a's centre over b's
+  footprint (b's extents turned by its yaw, plus a margin).
+
+For a head k and a kind of pair (object-location, object-object), `holds_given` is P(r_k = 1 | relation)
+and `given_holds` is P(relation | r_k = 1); a head "means" a relation when both are high.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+import torch
+
+from symlearn.learning.relational_training import EntitySplit, entity_split, load_relational
+from symlearn.world import LOCATIONS, OBJECT_SIZE, ObjectType
+
+AT_M = 0.05
+CONTACT_M = 0.02
+FOOTPRINT_MARGIN_M = 0.01
+_HALF = {t.value: np.array(OBJECT_SIZE[t]) / 2 for t in ObjectType}
+
+
+def yaw_of(quat: np.ndarray) -> np.ndarray:
+    """Yaw (rad) of (..., 4) xyzw quaternions."""
+    x, y, z, w = np.moveaxis(quat, -1, 0)
+    return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+
+
+def oracle_at(pose: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(N, K, L) bool: object centre within AT_M of each location."""
+    d = np.linalg.norm(pose[..., None, :2] - np.array(LOCATIONS)[None, None], axis=-1)
+    return (d < AT_M) & mask[..., None]
+
+
+def oracle_nearest(pose: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(N, K, L) bool: the location nearest each object's centre (one per real object)."""
+    d = np.linalg.norm(pose[..., None, :2] - np.array(LOCATIONS)[None, None], axis=-1)
+    return (np.arange(len(LOCATIONS))[None, None] == d.argmin(-1)[..., None]) & mask[..., None]
+
+
+def oracle_on(pose: np.ndarray, types: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(N, K, K) bool: [a, b] when object a rests on object b."""
+    half = np.where(types[..., None] == ObjectType.STICK, _HALF[1], _HALF[0])  # (N, K, 3)
+    bottom = pose[..., 2] - half[..., 2]
+    top = pose[..., 2] + half[..., 2]
+    touch = np.abs(bottom[:, :, None] - top[:, None, :]) < CONTACT_M
+    yaw = yaw_of(pose[..., 3:])
+    dx = pose[:, :, None, 0] - pose[:, None, :, 0]
+    dy = pose[:, :, None, 1] - pose[:, None, :, 1]
+    c, s = np.cos(yaw)[:, None, :], np.sin(yaw)[:, None, :]
+    u, v = c * dx + s * dy, -s * dx + c * dy  # a's centre in b's frame
+    over = (np.abs(u) < half[:, None, :, 0] + FOOTPRINT_MARGIN_M) & (np.abs(v) < half[:, None, :, 1] + FOOTPRINT_MARGIN_M)
+    k = pose.shape[1]
+    pair = mask[:, :, None] & mask[:, None, :] & ~np.eye(k, dtype=bool)[None]
+    return touch & over & pair
+
+
+@torch.no_grad()
+def relation_bits(model, split: EntitySplit, windows: torch.Tensor, batch_size: int = 256) -> np.ndarray:
+    """(N, R, E, E) bool: the model's relational bits on a split's pre-states (evaluation: thresholded)."""
+    out = []
+    for a in range(0, len(split), batch_size):
+        idx = torch.arange(a, min(a + batch_size, len(split)))
+        obj, mask, loc, _ = split.inputs(idx, windows)
+        out.append(model.symbols(obj, mask, loc)[2].bool().numpy())
+    return np.concatenate(out)
+
+
+def score(bits: np.ndarray, truth: np.ndarray, valid: np.ndarray) -> dict:
+    """P(bit | truth), P(truth | bit) and P(bit) over the valid pairs."""
+    b, t = bits[valid], truth[valid]
+    return {"holds_given": round(float(b[t].mean()), 4) if t.any() else None,
+            "given_holds": round(float(t[b].mean()), 4) if b.any() else None,
+            "rate": round(float(b.mean()), 4), "pairs": int(valid.sum()), "true_pairs": int(t.sum())}
+
+
+def probe(run_dir: Path, roots: Sequence[Path], split: str = "val") -> dict:
+    """Score every relation head of RUN/relations.pt on a split of the data sets `roots`."""
+    from symlearn.data.dataset import load_split
+
+    model, blob = load_relational(run_dir)
+    windows_np = blob["windows"].numpy()
+    k = int(blob["max_objects"])
+    data, _, _ = entity_split(roots, split, windows_np, k, blob["mean"].numpy(), blob["std"].numpy())
+    pose = np.concatenate([np.pad(d.pre_pose, [(0, 0), (0, k - d.pre_pose.shape[1]), (0, 0)])
+                           for d in (load_split(Path(r), split) for r in roots)])
+    types = np.concatenate([np.pad(d.obj_type, [(0, 0), (0, k - d.obj_type.shape[1])], constant_values=-1)
+                            for d in (load_split(Path(r), split) for r in roots)])
+    mask = data.mask.numpy()
+    bits = relation_bits(model, data, torch.from_numpy(windows_np.astype(np.float32)))
+    at, on = oracle_at(pose, mask), oracle_on(pose, types, mask)
+    n_loc = len(LOCATIONS)
+    obj_loc_valid = np.broadcast_to(mask[..., None], at.shape)
+    obj_obj_valid = mask[:, :, None] & mask[:, None, :] & ~np.eye(k, dtype=bool)[None]
+    heads = []
+    for h in range(bits.shape[1]):
+        ol, oo = bits[:, h, :k, k:k + n_loc], bits[:, h, :k, :k]
+        lo = bits[:, h, k:k + n_loc, :k].transpose(0, 2, 1)
+        heads.append({"head": h,
+                      "object_location": {"at": score(ol, at, obj_loc_valid),
+                                          "nearest": score(ol, oracle_nearest(pose, mask), obj_loc_valid)},
+                      "location_object": {"at": score(lo, at, obj_loc_valid)},
+                      "object_object": {"on": score(oo, on, obj_obj_valid),
+                                        "under": score(oo, on.transpose(0, 2, 1), obj_obj_valid)}})
+    return {"run": str(run_dir), "data": [str(r) for r in roots], "split": split, "heads": heads}
+
+
+def format_probe(res: dict) -> str:
+    """The probe as a table: per head, P(bit | relation) and P(relation | bit) for each pair kind."""
+    lines = [f"{'head':>4}  {'pairs':<16} {'relation':<6} {'P(bit|rel)':>10} {'P(rel|bit)':>10} {'P(bit)':>7}"]
+    for h in res["heads"]:
+        for kind in ("object_location", "location_object", "object_object"):
+            for name, s in h[kind].items():
+                f = lambda v: "-" if v is None else f"{v:.3f}"  # noqa: E731
+                lines.append(f"{h['head']:>4}  {kind:<16} {name:<6} {f(s['holds_given']):>10} "
+                             f"{f(s['given_holds']):>10} {s['rate']:>7.3f}")
+    return "\n".join(lines)

@@ -1,0 +1,283 @@
+"""The relational model: location entities, learned unary and relational bits, its training and its probes."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from symlearn.learning.carrying import CARRY_PROBES, judge
+from symlearn.learning.entities import location_crops, location_windows, project_to_pixels
+from symlearn.learning.relational import RelationalConfig, RelationalDeepSym
+from symlearn.learning.relation_probe import oracle_at, oracle_on
+from symlearn.sim.camera import CameraConfig
+from symlearn.world import LOCATIONS, ObjectType
+
+from conftest import cli
+
+C, S = ObjectType.CUBE, ObjectType.STICK
+
+
+def _scene(sim, spec):
+    sim.build(spec)
+    obs = sim.observe()
+    return obs, sim.get_scene()
+
+
+def test_location_windows_sit_where_the_camera_sees_objects_at_the_locations(sim):
+    # a cube dropped at each location: its crop (centred on its visible pixels) lies within 4 px of the window
+    windows = location_windows(CameraConfig(), 64)
+    for loc in range(6):
+        obs, _ = _scene(sim, ((C, loc),))
+        assert np.abs(obs.origins[0].astype(int) - windows[loc]).max() <= 4, (loc, obs.origins[0], windows[loc])
+
+
+def test_projection_inverts_the_crop_rays():
+    cam = CameraConfig()
+    px = project_to_pixels(np.array([cam.target]), cam)[0]
+    assert np.allclose(px, [cam.size / 2 - 0.5] * 2, atol=1e-6)  # the target is seen at the image centre
+
+
+def test_location_crop_shows_what_stands_there(sim):
+    obs, _ = _scene(sim, ((C, 4), (C, 0)))
+    windows = location_windows(CameraConfig(), 64)
+    crops = location_crops(obs.crops[None].astype(np.float16), obs.origins[None], np.array([2]), windows)[0]
+    seen = (crops > 0).sum((1, 2))
+    assert seen[4] > 200 and seen[0] > 200, seen
+    assert seen[5] == 0 and seen[2] == 0, seen  # the far cells beside no object stay empty
+    # the pasted pixels are the objects' own depths
+    assert np.isclose(crops[4][crops[4] > 0].astype(np.float32).min(), obs.crops[0][obs.crops[0] > 0].min(), atol=2e-3)
+
+
+def _model():
+    torch.manual_seed(0)
+    return RelationalDeepSym(RelationalConfig(conv_channels=(8, 8, 8, 8), feature_dim=16, hidden=16,
+                                              decoder_hidden=(16,))).eval()
+
+
+def test_symbols_at_evaluation_are_bits_and_at_is_one_location_per_object():
+    m = _model()
+    obj, loc = torch.rand(2, 4, 3, 64, 64), torch.rand(2, 6, 3, 64, 64)
+    mask = torch.tensor([[1, 1, 1, 0], [1, 0, 0, 0]]).bool()
+    out = m(obj, mask, loc, torch.tensor([3, 20]))
+    assert set(out.relations.unique().tolist()) <= {0.0, 1.0}
+    at = out.relations[:, 0, :4, 4:]
+    assert at.sum(-1).tolist() == [[1, 1, 1, 0], [1, 0, 0, 0]]  # exactly one location per real object
+    assert out.relations[1, :, 1:4].abs().sum() == 0 and out.relations[1, :, :, 1:4].abs().sum() == 0  # padding
+    assert out.relations[:, 1:, torch.arange(4), torch.arange(4)].abs().sum() == 0  # no object relates to itself
+    assert out.effect[1, 1:].abs().sum() == 0
+
+
+def test_the_model_is_equivariant_to_the_order_of_objects():
+    m = _model()
+    obj, loc = torch.rand(1, 3, 3, 64, 64), torch.rand(1, 6, 3, 64, 64)
+    mask, act = torch.ones(1, 3, dtype=torch.bool), torch.tensor([7])
+    a = m(obj, mask, loc, act)
+    perm = torch.tensor([2, 0, 1])
+    b = m(obj[:, perm], mask, loc, act)
+    assert torch.allclose(a.effect[:, perm], b.effect, atol=1e-5)
+    assert torch.equal(a.codes[:, perm], b.codes)
+    ent = torch.cat([perm, torch.arange(3, 9)])
+    assert torch.equal(a.relations[:, :, ent][:, :, :, ent], b.relations)
+
+
+def test_object_codes_do_not_see_where_an_object_is():
+    # the same depth crop at another image position and 20 cm further from the camera: the unary code is the same
+    # (it reads depth relative to the crop's nearest pixel only); the location relation may change
+    m = _model()
+    depth = torch.zeros(1, 1, 64, 64)
+    depth[..., 20:40, 25:35] = 1.0 + torch.linspace(0, 0.05, 20)[:, None]
+    pos = torch.stack(torch.meshgrid(torch.linspace(0, 0.25, 64), torch.linspace(0, 0.25, 64), indexing="xy"))
+    a = torch.cat([depth, pos[None]], 1)[:, None]
+    b = torch.cat([depth + 0.2 * (depth > 0), pos[None] + 0.5], 1)[:, None]
+    loc = torch.rand(1, 6, 3, 64, 64)
+    mask = torch.ones(1, 1, dtype=torch.bool)
+    ca = m.symbols(a, mask, loc)[0]
+    cb = m.symbols(b, mask, loc)[0]
+    assert torch.equal(ca, cb)
+    fa, fb = m.features(a, mask, loc), m.features(b, mask, loc)
+    assert not torch.allclose(fa[:, 0], fb[:, 0])  # the relation heads do see it
+
+
+def test_oracle_relations_of_the_probe_read_a_stack_and_a_rider(sim):
+    _, scene = _scene(sim, ((S, 1), (C, 0), (C, 0)))  # two cubes stacked on the stick's left end
+    pose = np.array([[list(o.position) + list(o.orientation) for o in scene.objects]], np.float32)
+    types = np.array([[int(o.type) for o in scene.objects]])
+    mask = np.ones((1, 3), bool)
+    on = oracle_on(pose, types, mask)[0]
+    assert on.tolist() == [[False, False, False], [True, False, False], [False, True, False]]
+    at = oracle_at(pose, mask)[0]
+    assert at[0].tolist() == [i == 1 for i in range(6)]
+    assert at[1, 0] and at[2, 0]
+
+
+def test_carrying_verdicts():
+    assert judge(np.array([0.0, 178.0, 0.0]), np.array([0.0, 180.0, 0.0]))["right"]
+    assert not judge(np.array([0.0, 100.0, 0.0]), np.array([0.0, 180.0, 0.0]))["right"]  # a rider 80 mm short
+    assert not judge(np.array([0.0, 266.0, 0.0]), np.array([0.0, 0.0, 0.0]))["right"]  # a false rider
+    assert judge(np.array([5.0, -8.0, 40.0]), np.array([0.0, 0.0, 0.0]))["right"]  # still: horizontal only
+    names = [p.name for p in CARRY_PROBES]
+    assert len(set(names)) == len(names) and {"table1_case1", "table1_case2", "table1_case3"} <= set(names)
+    for p in CARRY_PROBES:
+        assert p.order is None or sorted(p.order) == list(range(len(p.spec)))
+        assert all(0 <= loc < len(LOCATIONS) for _, loc in p.spec)
+
+
+def test_probe_scenes_show_the_physics_they_name(sim):
+    # the truth each probe relies on: riders move with the stick, the stack beside it does not
+    from symlearn.learning.carrying import CARRY_PROBES as P
+
+    want = {"table1_case2": [True, False, True], "stack_beside_near": [True, False, False],
+            "stack_beside_far": [True, False, False], "stacked_on_end": [True, True, True]}
+    for p in P:
+        if p.name in want:
+            sim.build(p.spec)
+            eff = sim.step(p.action).effect
+            assert [bool(np.linalg.norm(e[:2]) >= 0.1) for e in eff] == want[p.name], (p.name, eff)
+
+
+def test_train_relations_trains_resumes_and_refuses_other_settings(tiny_data, tmp_path, capsys):
+    out = tmp_path / "rel"
+    rc, text = cli("train-relations", "--data", tiny_data.path, "--out", out, "--epochs", "1", "--threads", "1", "--quiet")
+    assert rc == 0, text
+    blob = torch.load(out / "relations.pt", map_location="cpu", weights_only=True)
+    assert blob["epoch"] == 1 and blob["windows"].shape == (6, 2)
+    metrics = json.loads((out / "relations_metrics.json").read_text())
+    assert len(metrics["history"]) == 1 and np.isfinite(metrics["history"][0]["mae_mm"])
+    rc, text = cli("train-relations", "--data", tiny_data.path, "--out", out, "--epochs", "2", "--threads", "1", "--quiet")
+    assert rc == 0, text  # resumed: one more epoch
+    assert [h["epoch"] for h in json.loads((out / "relations_metrics.json").read_text())["history"]] == [1, 2]
+    rc, text = cli("train-relations", "--data", tiny_data.path, "--out", out, "--epochs", "2", "--seed", "3",
+                   "--threads", "1", "--quiet")
+    assert rc == 2 and "other settings" in capsys.readouterr().err
+    rc, text = cli("train-relations", "--data", tmp_path / "nowhere", "--out", tmp_path / "r2", "--quiet")
+    assert rc == 2 and "not a data set folder" in capsys.readouterr().err and not (tmp_path / "r2").exists()
+
+
+def test_the_grasp_loss_pulls_the_held_object_to_the_pick_location_only():
+    from symlearn.learning.relational_training import grasp_loss
+
+    k = 3
+    logits = torch.zeros(2, 4, k + 6, k + 6, requires_grad=True)
+    held, actions = torch.tensor([1, -1]), torch.tensor([4 * 6 + 2, 7])  # scene 0: object 1 held, picked at l4
+    loss = grasp_loss(logits, held, actions, k)
+    assert torch.isclose(loss, torch.log(torch.tensor(6.0)))  # uniform over 6 locations
+    loss.backward()
+    g = logits.grad
+    assert g[0, 0, 1, k + 4] < 0 and (g[0, 0, 1, k:k + 4] > 0).all()  # raise l4, lower the others
+    assert g[1].abs().sum() == 0 and g[0, 0, [0, 2]].abs().sum() == 0 and g[:, 1:].abs().sum() == 0
+    assert grasp_loss(logits, torch.tensor([-1, -1]), actions, k) == 0
+
+
+def test_the_learned_route_end_to_end_exports_a_domain_and_benchmarks_closed_loop(tiny_data, tmp_path, capsys):
+    import pddl
+
+    run, problems = tmp_path / "rel", tmp_path / "problems"
+    assert cli("train-relations", "--data", tiny_data.path, "--out", run, "--epochs", "1", "--threads", "1",
+               "--quiet")[0] == 0
+    rc, text = cli("export-learned", "--run", run, "--data", tiny_data.path, "--min-count", "1", "--threads", "1")
+    assert rc == 0, capsys.readouterr().err
+    report = json.loads((run / "learned" / "report.json").read_text())
+    ops = json.loads((run / "learned" / "operators.json").read_text())
+    assert report["operators"] == len(ops) and report["transitions"]["changed"] >= report["transitions"]["covered"]
+    domain = pddl.parse_domain(run / "learned" / "domain.pddl")
+    assert {a.name for a in domain.actions} == {o["name"] for o in ops}
+    assert {p.name for p in domain.predicates} >= {"at"}
+    assert cli("problems", "--out", problems, "--kind", "located-walks", "--n", "2", "--objects", "1-1",
+               "--length", "1-1", "--seed", "3")[0] == 0
+    out = tmp_path / "bench.json"
+    rc, _ = cli("benchmark-learned", "--run", run, "--problems", problems, "--out", out, "--timeout", "5")
+    assert rc == 0, capsys.readouterr().err
+    res = json.loads(out.read_text())
+    assert [r["k"] for r in res["results"]] == [1, 1]
+    for r in res["results"]:
+        assert isinstance(r["success"], bool) and r["stop"]
+        assert r["success"] == (r["stop"] == "goal reached")
+        assert len(r["plan_times_s"]) >= len(r["actions"])  # one planner call before every action
+    assert res["summary"]["1-5"]["problems"] == 2
+    before = out.read_bytes()
+    assert cli("benchmark-learned", "--run", run, "--problems", problems, "--out", out, "--timeout", "5")[0] == 0
+    assert json.loads(out.read_bytes())["results"] == json.loads(before)["results"]  # resumed: nothing rerun
+    rc, _ = cli("benchmark-learned", "--run", run, "--problems", problems, "--out", out, "--timeout", "7")
+    assert rc == 2 and "other settings" in capsys.readouterr().err and out.read_bytes() == before
+
+
+def test_the_ride_loss_reads_r1_of_every_object_against_the_held_one():
+    from symlearn.learning.relational_training import ride_loss
+
+    k = 3
+    logits = torch.zeros(1, 4, k + 6, k + 6, requires_grad=True)
+    mask = torch.tensor([[True, True, True]])
+    rider = torch.tensor([[False, False, True]])  # object 2 rode on the held object 0; object 1 stayed
+    ride_loss(logits, torch.tensor([0]), rider, mask).backward()
+    g = logits.grad[0, 1]
+    assert g[2, 0] < 0 and g[1, 0] > 0  # raise r1(2, 0), lower r1(1, 0)
+    assert g[0, 0] == 0 and logits.grad.abs().sum() == g[1, 0].abs() + g[2, 0].abs()
+
+
+def test_the_ride_loss_puts_what_stayed_at_the_pick_location_under_the_held_object():
+    from symlearn.learning.relational_training import ride_loss
+
+    k = 3
+    logits = torch.zeros(1, 4, k + 6, k + 6, requires_grad=True)
+    at = torch.zeros(1, k + 6, k + 6)
+    at[0, 0, k + 4] = at[0, 1, k + 4] = at[0, 2, k + 1] = 1  # objects 0 and 1 at l4, object 2 at l1
+    mask, rider = torch.ones(1, 3, dtype=torch.bool), torch.zeros(1, 3, dtype=torch.bool)
+    ride_loss(logits, torch.tensor([0]), rider, mask, at, torch.tensor([4 * 6 + 2])).backward()
+    g = logits.grad[0, 1]
+    assert g[0, 1] < 0  # object 0 was picked at l4 and object 1 stayed there: r1(0, 1), "0 rests on 1", raised
+    assert g[0, 2] == 0  # object 2 stood elsewhere: no claim about r1(0, 2)
+    assert g[1, 0] > 0 and g[2, 0] > 0  # neither rode along: r1(1, 0) and r1(2, 0) lowered
+
+
+SHIPPED = Path(__file__).resolve().parents[1] / "pretrained" / "relations"
+
+
+def test_the_shipped_model_places_a_cube_at_the_location_it_stands_at(sim):
+    from symlearn.learning.relational_training import load_relational
+    from symlearn.planning.learned_loop import observe_atoms
+
+    model, blob = load_relational(SHIPPED)
+    for loc in range(6):
+        sim.build(((C, loc),))
+        atoms = observe_atoms(sim, model, blob)
+        assert ("at", "o1", f"l{loc}") in atoms, (loc, sorted(atoms))
+        assert {a for a in atoms if a[0] == "empty"} == {("empty", f"l{j}") for j in range(6) if j != loc}
+    sim.build(((C, 3), (C, 3)))  # a stack: both cubes at l3, nothing else
+    atoms = observe_atoms(sim, model, blob)
+    assert {a for a in atoms if a[0] == "at"} == {("at", "o1", "l3"), ("at", "o2", "l3")}
+
+
+def test_a_problem_written_by_hand_from_the_docs_is_solved_by_stock_planners():
+    # docs/RELATIONS.md: objects, their `at` facts, the empty locations and a goal of `at` facts; no static facts
+    from search.classical import solve_pddl
+    from search.stock_planners import solve_texts
+
+    domain = (SHIPPED / "learned" / "domain.pddl").read_text()
+    problem = """(define (problem swap) (:domain learned-relations)
+  (:objects a b - item)
+  (:init (at a l0) (at b l3) (empty l1) (empty l2) (empty l4) (empty l5))
+  (:goal (and (at a l3) (at b l0))))"""
+    plans = {p: solve_texts(domain, problem, p, 60.0) for p in ("fd-lama-first", "fd-lmcut", "pyperplan")}
+    for name, res in plans.items():
+        assert res.status.name == "SOLVED", (name, res.message)
+    # the optimal plan uses move-12, a swap of two objects the data showed 63 times (docs/RELATIONS.md: an artefact of
+    # the learned `at` when a stick's end covers a cell); lama may make room instead; neither is longer than 3 moves
+    assert [s.split()[0] for s in plans["fd-lmcut"].steps] == ["(move-12"]
+    assert all(len(r.steps) <= 3 for r in plans.values())
+    up = solve_pddl(domain, problem, "fast-downward", 60.0)
+    assert up.status.name == "SOLVED" and 1 <= len(up.steps) <= 3, up.message  # UP's validator accepted it
+
+
+def test_the_learned_commands_refuse_bad_input_in_one_line(tmp_path, capsys):
+    rc, _ = cli("benchmark-learned", "--run", SHIPPED, "--problems", tmp_path, "--out", tmp_path / "b.json",
+                "--timeout", "-1")
+    err = capsys.readouterr().err
+    assert rc == 2 and "timeout_s=-1" in err and len(err.strip().splitlines()) == 1 and not (tmp_path / "b.json").exists()
+    rc, _ = cli("export-learned", "--run", tmp_path, "--data", tmp_path)
+    err = capsys.readouterr().err
+    assert rc == 2 and "relations.pt" in err and not (tmp_path / "learned").exists()
+    rc, _ = cli("benchmark-learned", "--run", tmp_path, "--problems", tmp_path, "--out", tmp_path / "b.json")
+    assert rc == 2 and "export-learned" in capsys.readouterr().err
