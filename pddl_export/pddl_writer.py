@@ -149,6 +149,11 @@ def action_name(action: int) -> str:
     return f"pick-{int(action) // N_LOCATIONS}-release-{int(action) % N_LOCATIONS}"
 
 
+def names_action_id(name: str) -> bool:
+    """Whether an action name is 'pick-P-release-R[-sN]' (the rules' domains), which action_id_from_name reads."""
+    return bool(_ACTION_RE.match(name))
+
+
 def action_id_from_name(name: str) -> int:
     """Action id of 'pick-P-release-R' or of a grounded 'pick-P-release-R-sN'."""
     m = _ACTION_RE.match(name)

@@ -208,4 +208,4 @@ def solve_pddl(
     extra.setdefault("planner_time_s", 0.0)
     return PlanResult(planner=inner.planner, status=inner.status, plan=inner.plan,
                       predicted_states=inner.predicted_states, expansions=inner.expansions,
-                      planning_time_s=total, message=inner.message, extra=extra)
+                      planning_time_s=total, message=inner.message, extra=extra, steps=inner.steps)

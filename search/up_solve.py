@@ -13,7 +13,7 @@ import warnings
 from dataclasses import dataclass
 from typing import Any
 
-from pddl_export.pddl_writer import action_id_from_name
+from pddl_export.pddl_writer import action_id_from_name, names_action_id
 from search.result import PlanResult, PlanStatus, failed
 from search.up_problem import predicted_states, problem_on_domain, with_only_actions
 
@@ -174,14 +174,19 @@ def _validated_plan(original: Any, plan: Any, chain: tuple[Any, ...], planner: s
         if check.status != ValidationResultStatus.VALID:
             reason = getattr(check, "reason", None) or getattr(check, "inapplicable_action", None) or ""
             return failed(planner, PlanStatus.ERROR, t0, f"plan failed validation on the original problem {reason}", **extra)
-        ids = tuple(action_id_from_name(ai.action.name) for ai in plan.actions)
-        states, note = predicted_states(checked, plan)
+        steps = tuple("(" + " ".join([ai.action.name, *(str(p) for p in ai.actual_parameters)]) + ")"
+                      for ai in plan.actions)
+        if all(names_action_id(ai.action.name) for ai in plan.actions):
+            ids = tuple(action_id_from_name(ai.action.name) for ai in plan.actions)
+            states, note = predicted_states(checked, plan)
+        else:  # a domain whose actions are not named by their action ids (the learned relational domain): steps
+            ids, states, note = (), (), ""
     except Exception as e:  # noqa: BLE001
         return failed(planner, PlanStatus.ERROR, t0, f"plan mapping/validation failed: {type(e).__name__}: {e}", **extra)
     if note:
         extra["note"] = note
     return PlanResult(planner=planner, status=PlanStatus.SOLVED, plan=ids, predicted_states=states,
-                      expansions=expansions, planning_time_s=time.perf_counter() - t0, extra=extra)
+                      expansions=expansions, planning_time_s=time.perf_counter() - t0, extra=extra, steps=steps)
 
 
 def _plan(problem: Any, planner: str, spec: PlannerSpec, timeout_s: float, deadline: float, t0: float,

@@ -390,3 +390,34 @@ def test_benchmark_and_pipeline_are_split_by_job():
         assert {f"{package}.{s}" for s in siblings} <= graph[f"{package}.{module.removesuffix('.py')}"]
     assert "symlearn.pipeline_configs" in graph["symlearn.pipeline_stages"]
     assert not {"symlearn.pipeline", "symlearn.pipeline_stages"} & graph["symlearn.pipeline_presets"]
+
+
+# The learned relational route: what its planner reads is computed by the network from the depth crops.
+LEARNED_ROUTE = ("symlearn.learning.entities", "symlearn.learning.relational", "symlearn.learning.relational_training",
+                 "symlearn.symbolic.learned_state", "pddl_export.learned_domain", "symlearn.export.learned_export",
+                 "symlearn.planning.learned_loop", "symlearn.planning.learned_benchmark", "symlearn.learning.carrying")
+# The hand-written geometry it must not reach: the location fields, the scene graph over them, their codec,
+# and the lifted domain built on them (the oracle route, kept for comparison).
+GEOMETRY = ("symlearn.symbolic.locations", "pddl_export.lifted_scene", "pddl_export.location_codec",
+            "pddl_export.lifted_vocabulary", "symlearn.symbolic.transition_data")
+
+
+def _reachable(graph: dict[str, set[str]], root: str) -> set[str]:
+    seen, todo = set(), [root]
+    while todo:
+        m = todo.pop()
+        if m not in seen:
+            seen.add(m)
+            todo += sorted(graph.get(m, ()))
+    return seen
+
+
+def test_the_learned_route_never_imports_the_geometry_fields_or_the_scene_graph():
+    graph = import_graph()
+    assert set(LEARNED_ROUTE) | set(GEOMETRY) <= set(graph)
+    for mod in LEARNED_ROUTE:
+        reached = _reachable(graph, mod) & set(GEOMETRY)
+        assert not reached, f"{mod} reaches {sorted(reached)}"
+    # the check sees a real import chain: the oracle route does reach the geometry
+    assert "symlearn.symbolic.locations" in _reachable(graph, "symlearn.symbolic.transition_data")
+    assert "pddl_export.lifted_scene" in _reachable(graph, "pddl_export.lifted_domain")

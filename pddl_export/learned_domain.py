@@ -1,0 +1,189 @@
+"""Operators found from data over learned predicates, written as a lifted PDDL domain (pure: no torch).
+
+A symbolic state is a set of ground atoms over objects `o1..ok` and the six locations `l0..l5`:
+`("at", o, l)` (the learned object-location relation), `("rK", a, b)` (learned object-object relation K) and
+`("uB", o)` (bit B of o's learned unary code). An observed transition is a pre-state, a post-state and the
+action's pick and release locations.
+
+Operators are found as the authors' follow-up does (arXiv 2401.01123): transitions are grouped by their
+lifted effect, and each group's precondition is what every member's pre-state holds.
+
+- Lifting: the pick location becomes ?from, the release location ?to (one ?at when they are equal), every
+  object named by an added or deleted atom a variable ?o1, ?o2, ... numbered in the order that gives the
+  smallest written effect, so two transitions that differ only in the names of their objects share a group.
+  Any other location stays a constant of the domain: a rider on a stick's end moves from one named location
+  to another, and which ones is what the data showed for these two arguments.
+- The precondition of a group is the set of lifted atoms over its variables true in every member's
+  pre-state (or in a share of them: learned symbols are noisy); atoms naming an object outside the effect are left out (STRIPS has no quantifiers), so the
+  precondition says what must hold of the objects that change and of the two locations.
+- A group seen fewer than `min_count` times is dropped as noise of the learned symbols.
+
+Why grouping by effect: an operator of STRIPS has one add and one delete list, so transitions with
+different effects cannot share one; grouping by the precondition instead would merge different outcomes.
+"""
+from __future__ import annotations
+
+import itertools
+from collections import Counter, defaultdict
+from dataclasses import dataclass
+from typing import Iterable, Sequence
+
+Atom = tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Transition:
+    """One observed action: ground atoms before and after, the pick and release location names."""
+
+    pre: frozenset[Atom]
+    post: frozenset[Atom]
+    pick: str
+    release: str
+
+
+@dataclass(frozen=True)
+class Operator:
+    """A lifted STRIPS operator: typed parameters, precondition, add and delete lists, and its support."""
+
+    name: str
+    parameters: tuple[tuple[str, str], ...]  # (variable, type)
+    precondition: tuple[Atom, ...]
+    add: tuple[Atom, ...]
+    delete: tuple[Atom, ...]
+    count: int  # transitions in its group
+
+
+def _lift(atom: Atom, names: dict[str, str]) -> Atom | None:
+    """The atom with its entities renamed (a location outside `names` stays a constant), or None if it names an
+    object outside `names`."""
+    args = tuple(names.get(a, a if a.startswith("l") else None) for a in atom[1:])
+    return None if None in args else (atom[0], *args)
+
+
+STATIC_PREFIX = "u"  # unary bits: what an object looks like; read in preconditions, never changed by an operator
+
+
+def changes(t: Transition) -> tuple[frozenset[Atom], frozenset[Atom]]:
+    """The atoms a transition adds and deletes, unary bits left out: the shape code of an object seen from
+    another place flips bits with the perspective, which is no effect of the action."""
+    add = frozenset(a for a in t.post - t.pre if not a[0].startswith(STATIC_PREFIX))
+    delete = frozenset(a for a in t.pre - t.post if not a[0].startswith(STATIC_PREFIX))
+    return add, delete
+
+
+def lift(t: Transition) -> tuple[tuple, dict[str, str]]:
+    """A transition's lifted effect key ((location variables), add, delete) and the names it gave."""
+    add, delete = changes(t)
+    locs = {t.pick: "?at"} if t.pick == t.release else {t.pick: "?from", t.release: "?to"}
+    objs = sorted({a for atom in add | delete for a in atom[1:] if a not in locs and not a.startswith("l")})
+    best = None
+    for perm in itertools.permutations(objs) if len(objs) <= 4 else [tuple(objs)]:
+        names = dict(locs) | {o: f"?o{i + 1}" for i, o in enumerate(perm)}
+        key = (tuple(sorted(locs.values())), tuple(sorted(_lift(a, names) for a in add)),
+               tuple(sorted(_lift(a, names) for a in delete)))
+        if best is None or key < best[0]:
+            best = (key, names)
+    return best
+
+
+def learn_operators(transitions: Iterable[Transition], min_count: int = 3, share: float = 1.0,
+                    max_objects: int = 4) -> list[Operator]:
+    """Operators over the transitions' atoms, most supported first (see the module docstring). A precondition
+    atom must hold in at least `share` of its group's pre-states (1: in all); an effect naming more than
+    `max_objects` objects is dropped (it grounds into too many actions to be worth its rare use)."""
+    groups: dict[tuple, list[frozenset[Atom]]] = defaultdict(list)
+    for t in transitions:
+        if not any(changes(t)):
+            continue  # nothing changed: no operator needed (the planner never needs a no-op)
+        key, names = lift(t)
+        groups[key].append(frozenset(x for x in (_lift(a, names) for a in t.pre) if x is not None))
+    ops = []
+    for key, pres in sorted(groups.items(), key=lambda kv: -len(kv[1])):
+        if len(pres) < min_count:
+            continue
+        loc_vars, add, delete = key
+        if len({v for a in add + delete for v in a[1:] if v.startswith("?o")}) > max_objects:
+            continue
+        counts = Counter(a for p in pres for a in p)
+        pre = frozenset(a for a, c in counts.items() if c >= share * len(pres))
+        variables = sorted({v for a in (*add, *delete, *pre) for v in a[1:] if v.startswith("?")} | set(loc_vars))
+        params = tuple((v, "location" if v in ("?at", "?from", "?to") else "item") for v in variables)
+        ops.append(Operator(f"move-{len(ops)}", params, tuple(sorted(pre)), add, delete, len(pres)))
+    return ops
+
+
+def coverage(ops: Sequence[Operator], transitions: Iterable[Transition]) -> dict:
+    """How many changing transitions fall in a kept operator's group, and of those, how many satisfy its
+    precondition (the precondition is an intersection, so all do on the data it was learned from)."""
+    keys = Counter()
+    kept = {(tuple(sorted({v for v, t in o.parameters if t == "location"})), o.add, o.delete) for o in ops}
+    for t in transitions:
+        if not any(changes(t)):
+            keys["unchanged"] += 1
+            continue
+        keys["changed"] += 1
+        keys["covered"] += lift(t)[0] in kept
+    return dict(keys)
+
+
+def predicates_of(ops: Sequence[Operator], extra: Iterable[Atom] = ()) -> dict[str, tuple[str, ...]]:
+    """Each predicate's argument types, from the atoms the operators and `extra` name."""
+    out: dict[str, tuple[str, ...]] = {"at": ("item", "location")}
+    for a in itertools.chain((a for o in ops for a in (*o.precondition, *o.add, *o.delete)), extra):
+        if a[0] == "at":
+            continue
+        out.setdefault(a[0], ("location",) if a[0] == "empty" else ("item",) * (len(a) - 1))
+    return dict(sorted(out.items()))
+
+
+def _atom(a: Atom) -> str:
+    return "(" + " ".join(a) + ")"
+
+
+def domain_pddl(ops: Sequence[Operator], name: str = "learned-relations", comments: dict[str, str] | None = None,
+                n_locations: int = 6) -> str:
+    """The operators as a typed STRIPS domain; `comments` say what each predicate was found to mean."""
+    comments = comments or {}
+    locs = " ".join(f"l{i}" for i in range(n_locations))
+    lines = [f"(define (domain {name})", "  (:requirements :strips :typing)", "  (:types item location)",
+             f"  (:constants {locs} - location)", "  (:predicates"]
+    for p, types in predicates_of(ops).items():
+        args = " ".join(f"?x{i} - {t}" for i, t in enumerate(types))
+        note = f"  ; {comments[p]}" if p in comments else ""
+        lines.append(f"    ({p} {args}){note}")
+    lines.append("  )")
+    for o in ops:
+        params = " ".join(f"{v} - {t}" for v, t in o.parameters)
+        lines += [f"  (:action {o.name}  ; seen {o.count} times", f"    :parameters ({params})",
+                  f"    :precondition (and {' '.join(map(_atom, o.precondition))})",
+                  f"    :effect (and {' '.join(map(_atom, o.add))} "
+                  f"{' '.join('(not ' + _atom(a) + ')' for a in o.delete)}))"]
+    lines.append(")")
+    return "\n".join(lines) + "\n"
+
+
+def problem_pddl(name: str, objects: Sequence[str], init: Iterable[Atom], goal: Iterable[Atom],
+                 predicates: Iterable[str], domain: str = "learned-relations") -> str:
+    """A problem over the learned predicates: objects, the observed atoms and a goal (the six locations are the
+    domain's constants l0..l5). Atoms of a predicate the domain does not declare (a bit no operator reads or
+    changes) are left out of the initial state: they can neither help nor hinder a plan."""
+    known = set(predicates)
+    init = [a for a in init if a[0] in known]
+    return (f"(define (problem {name}) (:domain {domain})\n  (:objects {' '.join(objects)} - item)\n"
+            f"  (:init {' '.join(map(_atom, sorted(init)))})\n  (:goal (and {' '.join(map(_atom, sorted(goal)))})))\n")
+
+
+def operators_to_json(ops: Sequence[Operator]) -> list[dict]:
+    """The operators as plain JSON."""
+    return [{"name": o.name, "parameters": [list(p) for p in o.parameters], "precondition": [list(a) for a in o.precondition],
+             "add": [list(a) for a in o.add], "delete": [list(a) for a in o.delete], "count": o.count} for o in ops]
+
+
+def operators_from_json(rows: list[dict], where: str = "operators") -> list[Operator]:
+    """Operators back from operators_to_json's form; a malformed entry is refused naming `where`."""
+    try:
+        return [Operator(str(r["name"]), tuple((str(v), str(t)) for v, t in r["parameters"]),
+                         tuple(tuple(map(str, a)) for a in r["precondition"]), tuple(tuple(map(str, a)) for a in r["add"]),
+                         tuple(tuple(map(str, a)) for a in r["delete"]), int(r["count"])) for r in rows]
+    except (KeyError, TypeError, ValueError) as e:
+        raise ValueError(f"{where}: not a list of learned operators ({e})") from None

@@ -1,0 +1,151 @@
+"""The learned relational route, closed loop in simulation: observe, compute the learned state, plan, act, repeat.
+
+At every step the scene is observed, the relational model computes its symbolic state (objects o1..ok,
+`(at o l)`, `(rK a b)`, `(uB o)`: symlearn.symbolic.learned_state), the state and the goal are written as a
+PDDL problem of the learned domain (pddl_export.learned_domain), stock Fast Downward plans, and the first
+action of the plan is executed; then the loop observes again. The goal is given as the problem's goal scene,
+as the seed paper gives it: the scene is placed, observed and turned into learned atoms the same way, and the
+goal keeps its `at` atoms and the atoms of the relation heads named in `goal_relations`.
+
+Success is the simulator's: every object within the problem's tolerance of its goal position.
+"""
+from __future__ import annotations
+
+import dataclasses
+import re
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from pddl_export.learned_domain import Atom, Operator, domain_pddl, predicates_of, problem_pddl
+from search.stock_planners import solve_texts
+from symlearn.config_file import TIMEOUT_S, Bound, check_bounds
+from symlearn.problems.problem import GOAL_TOLERANCE_M, Problem, max_goal_distance
+from symlearn.symbolic.learned_state import atoms_of, scene_symbols
+from symlearn.world import N_LOCATIONS, Action
+
+
+@dataclass(frozen=True)
+class LearnedLoopConfig:
+    """How the learned route runs a problem."""
+
+    planner: str = "fd-lama-first"  # a search.stock_planners configuration
+    timeout_s: float = 10.0  # per planner call
+    max_steps_factor: float = 2.0  # at most factor x the generator's plan length + 2 actions are executed
+    goal_relations: tuple[str, ...] = ()  # object-object heads ("r1", ...) the goal keeps beside `at`
+    drop: tuple[str, ...] = ()  # the ablation: predicates ("r1", "nothing-r1", ...) removed from domain and states
+
+    def __post_init__(self) -> None:
+        """Refuse a time limit or step factor no run can use, before the simulator starts."""
+        check_bounds(self, {"timeout_s": TIMEOUT_S, "max_steps_factor": Bound(0.0, 100.0, lo_open=True)})
+
+
+@dataclass
+class LoopResult:
+    """One problem's run: success, the actions executed, planner calls and their times, why it stopped."""
+
+    name: str
+    k: int
+    optimal_length: int | None
+    success: bool
+    actions: list[int] = field(default_factory=list)
+    plan_times_s: list[float] = field(default_factory=list)
+    first_plan_length: int | None = None
+    stop: str = ""
+
+    def to_json(self) -> dict:
+        return dict(self.__dict__)
+
+
+def observe_atoms(sim, model, blob: dict) -> frozenset[Atom]:
+    """The learned state of the scene in the simulator now."""
+    obs = sim.observe()
+    k = obs.crops.shape[0]
+    codes, rel = scene_symbols(model, blob["windows"].numpy(), obs.crops[None].astype(np.float16),
+                               obs.origins[None], np.array([k]))
+    return atoms_of(codes[0], rel[0], k)
+
+
+def goal_atoms(sim, model, blob: dict, problem: Problem, relations: Sequence[str]) -> frozenset[Atom]:
+    """The goal scene's learned atoms: `at` and the named relation heads, for the objects the goal fixes."""
+    sim.reset(problem.goal)
+    free = {f"o{i + 1}" for i in problem.free}
+    keep = {"at", *relations}
+    return frozenset(a for a in observe_atoms(sim, model, blob)
+                     if a[0] in keep and not free & set(a[1:]))
+
+
+def step_action(step: str, ops: dict[str, Operator]) -> int:
+    """A plan step "(move-3 l0 o1 l2)" -> the action id pick * 6 + release of its location arguments."""
+    parts = step.strip("() ").split()
+    op = ops[parts[0]]
+    binding = {v: a for (v, _), a in zip(op.parameters, parts[1:])}
+    pick = binding.get("?at", binding.get("?from"))
+    release = binding.get("?at", binding.get("?to"))
+    loc = re.compile(r"l(\d)$")
+    return Action(int(loc.match(pick).group(1)), int(loc.match(release).group(1))).id
+
+
+def without(ops: Sequence[Operator], drop: Sequence[str]) -> list[Operator]:
+    """The operators with every atom of the predicates in `drop` removed (the load-bearing ablation)."""
+    if not drop:
+        return list(ops)
+    keep = lambda atoms: tuple(a for a in atoms if a[0] not in drop)  # noqa: E731
+    return [dataclasses.replace(o, precondition=keep(o.precondition), add=keep(o.add), delete=keep(o.delete))
+            for o in ops]
+
+
+def run_learned(sim, model, blob: dict, ops: Sequence[Operator], problem: Problem,
+                cfg: LearnedLoopConfig = LearnedLoopConfig()) -> LoopResult:
+    """One problem, closed loop (see the module docstring)."""
+    ops = without(ops, cfg.drop)
+    domain = domain_pddl(ops)
+    by_name = {o.name: o for o in ops}
+    predicates = predicates_of(ops)
+    goal = frozenset(a for a in goal_atoms(sim, model, blob, problem, cfg.goal_relations) if a[0] not in cfg.drop)
+    sim.reset(problem.initial)
+    objects = [f"o{i + 1}" for i in range(problem.initial.k)]
+    res = LoopResult(problem.name, problem.initial.k, problem.optimal_length, False)
+    limit = int(cfg.max_steps_factor * max(problem.generator_length, 1)) + 2
+    while True:
+        if max_goal_distance(sim.get_scene(), problem.goal, problem.free) <= GOAL_TOLERANCE_M:
+            res.success, res.stop = True, "goal reached"
+            return res
+        if len(res.actions) >= limit:
+            res.stop = "step limit"
+            return res
+        state = frozenset(a for a in observe_atoms(sim, model, blob) if a[0] not in cfg.drop)
+        if goal <= state:
+            res.stop = "goal believed reached"
+            return res
+        t0 = time.perf_counter()
+        plan = solve_texts(domain, problem_pddl("p", objects, state, goal, predicates), cfg.planner, cfg.timeout_s)
+        res.plan_times_s.append(round(time.perf_counter() - t0, 3))
+        if plan.status.name != "SOLVED" or not plan.steps:
+            res.stop = f"planner: {plan.status.name.lower()} {plan.message}"[:200]
+            return res
+        if res.first_plan_length is None:
+            res.first_plan_length = len(plan.steps)
+        action = step_action(plan.steps[0], by_name)
+        sim.step(Action(action // N_LOCATIONS, action % N_LOCATIONS))
+        res.actions.append(action)
+
+
+def summarize(results: Sequence[LoopResult]) -> dict:
+    """Success rate by object count band, and executed length over the shortest plan."""
+    out = {}
+    for name, lo, hi in (("1-5", 1, 5), ("6-8", 6, 8), ("all", 1, 99)):
+        rows = [r for r in results if lo <= r.k <= hi]
+        if not rows:
+            continue
+        ok = [r for r in rows if r.success and r.optimal_length]
+        out[name] = {"problems": len(rows), "success": round(sum(r.success for r in rows) / len(rows), 3),
+                     "length_over_shortest": round(float(np.mean([len(r.actions) / r.optimal_length for r in ok])), 3)
+                     if ok else None,
+                     "median_plan_s": round(float(np.median([t for r in rows for t in r.plan_times_s])), 3)
+                     if any(r.plan_times_s for r in rows) else None,
+                     "max_plan_s": max((t for r in rows for t in r.plan_times_s), default=None)}
+    return out

@@ -1,0 +1,74 @@
+"""The symbolic state a planner reads on the learned route: what the relational model computes from the crops.
+
+Objects are named o1..ok in the order the scene lists them, locations l0..l5. A state holds
+`(at o l)` from relation head 0, `(rK a b)` from object-object head K and `(uB o)` for each set bit B of o's
+unary code, with the closed world's negations a STRIPS operator needs: `(nothing-rK b)` when no object
+relates to b by head K, and `(empty l)` when no object is at l. Nothing here reads a pose, a location field or
+a simulator label.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+import torch
+
+from pddl_export.learned_domain import Atom, Transition
+from symlearn.data.dataset import load_split
+from symlearn.data.model_input import model_inputs
+from symlearn.learning.entities import location_crops
+
+
+def atoms_of(codes: np.ndarray, rel: np.ndarray, n_objects: int) -> frozenset[Atom]:
+    """One scene's atoms from its object codes (K, bits) and relations (R, E, E), E = K + 6."""
+    k = codes.shape[0]
+    out: set[Atom] = set()
+    for i in range(n_objects):
+        o = f"o{i + 1}"
+        out.update((f"u{b}", o) for b in np.flatnonzero(codes[i] > 0.5))
+        out.update(("at", o, f"l{j}") for j in np.flatnonzero(rel[0, i, k:] > 0.5))
+        for h in range(1, rel.shape[0]):
+            out.update((f"r{h}", o, f"o{j + 1}") for j in np.flatnonzero(rel[h, i, :n_objects] > 0.5))
+    # the closed world's negations of the relations, as atoms a STRIPS operator can test and change
+    objects = [f"o{i + 1}" for i in range(n_objects)]
+    for h in range(1, rel.shape[0]):
+        out.update((f"nothing-r{h}", o) for o in objects if not any((f"r{h}", a, o) in out for a in objects))
+    for j in range(rel.shape[-1] - k):
+        if not any(("at", o, f"l{j}") in out for o in objects):
+            out.add(("empty", f"l{j}"))
+    return frozenset(out)
+
+
+@torch.no_grad()
+def scene_symbols(model, windows: np.ndarray, depth: np.ndarray, origin: np.ndarray, n_objects: np.ndarray,
+                  batch_size: int = 256) -> tuple[np.ndarray, np.ndarray]:
+    """(N, K, 64, 64) crops, (N, K, 2) origins, (N,) counts -> codes (N, K, bits) and relations (N, R, E, E)."""
+    loc = location_crops(depth, origin, n_objects, windows)
+    codes, rels = [], []
+    k = depth.shape[1]
+    for a in range(0, len(depth), batch_size):
+        sl = slice(a, a + batch_size)
+        obj = model_inputs(torch.from_numpy(depth[sl].astype(np.float32)), torch.from_numpy(origin[sl].astype(np.float32)))
+        win = torch.from_numpy(np.broadcast_to(windows, (obj.shape[0],) + windows.shape).astype(np.float32))
+        loc_in = model_inputs(torch.from_numpy(loc[sl].astype(np.float32)), win)
+        mask = torch.from_numpy(np.arange(k)[None] < n_objects[sl, None])
+        c, _, r, _, _ = model.symbols(obj, mask, loc_in)
+        codes.append(c.numpy())
+        rels.append(r.numpy())
+    return np.concatenate(codes), np.concatenate(rels)
+
+
+def data_transitions(model, blob: dict, roots: Sequence[Path], split: str) -> list[Transition]:
+    """Every sample of a split of the data sets as a Transition between learned symbolic states."""
+    windows = blob["windows"].numpy()
+    out = []
+    for root in roots:
+        d = load_split(Path(root), split)
+        pre = scene_symbols(model, windows, d.pre_depth, d.pre_origin, d.n_objects)
+        post = scene_symbols(model, windows, d.post_depth, d.post_origin, d.n_objects)
+        for i in range(len(d)):
+            n, a = int(d.n_objects[i]), int(d.action[i])
+            out.append(Transition(atoms_of(pre[0][i], pre[1][i], n), atoms_of(post[0][i], post[1][i], n),
+                                  f"l{a // 6}", f"l{a % 6}"))
+    return out

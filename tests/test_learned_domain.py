@@ -1,0 +1,108 @@
+"""Operators found from transitions over learned predicates, and their PDDL: lifting, grouping, planning."""
+from __future__ import annotations
+
+import pddl
+
+from pddl_export.learned_domain import (Transition, coverage, domain_pddl, learn_operators, lift, predicates_of,
+                                        problem_pddl)
+from search.stock_planners import solve_texts
+
+
+def _t(pre, post, pick, release):
+    return Transition(frozenset(pre), frozenset(post), pick, release)
+
+
+# a cube moved from one location to another (o1 or o2: the names must not matter), with a unary bit u0
+MOVES = [_t({("at", o, "l0"), ("u0", o), ("at", "o9", "l4")}, {("at", o, "l2"), ("u0", o), ("at", "o9", "l4")},
+            "l0", "l2") for o in ("o1", "o2", "o1")]
+# a stick (u1) at the pick location carrying a rider (r1 rider stick) along: both change location
+CARRY = [_t({("at", "o1", "l1"), ("u1", "o1"), ("at", "o2", "l0"), ("r1", "o2", "o1"), ("u0", "o2")},
+            {("at", "o1", "l2"), ("u1", "o1"), ("at", "o2", "l1"), ("r1", "o2", "o1"), ("u0", "o2")}, "l1", "l2")] * 3
+
+
+def test_lifting_names_objects_by_role_not_by_name():
+    a, _ = lift(MOVES[0])
+    b, _ = lift(MOVES[1])
+    assert a == b == (("?from", "?to"), (("at", "?o1", "?to"),), (("at", "?o1", "?from"),))
+
+
+def test_operators_group_by_effect_and_intersect_preconditions():
+    noise = [_t({("at", "o1", "l3")}, {("at", "o1", "l5")}, "l3", "l4")]  # landed beside ?to, seen once: dropped
+    flip = [_t({("at", "o1", "l3"), ("u2", "o1")}, {("at", "o1", "l3"), ("u5", "o1")}, "l1", "l2")]  # no change
+    ops = learn_operators(MOVES + CARRY + noise, min_count=3)
+    assert [o.count for o in ops] == [3, 3]
+    move = next(o for o in ops if len(o.add) == 1)
+    assert set(move.precondition) == {("at", "?o1", "?from"), ("u0", "?o1")}  # o9 is outside the effect: not kept
+    carry = next(o for o in ops if len(o.add) == 2)
+    rider, stick = ("?o2", "?o1") if ("r1", "?o2", "?o1") in carry.precondition else ("?o1", "?o2")
+    assert ("r1", rider, stick) in carry.precondition and ("at", stick, "?from") in carry.precondition
+    # the rider's locations are not the action's arguments: they stay the constants the data showed
+    assert ("at", rider, "l0") in carry.precondition and ("at", rider, "?from") in carry.add
+    assert ("at", rider, "l0") in carry.delete
+    assert coverage(ops, MOVES + CARRY + noise + flip) == {"changed": 7, "covered": 6, "unchanged": 1}
+    assert all(not a[0].startswith("u") for o in ops for a in o.add + o.delete)  # unary bits: preconditions only
+
+
+def test_the_domain_parses_and_a_stock_planner_plans_a_carry():
+    ops = learn_operators(MOVES + CARRY, min_count=3)
+    domain = domain_pddl(ops, comments={"at": "the learned object-location relation"})
+    parsed = pddl.parse_domain  # the pddl package reads it back
+    import tempfile
+    from pathlib import Path
+    with tempfile.TemporaryDirectory() as tmp:
+        (Path(tmp) / "d.pddl").write_text(domain)
+        d = parsed(Path(tmp) / "d.pddl")
+    assert {a.name for a in d.actions} == {o.name for o in ops}
+    problem = problem_pddl("p", ["o1", "o2"], {("at", "o1", "l0"), ("u0", "o1"), ("at", "o2", "l3"), ("u0", "o2")},
+                           {("at", "o1", "l2"), ("at", "o2", "l2")}, predicates_of(ops))
+    res = solve_texts(domain, problem, "fd-lama-first", 20.0)
+    assert res.status.name == "SOLVED", res.message
+    assert len(res.steps) == 2 and all(s.startswith("(move-") for s in res.steps)
+    # an item no operator moves (only u0 items were seen moved alone, u1 ones carrying) stays: proved unsolvable
+    stuck = problem_pddl("q", ["o1", "o3"], {("at", "o1", "l0"), ("u0", "o1"), ("at", "o3", "l4"), ("u7", "o3")},
+                         {("at", "o3", "l5")}, predicates_of(ops))
+    res = solve_texts(domain, stuck, "fd-lama-first", 20.0)
+    assert res.status.name == "UNSOLVABLE", res.message
+
+
+def test_plan_steps_map_to_the_robot_actions_of_their_location_arguments():
+    from symlearn.planning.learned_loop import LoopResult, step_action, summarize
+    from symlearn.world import action_id
+
+    ops = {o.name: o for o in learn_operators(MOVES + CARRY, min_count=3)}
+    move = next(o for o in ops.values() if len(o.add) == 1)
+    args = {"?from": "l0", "?to": "l2", "?o1": "o3"}
+    step = f"({move.name} {' '.join(args[v] for v, _ in move.parameters)})"
+    assert step_action(step, ops) == action_id(0, 2)
+    rows = [LoopResult("a", 2, 2, True, [1, 2, 3], [0.2, 0.4]), LoopResult("b", 7, 1, False, [], [3.0])]
+    s = summarize(rows)
+    assert s["1-5"]["success"] == 1.0 and s["1-5"]["length_over_shortest"] == 1.5
+    assert s["6-8"]["success"] == 0.0 and s["all"]["max_plan_s"] == 3.0 and s["all"]["median_plan_s"] == 0.4
+
+
+def test_the_unified_planning_route_solves_and_validates_the_learned_domain():
+    from search.classical import solve_pddl
+
+    ops = learn_operators(MOVES + CARRY, min_count=3)
+    domain = domain_pddl(ops)
+    problem = problem_pddl("p", ["o1", "o2"], {("at", "o1", "l0"), ("u0", "o1"), ("at", "o2", "l3"), ("u0", "o2")},
+                           {("at", "o1", "l2"), ("at", "o2", "l2")}, predicates_of(ops))
+    lama = solve_texts(domain, problem, "fd-lama-first", 20.0)
+    for engine in ("fast-downward", "pyperplan", "symk"):
+        res = solve_pddl(domain, problem, engine, 30.0)
+        assert res.status.name == "SOLVED", (engine, res.message)
+        assert res.extra["validate_time_s"] >= 0  # UP's PlanValidator passed the plan
+        assert len(res.steps) == len(lama.steps) == 2 and res.plan == ()
+
+
+def test_a_relation_head_that_never_holds_leaves_no_negation_in_the_domain():
+    from symlearn.export.learned_export import prune_dead_relations
+
+    trs = [_t({("at", "o1", "l0"), ("nothing-r1", "o1"), ("nothing-r2", "o1")},
+              {("at", "o1", "l2"), ("nothing-r1", "o1"), ("nothing-r2", "o1")}, "l0", "l2"),
+           _t({("at", "o1", "l0"), ("at", "o2", "l1"), ("r2", "o1", "o2"), ("nothing-r1", "o1"), ("nothing-r1", "o2"),
+               ("nothing-r2", "o1")}, {("at", "o1", "l0"), ("at", "o2", "l1"), ("nothing-r1", "o1"),
+                                       ("nothing-r1", "o2"), ("nothing-r2", "o1")}, "l3", "l4")]
+    out = prune_dead_relations(trs)
+    names = {a[0] for t in out for a in t.pre | t.post}
+    assert "nothing-r1" not in names and {"nothing-r2", "r2", "at"} <= names  # r2 holds somewhere: kept
