@@ -176,3 +176,18 @@ def test_the_results_grid_is_recomputed_from_its_two_files():
             assert len(printed) == 2 and all(matches(p, w) for p, w in zip(printed, want)), (k, column, cell, want)
             checked += 1
     assert checked == 20
+
+
+def test_the_learned_route_table_is_the_one_its_result_file_holds():
+    # README's table under "A domain learned all the way down": each route's success at 1-5 and 6-8 objects, two
+    # digits, from bench/results/relations_test_table.json (docs/RELATIONS.md prints the same figures)
+    table = json.loads((ROOT / "bench/results/relations_test_table.json").read_text())["table"]
+    rows = {"learned relations, stock Fast Downward": "learned relations (fd-lama-first)",
+            "oracle predicates, stock Fast Downward (`fast-downward-lifted`)": "oracle predicates (fast-downward-lifted)",
+            "whole codes (`astar-outcomes`, the paper's route)": "whole codes (astar-outcomes)"}
+    readme = (ROOT / "README.md").read_text()
+    for label, route in rows.items():
+        m = re.search(rf"^\| {re.escape(label)} \| ([0-9.]+) \| ([0-9.]+) \|$", readme, re.M)
+        assert m, label
+        want = [table[route][band]["all"]["success"] for band in ("1-5", "6-8")]
+        assert [float(x) for x in m.groups()] == [round(w, 2) for w in want], (label, want)

@@ -1,0 +1,68 @@
+"""The side-by-side table of docs/RELATIONS.md: the learned relational route, the oracle predicates and the paper's
+whole-code route on the same problems, closed loop, by objects x shortest-plan length.
+
+    python experiments/relations_table.py --learned RUN/learned/test.json RUN/learned/test68.json \\
+        --benchmark ORACLE.json --out bench/results/relations_test_table.json
+
+ORACLE.json is `symlearn benchmark --run pretrained/recommended --problems A,B --planners
+fast-downward-lifted,astar-outcomes` on the same sets (its closed-loop rows are read).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+from pddl_export.files import atomic_write_json
+
+BANDS = (("1-5", 1, 5), ("6-8", 6, 8))
+LENGTHS = (("1", 1, 1), ("2", 2, 2), ("3+", 3, 99))
+
+
+def table(rows: list[tuple[str, int, int | None, bool, float | None]]) -> dict:
+    """rows of (route, objects, shortest length, success, executed/shortest) -> success per cell, mean length ratio."""
+    cells: dict = defaultdict(list)
+    ratio: dict = defaultdict(list)
+    for route, k, opt, ok, r in rows:
+        for band, lo, hi in BANDS:
+            if lo <= k <= hi:
+                cells[(route, band, "all")].append(ok)
+                ratio[(route, band)] += [r] if r is not None else []
+                for name, a, b in LENGTHS:
+                    if opt is not None and a <= opt <= b:
+                        cells[(route, band, name)].append(ok)
+    out: dict = {}
+    for (route, band, length), v in sorted(cells.items()):
+        out.setdefault(route, {}).setdefault(band, {})[length] = {"success": round(sum(v) / len(v), 3), "n": len(v)}
+    for (route, band), v in ratio.items():
+        out[route][band]["executed_over_shortest"] = round(float(np.mean(v)), 3) if v else None
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--learned", nargs="+", required=True, help="benchmark-learned result files")
+    ap.add_argument("--benchmark", required=True, help="a symlearn benchmark file of the oracle and whole-code routes")
+    ap.add_argument("--out", required=True)
+    a = ap.parse_args()
+    rows = []
+    for f in a.learned:
+        for r in json.loads(Path(f).read_text())["results"]:
+            opt = r["optimal_length"]
+            rows.append(("learned relations (fd-lama-first)", r["k"], opt, r["success"],
+                         len(r["actions"]) / opt if r["success"] and opt else None))
+    names = {"fast-downward-lifted": "oracle predicates (fast-downward-lifted)",
+             "astar-outcomes": "whole codes (astar-outcomes)"}
+    for r in json.loads(Path(a.benchmark).read_text())["rows"]:
+        if r.get("closed_loop") and r["planner"] in names:
+            opt = r.get("optimal_length")
+            rows.append((names[r["planner"]], r["n_objects"], opt, r["success"],
+                         r["executed_length"] / opt if r["success"] and opt and r.get("executed_length") else None))
+    atomic_write_json(Path(a.out), {"learned": a.learned, "benchmark": a.benchmark, "table": table(rows)})
+
+
+if __name__ == "__main__":
+    main()
