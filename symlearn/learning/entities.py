@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from symlearn.sim.camera import CameraConfig
+from symlearn.sim.camera import CameraConfig, camera_axes
 from symlearn.world import LOCATIONS, TABLE_TOP_Z
 
 # The height the window is centred at: a cube standing at a location reaches 10 cm above the table, a stick
@@ -30,12 +30,7 @@ def project_to_pixels(points: np.ndarray, cam: CameraConfig) -> np.ndarray:
     """(..., 3) world points -> (..., 2) image (row, col) in pixels, the inverse of the crops' view rays
     (symlearn.sim.camera: row 0 at the top, pixel centres at +0.5)."""
     p = np.asarray(points, np.float64)
-    eye, target, up = (np.asarray(v, np.float64) for v in (cam.eye, cam.target, cam.up))
-    fwd = (target - eye) / np.linalg.norm(target - eye)
-    right = np.cross(fwd, up)
-    right /= np.linalg.norm(right)
-    cam_up = np.cross(right, fwd)
-    tan = np.tan(np.radians(cam.fov_deg) / 2)
+    eye, fwd, right, cam_up, tan = camera_axes(cam)
     v = p - eye
     d = v @ fwd
     x = (v @ right) / d / tan

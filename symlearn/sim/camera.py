@@ -110,15 +110,19 @@ def position_channels(origins: np.ndarray, crop: int, image_size: int) -> np.nda
     return np.stack([x, y], axis=-3).astype(np.float32)
 
 
-def _window_rays(origins: np.ndarray, s: int, cam: CameraConfig):
-    """The camera's eye and axes, and the (..., S) view-ray slopes over each S x S window's columns and rows."""
-    origins = np.asarray(origins, np.float32)
+def camera_axes(cam: CameraConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    """The camera's eye, forward, right and up unit axes (float64), and the tangent of half its field of view."""
     eye, target, up = (np.asarray(v, np.float64) for v in (cam.eye, cam.target, cam.up))
     fwd = (target - eye) / np.linalg.norm(target - eye)
     right = np.cross(fwd, up)
     right /= np.linalg.norm(right)
-    cam_up = np.cross(right, fwd)
-    tan = np.tan(np.radians(cam.fov_deg) / 2)
+    return eye, fwd, right, np.cross(right, fwd), float(np.tan(np.radians(cam.fov_deg) / 2))
+
+
+def _window_rays(origins: np.ndarray, s: int, cam: CameraConfig):
+    """The camera's eye and axes, and the (..., S) view-ray slopes over each S x S window's columns and rows."""
+    origins = np.asarray(origins, np.float32)
+    eye, fwd, right, cam_up, tan = camera_axes(cam)
     offs = np.arange(s, dtype=np.float32) + 0.5
     rows = origins[..., 0, None] + offs  # (..., S) pixel-centre rows of the window
     cols = origins[..., 1, None] + offs
