@@ -281,3 +281,7 @@ def test_the_learned_commands_refuse_bad_input_in_one_line(tmp_path, capsys):
     assert rc == 2 and "relations.pt" in err and not (tmp_path / "learned").exists()
     rc, _ = cli("benchmark-learned", "--run", tmp_path, "--problems", tmp_path, "--out", tmp_path / "b.json")
     assert rc == 2 and "export-learned" in capsys.readouterr().err
+    (tmp_path / "relations.pt").write_bytes(b"not a checkpoint")
+    rc, _ = cli("export-learned", "--run", tmp_path, "--data", tmp_path)
+    err = capsys.readouterr().err
+    assert rc == 2 and "relations.pt is not a readable checkpoint" in err and len(err.strip().splitlines()) == 1

@@ -22,6 +22,7 @@ error is kept as `relations.pt`.
 from __future__ import annotations
 
 import dataclasses
+import io
 import json
 import math
 import time
@@ -33,13 +34,14 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-from pddl_export.files import atomic_write_text
+from pddl_export.files import atomic_write_bytes, atomic_write_text
 from symlearn.config_file import Bound, check_bounds
 from symlearn.data.dataset import InteractionData, data_fingerprint, load_manifest, load_split
 from symlearn.data.model_input import model_inputs
 from symlearn.data.statistics import rider_mask
-from symlearn.learning.models import code_stability_loss
+from symlearn.learning.checkpoint import BlobKind, guarded_blob
 from symlearn.learning.entities import location_crops, location_windows
+from symlearn.learning.models import code_stability_loss, masked_mse
 from symlearn.learning.relational import RelationalConfig, RelationalDeepSym
 from symlearn.provenance import versions
 from symlearn.sim.camera import CameraConfig
@@ -47,6 +49,15 @@ from symlearn.world import N_LOCATIONS
 
 CHECKPOINT, LAST = "relations.pt", "relations_last.pt"
 STORED_CROP = 64  # the data sets' crop size
+RELATIONS_KIND, RELATIONS_FORMAT = "symlearn-relational-model", 1
+
+
+class RelationsError(ValueError):
+    """A relational checkpoint that is missing, foreign, of another format or damaged."""
+
+
+RELATIONAL_MODEL = BlobKind(RELATIONS_KIND, RELATIONS_FORMAT, "relational-model", "relational checkpoint",
+                            "no relational model at {path}; run 'symlearn train-relations' first", RelationsError)
 
 
 @dataclass(frozen=True)
@@ -200,12 +211,6 @@ def relation_density(logits: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
     return p.sum() / (pairs.sum() * (logits.shape[1] - 1)).clamp_min(1)
 
 
-def masked_mse(pred: torch.Tensor, target: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
-    """Mean squared error over the real objects' coordinates."""
-    m = mask[..., None].to(pred.dtype)
-    return ((pred - target) ** 2 * m).sum() / (m.sum() * 3).clamp_min(1.0)
-
-
 @torch.no_grad()
 def evaluate(model: RelationalDeepSym, split: EntitySplit, windows: torch.Tensor, std: np.ndarray,
              batch_size: int = 256) -> dict:
@@ -254,7 +259,7 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
     opt = torch.optim.AdamW(model.parameters(), lr=cfg.lr, weight_decay=0.0)
     start, best, history = 0, math.inf, []
     if last.exists():
-        blob = torch.load(last, map_location="cpu", weights_only=True)
+        blob = guarded_blob(last, RELATIONAL_MODEL)
         same = {**blob["config"], "epochs": cfg.epochs} == cfg.to_json()  # more epochs extend a run
         if not same or blob["inputs"] != inputs:
             raise ValueError(f"{last} was trained with other settings or data; use another --out")
@@ -299,7 +304,7 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
         if show:
             print(f"epoch {epoch + 1}/{cfg.epochs} train {row['train_loss']:.4f} val {row['loss']:.4f} "
                   f"mae {row['mae_mm']:.1f} mm riders {row['rider_mae_mm']} mm ({time.time() - t0:.0f} s)", flush=True)
-        blob = {"config": cfg.to_json(), "inputs": inputs, "model": model.state_dict(), "mean": torch.from_numpy(mean),
+        blob = {"kind": RELATIONS_KIND, "format_version": RELATIONS_FORMAT, "config": cfg.to_json(), "inputs": inputs, "model": model.state_dict(), "mean": torch.from_numpy(mean),
                 "std": torch.from_numpy(std), "windows": torch.from_numpy(windows_np.astype(np.int64)),
                 "camera": json.dumps(dataclasses.asdict(cam)), "max_objects": k, "epoch": epoch + 1,
                 "history": json.dumps(history), "versions": json.dumps(versions())}
@@ -314,15 +319,20 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
 
 
 def _save(blob: dict, path: Path) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    torch.save(blob, tmp)
-    tmp.replace(path)
+    """Write a checkpoint atomically (weights_only loadable: tensors, plain data and JSON strings)."""
+    buf = io.BytesIO()
+    torch.save(blob, buf)
+    atomic_write_bytes(path, buf.getvalue())
 
 
 def load_relational(run_dir: Path) -> tuple[RelationalDeepSym, dict]:
-    """The best relational model of a run (eval mode) and its checkpoint record (mean, std, windows, camera)."""
-    blob = torch.load(run_dir / CHECKPOINT, map_location="cpu", weights_only=True)
-    cfg = RelationalTrainConfig.from_json(blob["config"])
-    model = RelationalDeepSym(cfg.model)
-    model.load_state_dict(blob["model"])
+    """The best relational model of a run (eval mode) and its checkpoint record (mean, std, windows, camera); a
+    missing, foreign or damaged file is refused in one line (RelationsError) by the runs' one guarded loader."""
+    path = Path(run_dir) / CHECKPOINT
+    blob = guarded_blob(path, RELATIONAL_MODEL)
+    try:
+        model = RelationalDeepSym(RelationalTrainConfig.from_json(blob["config"]).model)
+        model.load_state_dict(blob["model"])
+    except (KeyError, TypeError, ValueError, RuntimeError) as e:
+        raise RelationsError(f"{path} is a damaged relational checkpoint ({str(e).splitlines()[0][:120]})") from None
     return model.eval(), blob
