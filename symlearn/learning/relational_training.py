@@ -140,12 +140,11 @@ def camera_of(root: Path) -> CameraConfig:
     return CameraConfig.from_json(load_manifest(root)["settings"]["sim"]["camera"])
 
 
-def entity_split(roots: Sequence[Path], split: str, windows: np.ndarray, k: int,
+def entity_split(datas: Sequence[InteractionData], windows: np.ndarray, k: int,
                  mean: np.ndarray | None = None, std: np.ndarray | None = None) -> tuple[EntitySplit, np.ndarray, np.ndarray]:
-    """The split of every data set, padded to k objects, with location crops; effects normalized by (mean, std),
-    computed from this split when not given."""
-    parts = [pad_objects(d, k) | {"n": d.n_objects, "action": d.action, "held": d.grasped}
-             for d in (load_split(r, split) for r in roots)]
+    """One split of several data sets (load_split), padded to k objects, with location crops; effects normalized by
+    (mean, std), computed from this split when not given."""
+    parts = [pad_objects(d, k) | {"n": d.n_objects, "action": d.action, "held": d.grasped} for d in datas]
     cat = {key: np.concatenate([p[key] for p in parts]) for key in parts[0]}
     if mean is None:
         eff = cat["effect"][cat["mask"]].astype(np.float64)
@@ -250,7 +249,8 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
         raise ValueError(f"the data sets {', '.join(map(str, roots))} were rendered with different cameras")
     cam = camera_of(roots[0])
     windows_np = location_windows(cam, STORED_CROP)
-    k = max(load_split(r, "val").effect.shape[1] for r in roots)
+    train_data, val_data = ([load_split(r, s) for r in roots] for s in ("train", "val"))
+    k = max(d.effect.shape[1] for d in val_data)
     inputs = [{"data": str(r), "data_fingerprint": data_fingerprint(r)} for r in roots]
     run_dir.mkdir(parents=True, exist_ok=True)
     last = run_dir / LAST
@@ -266,8 +266,9 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
         model.load_state_dict(blob["model"])
         opt.load_state_dict(blob["optimizer"])
         start, best, history = blob["epoch"], blob["best_val"], json.loads(blob["history"])
-    tr, mean, std = entity_split(roots, "train", windows_np, k)
-    va, _, _ = entity_split(roots, "val", windows_np, k, mean, std)
+    tr, mean, std = entity_split(train_data, windows_np, k)
+    va, _, _ = entity_split(val_data, windows_np, k, mean, std)
+    del train_data, val_data  # the padded tensors hold what training reads
     windows = torch.from_numpy(windows_np.astype(np.float32))
     for epoch in range(start, cfg.epochs):
         gen = torch.Generator().manual_seed(cfg.seed * 100_003 + epoch)
