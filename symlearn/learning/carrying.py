@@ -17,8 +17,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from symlearn.data.model_input import model_inputs
-from symlearn.learning.entities import location_crops
+from symlearn.learning.entities import entity_inputs, location_crops
 from symlearn.world import Action, ObjectType
 
 C, S = ObjectType.CUBE, ObjectType.STICK
@@ -78,8 +77,7 @@ def predict_observation(model, blob: dict, crops: np.ndarray, origins: np.ndarra
     depth = crops.astype(np.float16)[None]
     windows = blob["windows"].numpy()
     loc = location_crops(depth, origins[None], np.array([k]), windows)
-    obj = model_inputs(torch.from_numpy(depth.astype(np.float32)), torch.from_numpy(origins[None].astype(np.float32)))
-    loc_in = model_inputs(torch.from_numpy(loc.astype(np.float32)), torch.from_numpy(windows[None].astype(np.float32)))
+    obj, loc_in = entity_inputs(depth, origins[None], loc, windows)
     mask = torch.ones(1, k, dtype=torch.bool)
     eff = model(obj, mask, loc_in, torch.tensor([action_id])).effect[0].numpy()
     return eff * blob["std"].numpy() + blob["mean"].numpy()

@@ -17,7 +17,9 @@ origins; a location's crop is that image cut at the location's window.
 from __future__ import annotations
 
 import numpy as np
+import torch
 
+from symlearn.data.model_input import model_inputs
 from symlearn.sim.camera import CameraConfig, camera_axes
 from symlearn.world import LOCATIONS, TABLE_TOP_Z
 
@@ -75,3 +77,13 @@ def location_crops(depth: np.ndarray, origin: np.ndarray, n_objects: np.ndarray,
             r0, c0 = int(r) + pad, int(c) + pad
             out[a:a + chunk, li] = padded[:, r0:r0 + s, c0:c0 + s]
     return out
+
+
+def entity_inputs(depth: np.ndarray | torch.Tensor, origin: np.ndarray | torch.Tensor,
+                  loc_depth: np.ndarray | torch.Tensor, windows: np.ndarray | torch.Tensor
+                  ) -> tuple[torch.Tensor, torch.Tensor]:
+    """The relational model's inputs: (B, K, S, S) object crops with their (B, K, 2) origins and (B, L, S, S)
+    location crops with the (L, 2) windows -> (B, K, 3, S, S) and (B, L, 3, S, S) float32 (depth, image x, y)."""
+    loc_depth = torch.as_tensor(loc_depth).float()
+    win = torch.as_tensor(windows).float()[None].expand(loc_depth.shape[0], -1, -1)
+    return model_inputs(torch.as_tensor(depth).float(), torch.as_tensor(origin).float()), model_inputs(loc_depth, win)

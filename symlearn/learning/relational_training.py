@@ -40,7 +40,7 @@ from symlearn.data.dataset import InteractionData, data_fingerprint, load_manife
 from symlearn.data.model_input import model_inputs
 from symlearn.data.statistics import rider_mask
 from symlearn.learning.checkpoint import BlobKind, guarded_blob
-from symlearn.learning.entities import location_crops, location_windows
+from symlearn.learning.entities import entity_inputs, location_crops, location_windows
 from symlearn.learning.models import code_stability_loss, masked_mse
 from symlearn.learning.relational import RelationalConfig, RelationalDeepSym
 from symlearn.provenance import versions
@@ -119,9 +119,7 @@ class EntitySplit:
 
     def inputs(self, idx: torch.Tensor, windows: torch.Tensor):
         """Model inputs for rows idx: object crops, mask, location crops, actions."""
-        obj = model_inputs(self.depth[idx].float(), self.origin[idx])
-        loc_origin = windows[None].expand(len(idx), -1, -1).float()
-        loc = model_inputs(self.loc_depth[idx].float(), loc_origin)
+        obj, loc = entity_inputs(self.depth[idx], self.origin[idx], self.loc_depth[idx], windows)
         return obj, self.mask[idx], loc, self.action[idx]
 
 

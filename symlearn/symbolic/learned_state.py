@@ -16,8 +16,7 @@ import torch
 
 from pddl_export.learned_domain import Atom, Transition
 from symlearn.data.dataset import load_split
-from symlearn.data.model_input import model_inputs
-from symlearn.learning.entities import location_crops
+from symlearn.learning.entities import entity_inputs, location_crops
 
 
 def atoms_of(codes: np.ndarray, rel: np.ndarray, n_objects: int) -> frozenset[Atom]:
@@ -49,9 +48,7 @@ def scene_symbols(model, windows: np.ndarray, depth: np.ndarray, origin: np.ndar
     k = depth.shape[1]
     for a in range(0, len(depth), batch_size):
         sl = slice(a, a + batch_size)
-        obj = model_inputs(torch.from_numpy(depth[sl].astype(np.float32)), torch.from_numpy(origin[sl].astype(np.float32)))
-        win = torch.from_numpy(np.broadcast_to(windows, (obj.shape[0],) + windows.shape).astype(np.float32))
-        loc_in = model_inputs(torch.from_numpy(loc[sl].astype(np.float32)), win)
+        obj, loc_in = entity_inputs(depth[sl], origin[sl], loc[sl], windows)
         mask = torch.from_numpy(np.arange(k)[None] < n_objects[sl, None])
         c, _, r, _, _ = model.symbols(obj, mask, loc_in)
         codes.append(c.numpy())
