@@ -5,7 +5,6 @@ import json
 from pathlib import Path
 
 import numpy as np
-import pytest
 import torch
 
 from symlearn.learning.carrying import CARRY_PROBES, judge

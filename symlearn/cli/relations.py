@@ -50,7 +50,9 @@ def cmd_carrying(args: argparse.Namespace) -> int:
     from pddl_export.files import atomic_write_json
 
     res = carrying(Path(args.run))
-    if (Path(args.run) / "learned" / "operators.json").is_file():  # the carrying goals, planned and executed
+    from symlearn.export.learned_export import operators_path
+
+    if operators_path(Path(args.run)).is_file():  # the carrying goals, planned and executed
         from symlearn.planning.learned_benchmark import carry_goals
 
         res["goals"] = carry_goals(Path(args.run), tuple(args.goal_relations or ()))

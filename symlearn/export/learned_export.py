@@ -14,13 +14,16 @@ from pathlib import Path
 from typing import Sequence
 
 from pddl_export.files import atomic_write_files, sha256_file
-from pddl_export.learned_domain import Transition, coverage, domain_pddl, learn_operators, operators_to_json
+from pddl_export.bounded_json import read_json_file
+from pddl_export.learned_domain import (Operator, Transition, coverage, domain_pddl, learn_operators,
+                                        operators_from_json, operators_to_json)
 from symlearn.data.dataset import data_fingerprint
 from symlearn.learning.relational_training import CHECKPOINT, load_relational
 from symlearn.provenance import versions
 from symlearn.symbolic.learned_state import data_transitions
 
 LEARNED_DIR = "learned"
+OPERATORS = "operators.json"  # RUN/learned/operators.json: what the closed loop plans with
 # a lifted effect seen fewer times is dropped as noise of the learned symbols. Chosen on problems/rel_dev(68): 5 keeps
 # 131 operators, whose grounding makes every 6-8-object call time out (0.85 / 0.00 at 1-5 / 6-8 objects); 20 keeps
 # 35 (0.825 / 0.90)
@@ -53,6 +56,20 @@ def export_learned(run_dir: Path, roots: Sequence[Path], min_count: int = MIN_CO
     out = run_dir / LEARNED_DIR
     out.mkdir(exist_ok=True)
     atomic_write_files({out / "domain.pddl": domain_pddl(ops, comments=comments),
-                        out / "operators.json": json.dumps(operators_to_json(ops), indent=1),
+                        out / OPERATORS: json.dumps(operators_to_json(ops), indent=1),
                         out / "report.json": json.dumps(report, indent=1)})
     return report
+
+
+def operators_path(run_dir: Path) -> Path:
+    """RUN/learned/operators.json."""
+    return Path(run_dir) / LEARNED_DIR / OPERATORS
+
+
+def load_operators(run_dir: Path) -> list[Operator]:
+    """A run's learned operators, read by the bounded JSON reader; a missing or malformed file is refused in one
+    line naming it."""
+    path = operators_path(run_dir)
+    if not path.is_file():
+        raise ValueError(f"{path} is missing: run symlearn export-learned --run {run_dir} first")
+    return operators_from_json(read_json_file(path, what="learned operators"), str(path))

@@ -41,7 +41,7 @@ import torch.nn.functional as F
 
 from symlearn.config_file import Bound, check_bounds
 from symlearn.learning.models import gumbel_sigmoid, mlp
-from symlearn.world import N_ACTIONS, N_LOCATIONS
+from symlearn.world import N_LOCATIONS
 
 OBJECT, LOCATION = 0, 1  # the two kinds of entity
 

@@ -7,8 +7,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from pddl_export.bounded_json import read_json_file
 from pddl_export.files import atomic_write_text, sha256_file
-from pddl_export.learned_domain import operators_from_json
+from symlearn.export.learned_export import load_operators, operators_path
 from symlearn.learning.relational_training import CHECKPOINT, load_relational
 from symlearn.planning.learned_loop import LearnedLoopConfig, LoopResult, run_learned, summarize
 from symlearn.problems.problem import load_problems
@@ -22,35 +23,33 @@ def benchmark_learned(run_dir: Path, problems_dir: Path, out: Path, timeout_s: f
     from symlearn.sim.simulator import TabletopSimulator
 
     cfg = LearnedLoopConfig(timeout_s=timeout_s, goal_relations=goal_relations, drop=drop)
-    ops_path = Path(run_dir) / "learned" / "operators.json"
-    if not ops_path.is_file():
-        raise ValueError(f"{ops_path} is missing: run symlearn export-learned --run {run_dir} first")
-    ops = operators_from_json(json.loads(ops_path.read_text()), str(ops_path))
+    ops = load_operators(run_dir)
     model, blob = load_relational(Path(run_dir))
     settings = {"run": str(run_dir), "model_sha256": sha256_file(Path(run_dir) / CHECKPOINT),
-                "operators_sha256": sha256_file(ops_path), "problems": str(problems_dir),
+                "operators_sha256": sha256_file(operators_path(run_dir)), "problems": str(problems_dir),
                 "config": {**cfg.__dict__, "goal_relations": list(cfg.goal_relations), "drop": list(cfg.drop)}}
     done: dict[str, dict] = {}
     if out.is_file():
-        old = json.loads(out.read_text())
+        old = read_json_file(out, what="learned-route benchmark")
         if old.get("settings") != settings:
             raise ValueError(f"{out} holds a benchmark of other settings; choose another --out")
         done = {r["name"]: r for r in old["results"]}
-    results = []
+    results: list[dict] = []
+
+    def record() -> dict:
+        res = {"settings": settings, "summary": summarize([LoopResult(**x) for x in results]), "results": results,
+               "versions": versions()}
+        atomic_write_text(out, json.dumps(res, indent=1))
+        return res
+
     with TabletopSimulator() as sim:
         for _, problem in load_problems(Path(problems_dir)):
             if problem.name in done:
                 results.append(done[problem.name])
                 continue
-            r = run_learned(sim, model, blob, ops, problem, cfg)
-            results.append(r.to_json())
-            rows = [LoopResult(**x) for x in results]
-            atomic_write_text(out, json.dumps({"settings": settings, "summary": summarize(rows), "results": results,
-                                               "versions": versions()}, indent=1))
-    rows = [LoopResult(**x) for x in results]
-    res = {"settings": settings, "summary": summarize(rows), "results": results, "versions": versions()}
-    atomic_write_text(out, json.dumps(res, indent=1))
-    return res
+            results.append(run_learned(sim, model, blob, ops, problem, cfg).to_json())
+            record()
+    return record()
 
 
 def carry_goals(run_dir: Path, goal_relations: tuple[str, ...] = ()) -> list[dict]:
@@ -59,8 +58,7 @@ def carry_goals(run_dir: Path, goal_relations: tuple[str, ...] = ()) -> list[dic
     from symlearn.sim.simulator import TabletopSimulator
 
     model, blob = load_relational(Path(run_dir))
-    ops_path = Path(run_dir) / "learned" / "operators.json"
-    ops = operators_from_json(json.loads(ops_path.read_text()), str(ops_path))
+    ops = load_operators(run_dir)
     with TabletopSimulator() as sim:
         return [run_learned(sim, model, blob, ops, p, LearnedLoopConfig(goal_relations=goal_relations)).to_json()
                 for p in carry_problems(sim)]

@@ -15,7 +15,6 @@ import dataclasses
 import re
 import time
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Sequence
 
 import numpy as np
