@@ -259,7 +259,8 @@ def test_a_problem_written_by_hand_from_the_docs_is_solved_by_stock_planners():
   (:objects a b - item)
   (:init (at a l0) (at b l3) (empty l1) (empty l2) (empty l4) (empty l5))
   (:goal (and (at a l3) (at b l0))))"""
-    plans = {p: solve_texts(domain, problem, p, 60.0) for p in ("fd-lama-first", "fd-lmcut", "pyperplan")}
+    plans = {p: solve_texts(domain, problem, p, 60.0) for p in ("fd-lama-first", "fd-lmcut")}
+    plans["up-pyperplan"] = solve_pddl(domain, problem, "pyperplan", 60.0)  # stock pyperplan's parser has no `=`
     for name, res in plans.items():
         assert res.status.name == "SOLVED", (name, res.message)
     # the optimal plan uses move-12, a swap of two objects the data showed 63 times (docs/RELATIONS.md: an artefact of
@@ -284,3 +285,139 @@ def test_the_learned_commands_refuse_bad_input_in_one_line(tmp_path, capsys):
     rc, _ = cli("export-learned", "--run", tmp_path, "--data", tmp_path)
     err = capsys.readouterr().err
     assert rc == 2 and "relations.pt is not a readable checkpoint" in err and len(err.strip().splitlines()) == 1
+
+
+def _support_model() -> RelationalDeepSym:
+    torch.manual_seed(0)
+    return RelationalDeepSym(RelationalConfig(conv_channels=(8, 8, 8, 8), feature_dim=16, hidden=16,
+                                              decoder_hidden=(16,), n_relations=1, rounds=3, support=True)).eval()
+
+
+def test_the_rests_on_head_picks_at_most_one_support_among_real_objects():
+    m = _support_model()
+    obj, loc = torch.rand(3, 4, 3, 64, 64), torch.rand(3, 6, 3, 64, 64)
+    mask = torch.tensor([[1, 1, 1, 0], [1, 0, 0, 0], [1, 1, 1, 1]]).bool()
+    with torch.no_grad():
+        m.table.bias.fill_(-50.0)  # the table scores far below any object: every object rests on another one
+        on = m(obj, mask, loc, torch.tensor([3, 20, 0])).relations[:, 1, :4, :4]
+    assert on.sum(-1).tolist() == [[1, 1, 1, 0], [0, 0, 0, 0], [1, 1, 1, 1]]  # a lone object has only the table
+    assert on[0, :, 3].sum() == 0 and on[:, torch.arange(4), torch.arange(4)].abs().sum() == 0
+    with torch.no_grad():
+        m.table.bias.fill_(50.0)
+        on = m(obj, mask, loc, torch.tensor([3, 20, 0])).relations[:, 1]
+    assert on.sum() == 0  # all on the table
+
+
+def test_the_support_loss_reads_what_the_grasp_showed():
+    from symlearn.learning.relational_training import support_loss
+
+    k = 4
+    logits = torch.zeros(1, 2, k + 6, k + 6, requires_grad=True)
+    at = torch.zeros(1, k + 6, k + 6)
+    at[0, 0, k + 4] = at[0, 1, k + 4] = at[0, 2, k + 1] = at[0, 3, k + 1] = 1  # 0 and 1 at l4; 2 and 3 at l1
+    mask = torch.ones(1, k, dtype=torch.bool)
+    rider = torch.tensor([[False, False, True, False]])  # 0 held at l4; 2 rode along; 1 and 3 stayed
+    support_loss(logits, torch.tensor([0]), rider, mask, at, torch.tensor([4 * 6 + 2])).backward()
+    g = logits.grad[0, 1]
+    assert g[0, 1] < 0 and g[0, 0] > 0 and g[0, 2] > 0  # the held object rests on what stayed at l4, not the table
+    assert g[2, 0] < 0 and g[2, 2] > 0  # the rider rests on the held object, not on the table
+    assert g[1, 0] > 0 and g[3, 2] > 0 and g[3, 0] > 0  # what did not ride rests on neither the held object nor a rider
+    assert logits.grad[0, 0].abs().sum() == 0  # at(o, l) is not touched
+    lone = torch.zeros(1, 2, k + 6, k + 6, requires_grad=True)  # nothing else at the pick location: the table
+    at[0, 3, k + 1], at[0, 3, k + 5] = 0, 1  # 3 moved to l5: 2 stands alone at l1
+    support_loss(lone, torch.tensor([2]), torch.zeros(1, k, dtype=torch.bool), mask, at, torch.tensor([1 * 6])).backward()
+    assert lone.grad[0, 1, 2, 2] < 0 and (lone.grad[0, 1, 2, [0, 1]] > 0).all()
+
+
+def test_a_rests_on_head_is_written_as_on_clear_and_on_table():
+    from symlearn.symbolic.learned_state import atoms_of
+
+    k = 3
+    rel = np.zeros((2, k + 6, k + 6))
+    rel[0, 0, k + 2] = rel[0, 1, k + 2] = rel[0, 2, k + 5] = 1  # o1 and o2 at l2, o3 at l5
+    rel[1, 0, 1] = 1  # o1 rests on o2
+    atoms = atoms_of(np.zeros((k, 8)), rel, k, support=True)
+    assert {a for a in atoms if a[0] in ("on", "clear", "on-table")} == {
+        ("on", "o1", "o2"), ("clear", "o1"), ("clear", "o3"), ("on-table", "o2"), ("on-table", "o3")}
+    assert ("r1", "o1", "o2") in atoms_of(np.zeros((k, 8)), rel, k)  # a free head keeps its neutral name
+
+
+def test_the_post_support_loss_puts_the_released_object_on_what_stood_there_and_keeps_the_rest():
+    from symlearn.learning.relational_training import post_support_loss
+
+    k = 3
+    pre = torch.zeros(1, 2, k + 6, k + 6)
+    pre[0, 1, 1, 1] = 5.0  # before: object 1 surely on the table
+    post = torch.zeros(1, 2, k + 6, k + 6, requires_grad=True)
+    at = torch.zeros(1, k + 6, k + 6)
+    at[0, 0, k + 2] = at[0, 2, k + 2] = at[0, 1, k + 0] = 1  # after: 0 and 2 at l2, 1 at l0
+    mask, rider = torch.ones(1, k, dtype=torch.bool), torch.zeros(1, k, dtype=torch.bool)
+    post_support_loss(pre, post, torch.tensor([0]), rider, mask, at, torch.tensor([4 * 6 + 2])).backward()
+    g = post.grad[0, 1]
+    assert g[0, 2] < 0 and g[0, 0] > 0 and g[0, 1] > 0  # released at l2 onto object 2, the one standing there
+    assert g[1, 1] < 0  # object 1 stays on the table, as before
+    nothing = torch.zeros(1, 2, k + 6, k + 6, requires_grad=True)  # nothing held: every support persists
+    post_support_loss(pre, nothing, torch.tensor([-1]), rider, mask, at, torch.tensor([7])).backward()
+    assert nothing.grad[0, 1, 1, 1] < 0 and nothing.grad[0, 1, 0].abs().sum() < 1e-6  # 0 stays as uncertain as it was
+
+
+SHIPPED_ON = Path(__file__).resolve().parents[1] / "pretrained" / "relations_on"
+
+
+def test_the_shipped_rests_on_model_orders_a_tower_and_finds_the_top(sim):
+    from symlearn.learning.relational_training import load_relational
+    from symlearn.planning.learned_loop import observe_atoms
+
+    model, blob = load_relational(SHIPPED_ON)
+    sim.build(((C, 3), (C, 3), (C, 3), (C, 0)))  # a tower of three at l3, a lone cube at l0
+    atoms = observe_atoms(sim, model, blob)
+    heights = [o.position[2] for o in sim.get_scene().objects]
+    order = sorted(range(3), key=lambda i: heights[i])  # bottom, middle, top, as the simulator placed them
+    o = [f"o{i + 1}" for i in order]
+    assert {a for a in atoms if a[0] == "on"} == {("on", o[1], o[0]), ("on", o[2], o[1])}, sorted(atoms)
+    assert {a for a in atoms if a[0] == "clear"} == {("clear", o[2]), ("clear", "o4")}
+    assert {a for a in atoms if a[0] == "on-table"} == {("on-table", o[0]), ("on-table", "o4")}
+    assert {a for a in atoms if a[0] == "at"} == {("at", x, "l3") for x in o} | {("at", "o4", "l0")}
+
+
+def test_a_four_cube_tower_is_stated_and_built_by_stock_fast_downward_in_simulation(sim):
+    from symlearn.export.learned_export import load_operators
+    from symlearn.learning.relational_training import load_relational
+    from symlearn.planning.learned_loop import LearnedLoopConfig, run_learned
+    from symlearn.problems.problem import Problem
+
+    model, blob = load_relational(SHIPPED_ON)
+    spec = ((C, 0), (C, 1), (C, 2), (C, 4))
+    sim.build(spec)
+    initial = sim.get_scene()
+    sim.build(((C, 5), (C, 5), (C, 5), (C, 5)))  # the goal: all four in one tower at l5, o1 at the bottom
+    problem = Problem("tower4", 0, spec, initial, (0 * 6 + 5, 1 * 6 + 5, 2 * 6 + 5, 4 * 6 + 5), sim.get_scene(),
+                      task="tower-4")
+    # stated by hand, as docs/RELATIONS.md writes it (read from the goal scene, the rests-on head misreads a tower
+    # of four, which the data hardly show: the top on the second)
+    goal = frozenset({("at", "o1", "l5"), ("on", "o2", "o1"), ("on", "o3", "o2"), ("on", "o4", "o3")})
+    res = run_learned(sim, model, blob, load_operators(SHIPPED_ON), problem, LearnedLoopConfig(), goal)
+    assert res.success, (res.stop, res.actions)  # the simulator's verdict: every cube where the goal scene has it
+    assert len(res.actions) == 4  # one pick-and-place a cube
+
+
+def test_a_tower_written_by_hand_for_the_rests_on_domain_is_solved_by_stock_planners():
+    # docs/RELATIONS.md: items, where each stands, what rests on what, the empty locations, and the one unary bit the
+    # domain's unstacking operators read: (u4 c), without which d cannot be taken off c
+    from search.classical import solve_pddl
+    from search.stock_planners import solve_texts
+
+    domain = (SHIPPED_ON / "learned" / "domain.pddl").read_text()
+    problem = """(define (problem tower) (:domain learned-relations)
+  (:objects a b c d - item)
+  (:init (at a l0) (at b l1) (at c l2) (at d l2) (on d c) (u4 c)
+         (on-table a) (on-table b) (on-table c) (clear a) (clear b) (clear d) (empty l3) (empty l4) (empty l5))
+  (:goal (and (at a l4) (on b a) (on c b) (on d c))))"""
+    plans = {p: solve_texts(domain, problem, p, 60.0) for p in ("fd-lama-first", "fd-lmcut")}
+    plans["up-pyperplan"] = solve_pddl(domain, problem, "pyperplan", 60.0)  # stock pyperplan's parser has no `=`
+    for name, res in plans.items():
+        assert res.status.name == "SOLVED", (name, res.message)
+    # optimal: a to l4, b onto a, d off c, c onto b, d onto c
+    assert len(plans["fd-lmcut"].steps) == 5 and all(len(r.steps) >= 5 for r in plans.values())
+    up = solve_pddl(domain, problem, "fast-downward", 60.0)
+    assert up.status.name == "SOLVED" and len(up.steps) >= 5, up.message  # UP's validator accepted it

@@ -63,6 +63,8 @@ class RelationalConfig:
     tau: float = 1.0  # Gumbel-sigmoid temperature
     depth_ref: float = 2.0  # as ModelConfig: input depth d becomes (depth_ref - d) / depth_scale on seen pixels
     depth_scale: float = 0.5
+    support: bool = False  # head 1 is rests-on: each object rests on one other object or on the table
+
 
     def __post_init__(self) -> None:
         check_bounds(self, RELATIONAL_BOUNDS)
@@ -95,7 +97,9 @@ RELATIONAL_BOUNDS = {"bits": Bound(1, 16, integer=True), "location_bits": Bound(
                      "rounds": Bound(1, 8, integer=True), "decoder_hidden": _SIZE,
                      "tau": Bound(0.0, 1000.0, lo_open=True), "depth_ref": Bound(-100.0, 100.0),
                      "depth_scale": Bound(0.0, 100.0, lo_open=True)}
-RELATIONAL_PRESETS = {"quick": RelationalConfig()}
+RELATIONAL_PRESETS = {"quick": RelationalConfig(),
+                      # one object-object head, rests-on, as a hard attention over the other objects and the table
+                      "support": RelationalConfig(n_relations=1, rounds=3, support=True)}
 
 
 def hard_softmax(logits: torch.Tensor, tau: float, training: bool,
@@ -177,9 +181,11 @@ class RelationalDeepSym(nn.Module):
         self.query = nn.Linear(f, r * dk)
         self.key = nn.Linear(f, r * dk)
         self.bias = nn.Parameter(torch.zeros(r))
+        if cfg.support:  # the score of "rests on the table", the support head's choice beside the other objects
+            self.table = nn.Linear(f, 1)
         width = max(cfg.bits, cfg.location_bits)
         self.token = nn.Linear(width + 4, h)  # code, kind (2), is the pick location, is the release location
-        heads = r + 1
+        heads = r + 1 + int(cfg.support)  # rests-on carries messages both ways, as two heads
         self.values = nn.ModuleList(nn.Linear(h, heads * h) for _ in range(cfg.rounds))
         self.updates = nn.ModuleList(nn.Sequential(nn.Linear(heads * h + h, h), nn.ReLU(), nn.Linear(h, h))
                                      for _ in range(cfg.rounds))
@@ -235,6 +241,14 @@ class RelationalDeepSym(nn.Module):
         pairs = mask[:, :, None] & mask[:, None, :] & ~torch.eye(k, dtype=torch.bool, device=mask.device)[None]
         logits[:, 1:, :k, :k] = oo
         rel[:, 1:, :k, :k] = gumbel_sigmoid(oo, tau, training, generator) * pairs[:, None].to(oo.dtype)
+        if self.cfg.support:  # head 1, rests-on(a, b): one choice per object among the others and the table
+            eye = torch.eye(k, dtype=torch.bool, device=mask.device)[None]
+            table = self.table(obj).squeeze(-1)  # (B, K), written on the diagonal: "rests on itself" = the table
+            sup = torch.where(eye, table[:, :, None], oo[:, 0])
+            sup = sup.masked_fill(~(pairs | eye), -1e4)
+            logits[:, 1, :k, :k] = sup
+            choice = hard_softmax(sup, tau, training, generator)
+            rel[:, 1, :k, :k] = choice * pairs.to(choice.dtype)
         return codes, loc_codes, rel, logits, ent
 
     def decode(self, codes: torch.Tensor, loc_codes: torch.Tensor, rel: torch.Tensor, ent: torch.Tensor,
@@ -254,9 +268,11 @@ class RelationalDeepSym(nn.Module):
         flags[rows, k + pick, 0] = 1.0
         flags[rows, k + release, 1] = 1.0
         tok = self.token(torch.cat([z, kind, flags], -1)) * ent[..., None]
-        heads, h = self.cfg.n_relations + 1, self.cfg.hidden
+        heads, h = self.cfg.n_relations + 1 + int(self.cfg.support), self.cfg.hidden
         # at(o, l) carries messages both ways: an object hears its location, a location the objects at it
         links = torch.cat([rel[:, :1] + rel[:, :1].transpose(-1, -2), rel[:, 1:]], 1)
+        if self.cfg.support:  # a support hears what rests on it: the object under the held one is not picked
+            links = torch.cat([links, rel[:, 1:2].transpose(-1, -2)], 1)
         for values, update, norm in zip(self.values, self.updates, self.norms):
             v = values(tok).view(b, -1, heads, h).transpose(1, 2)  # (B, heads, E, H)
             msg = (links @ v).transpose(1, 2).reshape(b, -1, heads * h)  # sum over related entities, per head

@@ -34,7 +34,7 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-from pddl_export.files import atomic_write_bytes, atomic_write_text
+from pddl_export.files import atomic_write_bytes, atomic_write_text, sha256_file
 from symlearn.config_file import Bound, check_bounds
 from symlearn.data.dataset import InteractionData, data_fingerprint, load_manifest, load_split
 from symlearn.data.model_input import model_inputs
@@ -75,10 +75,22 @@ class RelationalTrainConfig:
     soft_at_epochs: int = 0  # the first epochs read at(o, l) as softmax weights (a warm-up), then a hard choice
     grasp_weight: float = 1.0  # weight of the cross-entropy that puts the grasped object at the pick location
     ride_weight: float = 0.0  # weight of the cross-entropy that makes r1(a, held) say whether a rode along
+    support_weight: float = 0.0  # weight of support_loss (a model with a rests-on head: model.support)
+    post_support_weight: float = 0.0  # weight of post_support_loss, read on the scene after the action
+    support_exclusive: float = 0.0  # weight of the penalty on more than one object resting on the same one
     seed: int = 0
 
     def __post_init__(self) -> None:
         check_bounds(self, TRAIN_BOUNDS)
+        if (self.support_weight or self.post_support_weight or self.support_exclusive) and not self.model.support:
+            raise ValueError("support_weight and post_support_weight need a model with a rests-on head (model.support)")
+
+    @staticmethod
+    def from_preset(name: str, **overrides) -> "RelationalTrainConfig":
+        """A named preset (TRAIN_PRESETS) with optional field overrides."""
+        if name not in TRAIN_PRESETS:
+            raise ValueError(f"unknown relational training preset {name!r}; known: {', '.join(TRAIN_PRESETS)}")
+        return dataclasses.replace(TRAIN_PRESETS[name], **overrides)
 
     def to_json(self) -> dict:
         d = dataclasses.asdict(self)
@@ -96,7 +108,21 @@ TRAIN_BOUNDS = {"epochs": Bound(1, 100_000, integer=True), "batch_size": Bound(1
                 "rider_scene_repeat": Bound(1, 100, integer=True),
                 "relation_sparsity": Bound(0.0, 100.0), "code_stability": Bound(0.0, 100.0),
                 "soft_at_epochs": Bound(0, 100_000, integer=True), "grasp_weight": Bound(0.0, 100.0),
-                "ride_weight": Bound(0.0, 100.0), "seed": Bound(0, 2**63 - 1, integer=True)}
+                "ride_weight": Bound(0.0, 100.0), "support_weight": Bound(0.0, 100.0),
+                "post_support_weight": Bound(0.0, 100.0), "support_exclusive": Bound(0.0, 100.0),
+                "seed": Bound(0, 2**63 - 1, integer=True)}
+TRAIN_PRESETS = {
+    # three free object-object heads (binarized attention), none told what to mean
+    "attention": RelationalTrainConfig(),
+    # one rests-on head, a hard attention over the other objects and the table, shaped by what the grasp showed
+    "support": RelationalTrainConfig(model=RelationalConfig.from_preset("support"), support_weight=1.0),
+    # and the rests-on head read on the scene after the action: where the held object landed, what kept its support
+    "support-post": RelationalTrainConfig(model=RelationalConfig.from_preset("support"), support_weight=1.0,
+                                          post_support_weight=1.0),
+    # and at most one object on each: the top of a three-object stack rests on the middle one, not the bottom
+    "support-exclusive": RelationalTrainConfig(model=RelationalConfig.from_preset("support"), support_weight=1.0,
+                                               post_support_weight=1.0, support_exclusive=1.0),
+}
 
 
 @dataclass
@@ -113,6 +139,7 @@ class EntitySplit:
     post_depth: torch.Tensor  # (N, K, 64, 64) float16, the objects after the action
     post_origin: torch.Tensor  # (N, K, 2) float32
     held: torch.Tensor  # (N,) int64: the object the suction tool held, -1 for none
+    post_loc_depth: torch.Tensor | None = None  # (N, L, 64, 64) float16, the locations after the action (if asked)
 
     def __len__(self) -> int:
         return int(self.action.shape[0])
@@ -121,6 +148,11 @@ class EntitySplit:
         """Model inputs for rows idx: object crops, mask, location crops, actions."""
         obj, loc = entity_inputs(self.depth[idx], self.origin[idx], self.loc_depth[idx], windows)
         return obj, self.mask[idx], loc, self.action[idx]
+
+    def post_inputs(self, idx: torch.Tensor, windows: torch.Tensor):
+        """The scene after the action, rows idx: object crops, mask, location crops."""
+        obj, loc = entity_inputs(self.post_depth[idx], self.post_origin[idx], self.post_loc_depth[idx], windows)
+        return obj, self.mask[idx], loc
 
 
 def pad_objects(data: InteractionData, k: int) -> dict[str, np.ndarray]:
@@ -139,9 +171,10 @@ def camera_of(root: Path) -> CameraConfig:
 
 
 def entity_split(datas: Sequence[InteractionData], windows: np.ndarray, k: int,
-                 mean: np.ndarray | None = None, std: np.ndarray | None = None) -> tuple[EntitySplit, np.ndarray, np.ndarray]:
-    """One split of several data sets (load_split), padded to k objects, with location crops; effects normalized by
-    (mean, std), computed from this split when not given."""
+                 mean: np.ndarray | None = None, std: np.ndarray | None = None,
+                 post: bool = False) -> tuple[EntitySplit, np.ndarray, np.ndarray]:
+    """One split of several data sets (load_split), padded to k objects, with location crops (also after the
+    action, with `post`); effects normalized by (mean, std), computed from this split when not given."""
     parts = [pad_objects(d, k) | {"n": d.n_objects, "action": d.action, "held": d.grasped} for d in datas]
     cat = {key: np.concatenate([p[key] for p in parts]) for key in parts[0]}
     if mean is None:
@@ -154,7 +187,9 @@ def entity_split(datas: Sequence[InteractionData], windows: np.ndarray, k: int,
                        torch.from_numpy(loc), torch.from_numpy(cat["action"].astype(np.int64)), eff,
                        torch.from_numpy(cat["rider"]), torch.from_numpy(cat["post_depth"]),
                        torch.from_numpy(cat["post_origin"].astype(np.float32)),
-                       torch.from_numpy(cat["held"].astype(np.int64))), mean, std
+                       torch.from_numpy(cat["held"].astype(np.int64)),
+                       torch.from_numpy(location_crops(cat["post_depth"], cat["post_origin"], cat["n"], windows))
+                       if post else None), mean, std
 
 
 def grasp_loss(logits: torch.Tensor, held: torch.Tensor, actions: torch.Tensor, k: int) -> torch.Tensor:
@@ -199,6 +234,87 @@ def ride_loss(logits: torch.Tensor, held: torch.Tensor, rider: torch.Tensor, mas
     return loss
 
 
+def support_loss(logits: torch.Tensor, held: torch.Tensor, rider: torch.Tensor, mask: torch.Tensor,
+                 at: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
+    """Cross-entropy of the rests-on head (relation 1 of a model.support model) from what the robot saw its grasp do.
+
+    Head 1 picks, for each object a, one support: another object b (logits[.., 1, a, b]) or the table (the
+    diagonal). In a scene where the suction tool held object h (picked at location p):
+    - h rests on one of the objects that stayed at p (the model's own at, detached), or on the table if none did:
+      a pick lifts the top object, so what stays where it was picked lay under it;
+    - an object that rode along rests on h or on another rider;
+    - an object that did not ride rests on neither h nor a rider.
+    Each is a set-valued target (the log of the probability summed over the set), so a three-object stack does
+    not have to say which of the two below it h touches; the network learns that from two-object stacks."""
+    rows = torch.nonzero(held >= 0).squeeze(-1)
+    if not len(rows):
+        return logits.new_zeros(())
+    k = mask.shape[1]
+    n = len(rows)
+    ar = torch.arange(n, device=mask.device)
+    h, m, rid = held[rows], mask[rows], rider[rows]
+    logp = torch.log_softmax(logits[rows, 1, :k, :k], -1)  # (n, K, K); the diagonal is "on the table"
+    eye = torch.eye(k, dtype=torch.bool, device=mask.device)[None]
+    is_h = F.one_hot(h, k).bool()
+    pick = actions[rows] // N_LOCATIONS
+    stayed = m & ~is_h & ~rid & (at[rows, :k, k:][ar, :, pick] > 0.5)  # (n, K)
+    target_h = torch.where(stayed.any(1, keepdim=True), stayed, is_h)  # h's candidates (or itself: the table)
+    loss_h = -torch.logsumexp(logp[ar, h].masked_fill(~target_h, -1e4), -1)
+    carried = is_h | rid  # (n, K): h and its riders
+    loss = loss_h.mean()
+    sets = carried[:, None, :] & ~eye  # (n, K, K): for object a, the carried objects other than itself
+    lse = torch.logsumexp(logp.masked_fill(~sets, -1e4), -1)  # (n, K): log P(a rests on a carried object)
+    riders = rid & m
+    if riders.any():
+        loss = loss - lse[riders].mean()
+    still = m & ~carried
+    if still.any():
+        loss = loss - torch.log1p(-lse[still].exp().clamp(max=1 - 1e-6)).mean()
+    return loss
+
+
+def post_support_loss(pre_logits: torch.Tensor, post_logits: torch.Tensor, held: torch.Tensor, rider: torch.Tensor,
+                      mask: torch.Tensor, post_at: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
+    """The rests-on head read on the scene after the action (model.support), from what the robot did:
+    - where it released the held object h (location r), h now rests on one of the objects at r that it did not
+      carry there (the model's own at on the scene after, detached), or on the table if there is none;
+    - every other object rests on what it rested on before (a pick-and-place moves only h and its riders, which
+      keep their supports): the cross-entropy of its support after against its support before, both ways.
+    Scenes where nothing was held (a pick at an empty location) change nothing: every object keeps its support."""
+    k = mask.shape[1]
+    eye = torch.eye(k, dtype=torch.bool, device=mask.device)[None]
+    pre = torch.log_softmax(pre_logits[:, 1, :k, :k], -1)
+    post = torch.log_softmax(post_logits[:, 1, :k, :k], -1)
+    is_h = F.one_hot(held.clamp_min(0), k).bool() & (held >= 0)[:, None]
+    keep = mask & ~is_h  # (B, K)
+    loss = pre.new_zeros(())
+    if keep.any():  # symmetric cross-entropy of the two supports (each side detached in turn)
+        ce = -(pre.exp().detach() * post).sum(-1) - (post.exp().detach() * pre).sum(-1)
+        loss = loss + ce[keep].mean() / 2
+    rows = torch.nonzero(held >= 0).squeeze(-1)
+    if len(rows):
+        ar = torch.arange(len(rows), device=mask.device)
+        h = held[rows]
+        release = actions[rows] % N_LOCATIONS
+        carried = is_h[rows] | rider[rows]
+        below = mask[rows] & ~carried & (post_at[rows, :k, k:][ar, :, release] > 0.5)
+        target = torch.where(below.any(1, keepdim=True), below, is_h[rows])
+        loss = loss - torch.logsumexp(post[rows][ar, h].masked_fill(~target, -1e4), -1).mean()
+    return loss
+
+
+def support_exclusion(logits: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+    """Mean squared excess over one of the objects resting on each object (rests-on probabilities summed per
+    support): in a three-object stack the top rests on the middle one, not also on the bottom one, which the
+    grasp alone cannot tell (both stayed where the top was picked). A stick with a cube on each end is the
+    exception the penalty pays for; it is rare in the data."""
+    k = mask.shape[1]
+    eye = torch.eye(k, dtype=torch.bool, device=mask.device)[None]
+    p = torch.softmax(logits[:, 1, :k, :k], -1).masked_fill(eye, 0.0) * mask[:, :, None]
+    excess = F.relu(p.sum(1) - 1.0) * mask
+    return (excess ** 2).sum() / mask.sum().clamp_min(1)
+
+
 def relation_density(logits: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
     """Mean probability of the object-object relations (heads 1.. of (B, R, E, E) logits) over the real pairs: a
     penalty that keeps a relation off where it does not help predict effects."""
@@ -239,8 +355,10 @@ def epoch_order(split: EntitySplit, repeat: int, gen: torch.Generator) -> torch.
     return rows[torch.randperm(len(rows), generator=gen)]
 
 
-def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainConfig, show: bool = True) -> dict:
-    """Train (or resume) the relational model on the data sets `roots`; returns the final metrics."""
+def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainConfig, show: bool = True,
+                    init: Path | None = None) -> dict:
+    """Train (or resume) the relational model on the data sets `roots`; returns the final metrics. With `init`, a
+    new run starts from the weights of that run's relations.pt (same architecture), recorded in the inputs."""
     roots = [Path(r) for r in roots]
     cams = {json.dumps(camera_of(r).__dict__, sort_keys=True, default=list) for r in roots}
     if len(cams) != 1:
@@ -250,6 +368,11 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
     train_data, val_data = ([load_split(r, s) for r in roots] for s in ("train", "val"))
     k = max(d.effect.shape[1] for d in val_data)
     inputs = [{"data": str(r), "data_fingerprint": data_fingerprint(r)} for r in roots]
+    if init is not None:
+        init_blob = guarded_blob(Path(init) / CHECKPOINT, RELATIONAL_MODEL)
+        if RelationalConfig.from_json(init_blob["config"]["model"]) != cfg.model:
+            raise ValueError(f"{Path(init) / CHECKPOINT} holds another architecture than --preset asks for")
+        inputs.append({"init": str(Path(init) / CHECKPOINT), "sha256": sha256_file(Path(init) / CHECKPOINT)})
     run_dir.mkdir(parents=True, exist_ok=True)
     last = run_dir / LAST
     torch.manual_seed(cfg.seed)
@@ -264,7 +387,9 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
         model.load_state_dict(blob["model"])
         opt.load_state_dict(blob["optimizer"])
         start, best, history = blob["epoch"], blob["best_val"], json.loads(blob["history"])
-    tr, mean, std = entity_split(train_data, windows_np, k)
+    elif init is not None:
+        model.load_state_dict(init_blob["model"])
+    tr, mean, std = entity_split(train_data, windows_np, k, post=bool(cfg.post_support_weight))
     va, _, _ = entity_split(val_data, windows_np, k, mean, std)
     del train_data, val_data  # the padded tensors hold what training reads
     windows = torch.from_numpy(windows_np.astype(np.float32))
@@ -291,8 +416,21 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
             if cfg.ride_weight:
                 loss = loss + cfg.ride_weight * ride_loss(out.relation_logits, tr.held[idx], tr.rider[idx], mask,
                                                           out.relations[:, 0].detach(), act)
-            if cfg.relation_sparsity:
-                loss = loss + cfg.relation_sparsity * relation_density(out.relation_logits, mask)
+            if cfg.support_weight:
+                loss = loss + cfg.support_weight * support_loss(out.relation_logits, tr.held[idx], tr.rider[idx],
+                                                                mask, out.relations[:, 0].detach(), act)
+            if cfg.support_exclusive:
+                loss = loss + cfg.support_exclusive * support_exclusion(out.relation_logits, mask)
+            if cfg.post_support_weight:
+                p_obj, _, p_loc = tr.post_inputs(idx, windows)
+                _, _, p_rel, p_logits, _ = model.symbols(p_obj, mask, p_loc, generator=gen)
+                loss = loss + cfg.post_support_weight * post_support_loss(
+                    out.relation_logits, p_logits, tr.held[idx], tr.rider[idx], mask, p_rel[:, 0].detach(), act)
+            if cfg.relation_sparsity:  # the free heads only: a rests-on head makes one choice per object anyway
+                free = out.relation_logits[:, 1 + int(cfg.model.support):]
+                if free.shape[1]:
+                    loss = loss + cfg.relation_sparsity * relation_density(
+                        torch.cat([out.relation_logits[:, :1], free], 1), mask)
             opt.zero_grad(set_to_none=True)
             loss.backward()
             opt.step()
