@@ -23,6 +23,7 @@ different effects cannot share one; grouping by the precondition instead would m
 """
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from collections import Counter, defaultdict
 from dataclasses import dataclass
@@ -112,6 +113,83 @@ def learn_operators(transitions: Iterable[Transition], min_count: int = 3, share
     return ops
 
 
+def bindings(op: Operator, state: frozenset[Atom], fixed: dict[str, str]) -> Iterable[dict[str, str]]:
+    """Every binding of an operator's variables to the entities of `state` under which its precondition holds,
+    extending `fixed` (the location variables); different variables take different entities, as a planner's
+    grounding would be asked to."""
+    by_pred: dict[str, list[Atom]] = defaultdict(list)
+    for a in state:
+        by_pred[a[0]].append(a)
+    pre = sorted(op.precondition, key=lambda a: len(by_pred.get(a[0], ())))
+
+    def extend(i: int, b: dict[str, str]):
+        if i == len(pre):
+            yield b
+            return
+        atom = pre[i]
+        for cand in by_pred.get(atom[0], ()):
+            nb, ok = dict(b), True
+            for var, val in zip(atom[1:], cand[1:]):
+                if not var.startswith("?"):
+                    ok = var == val
+                elif var in nb:
+                    ok = nb[var] == val
+                elif val in nb.values():
+                    ok = False
+                else:
+                    nb[var] = val
+                if not ok:
+                    break
+            if ok:
+                yield from extend(i + 1, nb)
+
+    yield from extend(0, dict(fixed))
+
+
+def precision(ops: Sequence[Operator], transitions: Sequence[Transition]) -> list[tuple[int, int]]:
+    """For each operator, (groundings that apply in a transition's pre-state at the action's two locations, those
+    that predict the observed change exactly). A planner may pick any applicable grounding, so each counts: an
+    operator whose precondition is too weak (noise removed an atom, or `clear ?o2` is missing so ?o2 may be a
+    block under the top) applies in many states or ways where the robot saw something else happen."""
+    out = []
+    for op in ops:
+        loc_vars = {v for v, t in op.parameters if t == "location"}
+        applies = hits = 0
+        for t in transitions:
+            fixed = {"?at": t.pick} if t.pick == t.release else {"?from": t.pick, "?to": t.release}
+            if set(fixed) != loc_vars:
+                continue
+            add, delete = changes(t)
+            for b in bindings(op, t.pre, fixed):
+                applies += 1
+                ground = lambda atoms: {tuple([a[0], *(b.get(x, x) for x in a[1:])]) for a in atoms}  # noqa: E731
+                hits += ground(op.add) == add and ground(op.delete) == delete
+        out.append((applies, hits))
+    return out
+
+
+def generalize(op: Operator, transitions: Sequence[Transition], slack: float = 0.05) -> Operator:
+    """The operator with every precondition atom dropped that the data do not need: an atom goes when, without
+    it, the operator still predicts the observed change as often (its precision falls by at most `slack`).
+
+    A group's shared atoms include correlates of its members (most stacks are built on a cube that stands on
+    the table, so `on-table ?o2` holds in nearly every member of "put ?o1 on ?o2"); a precondition kept for no
+    reason forbids plans the robot can carry out, such as a third cube on a tower. Atoms are tried in a fixed
+    order, and the relations of the objects the effect moves (`at ?o ?from`) are never dropped."""
+    def prec(o: Operator) -> float:
+        a, h = precision([o], transitions)[0]
+        return h / a if a else 0.0
+
+    base = prec(op)
+    for atom in sorted(op.precondition, key=lambda a: (a[0].startswith(STATIC_PREFIX) is False, a)):
+        if atom[0] == "at" and atom in op.delete:
+            continue
+        trial = dataclasses.replace(op, precondition=tuple(a for a in op.precondition if a != atom))
+        if prec(trial) >= base - slack:
+            op = trial
+    return op
+
+
 def coverage(ops: Sequence[Operator], transitions: Iterable[Transition]) -> dict:
     """How many changing transitions fall in a kept operator's group, and of those, how many satisfy its
     precondition (the precondition is an intersection, so all do on the data it was learned from)."""
@@ -140,12 +218,24 @@ def _atom(a: Atom) -> str:
     return "(" + " ".join(a) + ")"
 
 
+def distinct(op: Operator) -> list[str]:
+    """`(not (= ?a ?b))` for every pair of variables of one type: lifting gave different objects (and the pick and
+    release location, when they differ) different variables, so an operator was only ever seen with them apart.
+    Without it a planner may bind two to one object (move ?o1 onto itself) and reach a goal no robot can."""
+    out = []
+    for (a, ta), (b, tb) in itertools.combinations(op.parameters, 2):
+        if ta == tb:
+            out.append(f"(not (= {a} {b}))")
+    return out
+
+
 def domain_pddl(ops: Sequence[Operator], name: str = "learned-relations", comments: dict[str, str] | None = None,
                 n_locations: int = 6) -> str:
-    """The operators as a typed STRIPS domain; `comments` say what each predicate was found to mean."""
+    """The operators as a typed STRIPS domain with equality (distinct); `comments` say what each predicate was found
+    to mean."""
     comments = comments or {}
     locs = " ".join(f"l{i}" for i in range(n_locations))
-    lines = [f"(define (domain {name})", "  (:requirements :strips :typing)", "  (:types item location)",
+    lines = [f"(define (domain {name})", "  (:requirements :strips :typing :equality)", "  (:types item location)",
              f"  (:constants {locs} - location)", "  (:predicates"]
     for p, types in predicates_of(ops).items():
         args = " ".join(f"?x{i} - {t}" for i, t in enumerate(types))
@@ -155,7 +245,7 @@ def domain_pddl(ops: Sequence[Operator], name: str = "learned-relations", commen
     for o in ops:
         params = " ".join(f"{v} - {t}" for v, t in o.parameters)
         lines += [f"  (:action {o.name}  ; seen {o.count} times", f"    :parameters ({params})",
-                  f"    :precondition (and {' '.join(map(_atom, o.precondition))})",
+                  f"    :precondition (and {' '.join([*map(_atom, o.precondition), *distinct(o)])})",
                   f"    :effect (and {' '.join(map(_atom, o.add))} "
                   f"{' '.join('(not ' + _atom(a) + ')' for a in o.delete)}))"]
     lines.append(")")

@@ -106,3 +106,66 @@ def test_a_relation_head_that_never_holds_leaves_no_negation_in_the_domain():
     out = prune_dead_relations(trs)
     names = {a[0] for t in out for a in t.pre | t.post}
     assert "nothing-r1" not in names and {"nothing-r2", "r2", "at"} <= names  # r2 holds somewhere: kept
+
+
+def _stack_world():
+    """Blocks at two locations, read as on / clear / on-table: a pick lifts the top, a release puts it on the top."""
+    def state(stacks):  # {location: [bottom, ..., top]}
+        s = set()
+        for loc, objs in stacks.items():
+            for i, o in enumerate(objs):
+                s.add(("at", o, loc))
+                s.add(("on", o, objs[i - 1]) if i else ("on-table", o))
+            if objs:
+                s.add(("clear", objs[-1]))
+            else:
+                s.add(("empty", loc))
+        return frozenset(s)
+
+    def move(stacks, pick, release):
+        after = {k: list(v) for k, v in stacks.items()}
+        after[release].append(after[pick].pop())
+        return _t(state(stacks), state(after), pick, release)
+
+    # putting a block on another: 30 times onto a block on the table, 3 times onto the top of a two-block tower
+    # with another clear block d at l2 (so the target must be at the release location) and, 10 times, a block e
+    # under the moved one (so the moved one must be clear: the pick lifts the top)
+    onto = [move({"l0": [f"a{i}"], "l1": [f"b{i}"], "l2": [f"d{i}"]}, "l0", "l1") for i in range(20)]
+    onto += [move({"l0": [f"e{i}", f"a{i}"], "l1": [f"b{i}"], "l2": [f"d{i}"]}, "l0", "l1") for i in range(10)]
+    onto += [move({"l0": [f"a{i}"], "l1": [f"c{i}", f"b{i}"], "l2": [f"d{i}"]}, "l0", "l1") for i in range(3)]
+    return onto, move, state
+
+
+def test_precision_counts_where_an_operator_applies_and_what_it_predicts():
+    from pddl_export.learned_domain import precision
+
+    onto, move, _ = _stack_world()
+    op = next(o for o in learn_operators(onto, min_count=3, share=0.85) if o.count == 23)  # from the table
+    assert ("on-table", "?o2") in op.precondition  # held by 20 of 23: a correlate, kept by share 0.85
+    # a transition where the operator applies (a clear block on the table at l1) but the robot saw a different
+    # change: the block landed beside the tower instead
+    miss = _t(onto[0].pre, onto[0].pre - {("at", "a0", "l0")} | {("at", "a0", "l2"), ("empty", "l0")}, "l0", "l1")
+    assert precision([op], onto[:20] + [miss]) == [(21, 20)]
+    # bindings give different variables different objects: moving a0 onto itself is no grounding
+    lone = _t({("at", "a0", "l0"), ("clear", "a0"), ("on-table", "a0"), ("empty", "l1")},
+              {("at", "a0", "l1"), ("clear", "a0"), ("on-table", "a0"), ("empty", "l0")}, "l0", "l1")
+    assert precision([op], [lone]) == [(0, 0)]
+
+
+def test_generalize_drops_a_correlate_the_data_do_not_need_and_keeps_what_they_do():
+    from pddl_export.learned_domain import generalize
+
+    onto, _, _ = _stack_world()
+    op = generalize(next(o for o in learn_operators(onto, min_count=3, share=0.85) if o.count == 23), onto)
+    assert ("on-table", "?o2") not in op.precondition  # a block goes on a tower's top just as well
+    assert {("clear", "?o2"), ("clear", "?o1"), ("at", "?o1", "?from"), ("at", "?o2", "?to")} <= set(op.precondition)
+
+
+def test_a_goal_keeps_only_the_on_atoms_its_at_atoms_allow():
+    from symlearn.planning.learned_loop import consistent_goal
+
+    goal = frozenset({("at", "a", "l1"), ("at", "b", "l1"), ("at", "c", "l2"), ("on", "a", "b"), ("on", "c", "b"),
+                      ("on", "d", "b")})
+    assert consistent_goal(goal) == goal - {("on", "c", "b"), ("on", "d", "b")}  # d has no location in the goal: dropped too
+    two = frozenset({("at", "a", "l1"), ("at", "b", "l1"), ("at", "c", "l1"), ("on", "a", "c"), ("on", "b", "c")})
+    assert consistent_goal(two) == two - {("on", "a", "c"), ("on", "b", "c")}  # two on one: the order is left open

@@ -17,19 +17,22 @@ from pathlib import Path
 from symlearn.cli.args import non_negative_int, positive_int, set_threads, thread_count
 from symlearn.outputs import folder_output
 
+TRAIN_PRESET_NAMES = ("attention", "support", "support-post", "support-exclusive")  # symlearn.learning.relational_training.TRAIN_PRESETS (kept torch-free)
+
 
 def cmd_train_relations(args: argparse.Namespace) -> int:
     from symlearn.learning.relational_training import RelationalTrainConfig, train_relations
 
     overrides = {k: v for k, v in dict(epochs=args.epochs, seed=args.seed).items() if v is not None}
-    cfg = dataclasses.replace(RelationalTrainConfig(), **overrides)
+    cfg = RelationalTrainConfig.from_preset(args.preset, **overrides)
     for d in args.data:
         if not (Path(d) / "manifest.json").is_file():
             raise ValueError(f"{d}: not a data set folder (no manifest.json); make one with symlearn collect")
     folder_output(Path(args.out), "--out")
     set_threads(args.threads)
     print(f"train-relations: {cfg.epochs} epochs, seed {cfg.seed} -> {args.out}", file=sys.stderr)
-    out = train_relations([Path(d) for d in args.data], Path(args.out), cfg, show=not args.quiet)
+    out = train_relations([Path(d) for d in args.data], Path(args.out), cfg, show=not args.quiet,
+                          init=Path(args.init) if args.init else None)
     print(json.dumps({"run": args.out, "best_val_loss": out["best_val"], "last_epoch": out["history"][-1]}, indent=2))
     return 0
 
@@ -69,11 +72,12 @@ def cmd_carrying(args: argparse.Namespace) -> int:
 
 
 def cmd_export_learned(args: argparse.Namespace) -> int:
-    from symlearn.export.learned_export import export_learned
+    from symlearn.export.learned_export import LearnedExportConfig, export_learned
 
-    set_threads(args.threads)
     given = {} if args.min_count is None else {"min_count": args.min_count}
-    rep = export_learned(Path(args.run), [Path(d) for d in args.data], **given)
+    cfg = LearnedExportConfig.from_preset(args.preset, **given)
+    set_threads(args.threads)
+    rep = export_learned(Path(args.run), [Path(d) for d in args.data], cfg)
     print(json.dumps({k: rep[k] for k in ("operators", "min_count", "transitions")}))
     return 0
 
@@ -83,7 +87,7 @@ def cmd_benchmark_learned(args: argparse.Namespace) -> int:
 
     set_threads(args.threads)
     res = benchmark_learned(Path(args.run), Path(args.problems), Path(args.out), args.timeout,
-                            tuple(args.goal_relations or ()), tuple(args.drop or ()))
+                            tuple(args.goal_relations or ()), tuple(args.drop or ()), args.relax_unreachable)
     print(json.dumps(res["summary"], indent=1))
     return 0
 
@@ -94,7 +98,12 @@ def add_relations_commands(sub) -> None:
                                                "over objects and table locations, learned by effect prediction")
     t.add_argument("--data", required=True, nargs="+", help="one or more data sets (symlearn collect)")
     t.add_argument("--out", required=True, help="run directory (resumed if it holds the same run)")
+    t.add_argument("--preset", default="attention", choices=sorted(TRAIN_PRESET_NAMES),
+                   help="attention: three free object-object heads; support: one rests-on head; support-post: "
+                        "and its reading after the action; support-exclusive: and one object on each "
+                        "(docs/RELATIONS.md; default attention)")
     t.add_argument("--epochs", type=positive_int, help="default 30")
+    t.add_argument("--init", help="start a new run from the weights of this run's relations.pt (same preset)")
     t.add_argument("--seed", type=non_negative_int, help="default 0")
     t.add_argument("--threads", type=thread_count, help="CPU threads")
     t.add_argument("--quiet", action="store_true")
@@ -117,6 +126,9 @@ def add_relations_commands(sub) -> None:
                                               "(RUN/learned/domain.pddl)")
     x.add_argument("--run", required=True)
     x.add_argument("--data", required=True, nargs="+")
+    x.add_argument("--preset", default="intersection", choices=("intersection", "precise"),
+                   help="intersection: preconditions every group member holds; precise: for a noisy rests-on head "
+                        "(learned_export.EXPORT_PRESETS; default intersection)")
     x.add_argument("--min-count", type=positive_int, help="drop a lifted effect seen fewer times (default "
                                                           "learned_export.MIN_COUNT)")
     x.add_argument("--threads", type=thread_count)
@@ -131,5 +143,7 @@ def add_relations_commands(sub) -> None:
     b.add_argument("--goal-relations", nargs="*", help="object-object heads the goal keeps, e.g. r1")
     b.add_argument("--drop", nargs="*", help="the ablation: predicates removed from the domain, the states and the "
                                              "goal, e.g. r1 nothing-r1")
+    b.add_argument("--relax-unreachable", action="store_true",
+                   help="when the goal with its relations is proved unreachable, plan for its at atoms alone")
     b.add_argument("--threads", type=thread_count)
     b.set_defaults(func=cmd_benchmark_learned)

@@ -9,14 +9,18 @@ operator's group, with the settings, the model's hash and the data's fingerprint
 """
 from __future__ import annotations
 
+import dataclasses
 import json
+import random
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
 from pddl_export.files import atomic_write_files, sha256_file
 from pddl_export.bounded_json import read_json_file
-from pddl_export.learned_domain import (Operator, Transition, coverage, domain_pddl, learn_operators,
-                                        operators_from_json, operators_to_json)
+from pddl_export.learned_domain import (Operator, Transition, coverage, domain_pddl, generalize, learn_operators,
+                                        operators_from_json, operators_to_json, precision)
+from symlearn.config_file import Bound, check_bounds
 from symlearn.data.dataset import data_fingerprint
 from symlearn.learning.relational_training import CHECKPOINT, load_relational
 from symlearn.provenance import versions
@@ -24,32 +28,92 @@ from symlearn.symbolic.learned_state import data_transitions
 
 LEARNED_DIR = "learned"
 OPERATORS = "operators.json"  # RUN/learned/operators.json: what the closed loop plans with
-# a lifted effect seen fewer times is dropped as noise of the learned symbols. Chosen on problems/rel_dev(68): 5 keeps
-# 131 operators, whose grounding makes every 6-8-object call time out (0.85 / 0.00 at 1-5 / 6-8 objects); 20 keeps
-# 35 (0.825 / 0.90)
+# a lifted effect seen fewer times is dropped as noise of the learned symbols. Chosen on problems/rel_dev(68) with the
+# `at`-only model: 5 keeps 131 operators, whose grounding makes every 6-8-object call time out; 20 keeps 35
 MIN_COUNT = 20
 
 
+@dataclass(frozen=True)
+class LearnedExportConfig:
+    """How operators are found from the learned transitions (pddl_export.learned_domain), in this order:
+    group by lifted effect (`min_count`, `max_objects`), precondition = atoms shared by `share` of a group,
+    drop operators whose precision on `sample` training transitions is below `min_precision`, then drop the
+    precondition atoms the data do not need (`slack`). min_precision 0 and slack -1 turn the last two off."""
+
+    min_count: int = MIN_COUNT
+    share: float = 1.0
+    max_objects: int = 4
+    min_precision: float = 0.0
+    slack: float = -1.0
+    sample: int = 4000
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        check_bounds(self, {"min_count": Bound(1, 2**62, integer=True), "share": Bound(0.0, 1.0, lo_open=True),
+                            "max_objects": Bound(1, 8, integer=True), "min_precision": Bound(0.0, 1.0),
+                            "slack": Bound(-1.0, 1.0), "sample": Bound(1, 2**31, integer=True),
+                            "seed": Bound(0, 2**63 - 1, integer=True)})
+
+    @staticmethod
+    def from_preset(name: str, **overrides) -> "LearnedExportConfig":
+        if name not in EXPORT_PRESETS:
+            raise ValueError(f"unknown learned-export preset {name!r}; known: {', '.join(EXPORT_PRESETS)}")
+        return dataclasses.replace(EXPORT_PRESETS[name], **overrides)
+
+
+EXPORT_PRESETS = {
+    "intersection": LearnedExportConfig(),  # the follow-up's grouping: preconditions shared by every member
+    # for noisy relations: shared by 90%, operators that mispredict dropped, unneeded preconditions dropped
+    "precise": LearnedExportConfig(share=0.9, min_precision=0.25, slack=0.05),
+}
+
+
 def prune_dead_relations(transitions: list[Transition]) -> list[Transition]:
-    """The transitions without the `nothing-rK` atoms of every head K that holds for no pair in any state: such a
+    """The transitions without the `nothing-rK` atoms (`clear`, `on-table` for `on`) of every head K that holds for no pair in any state: such a
     head learned nothing (training switched it off), and its negation, true of every object, only clutters the
     domain."""
     alive = {a[0] for t in transitions for a in t.pre | t.post}
     dead = {p for p in alive if p.startswith("nothing-") and p[len("nothing-"):] not in alive}
+    if "on" not in alive:  # a rests-on head that never fired: clear and on-table are true of every object
+        dead |= {"clear", "on-table"} & alive
     if not dead:
         return transitions
     keep = lambda atoms: frozenset(a for a in atoms if a[0] not in dead)  # noqa: E731
     return [Transition(keep(t.pre), keep(t.post), t.pick, t.release) for t in transitions]
 
 
-def export_learned(run_dir: Path, roots: Sequence[Path], min_count: int = MIN_COUNT,
+def find_operators(transitions: Sequence[Transition], cfg: LearnedExportConfig) -> tuple[list[Operator], list[dict]]:
+    """The operators of `transitions` (see LearnedExportConfig) and, per operator found, what became of it."""
+    ops = learn_operators(transitions, cfg.min_count, cfg.share, cfg.max_objects)
+    sample = list(transitions)
+    if len(sample) > cfg.sample:
+        sample = random.Random(cfg.seed).sample(sample, cfg.sample)
+    kept, notes = [], []
+    for op, (applies, hits) in zip(ops, precision(ops, sample) if (cfg.min_precision or cfg.slack >= 0) else
+                                   [(0, 0)] * len(ops)):
+        p = hits / applies if applies else 0.0
+        note = {"name": op.name, "count": op.count, "applies": applies, "predicts": hits, "precision": round(p, 3)}
+        if cfg.min_precision and p < cfg.min_precision:
+            notes.append(note | {"kept": False})
+            continue
+        if cfg.slack >= 0:
+            general = generalize(op, sample, cfg.slack)
+            note["dropped_preconditions"] = [list(a) for a in op.precondition if a not in general.precondition]
+            op = general
+        kept.append(op)
+        notes.append(note | {"kept": True})
+    return kept, notes
+
+
+def export_learned(run_dir: Path, roots: Sequence[Path], cfg: LearnedExportConfig = LearnedExportConfig(),
                    comments: dict[str, str] | None = None) -> dict:
     """Write RUN/learned/{domain.pddl, operators.json, report.json}; returns the report."""
     run_dir = Path(run_dir)
     model, blob = load_relational(run_dir)
     transitions = prune_dead_relations(data_transitions(model, blob, roots, "train"))
-    ops = learn_operators(transitions, min_count)
-    report = {"operators": len(ops), "min_count": min_count, "transitions": coverage(ops, transitions),
+    ops, notes = find_operators(transitions, cfg)
+    report = {"operators": len(ops), "config": dataclasses.asdict(cfg), "min_count": cfg.min_count,
+              "transitions": coverage(ops, transitions), "found": notes,
               "model_sha256": sha256_file(run_dir / CHECKPOINT),
               "data": [{"data": str(r), "data_fingerprint": data_fingerprint(Path(r))} for r in roots],
               "versions": versions()}
