@@ -2,7 +2,7 @@
 whole-code route on the same problems, closed loop, by objects x shortest-plan length.
 
     python experiments/relations_table.py --learned RUN/learned/test.json RUN/learned/test68.json \\
-        --benchmark ORACLE.json --out bench/results/relations_test_table.json
+        [--learned-on RUN_ON/learned/test.json ...] [--benchmark ORACLE.json] --out bench/results/relations_test_table.json
 
 ORACLE.json is `symlearn benchmark --run pretrained/recommended --problems A,B --planners
 fast-downward-lifted,astar-outcomes` on the same sets (its closed-loop rows are read).
@@ -44,24 +44,26 @@ def table(rows: list[tuple[str, int, int | None, bool, float | None]]) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--learned", nargs="+", required=True, help="benchmark-learned result files")
-    ap.add_argument("--benchmark", required=True, help="a symlearn benchmark file of the oracle and whole-code routes")
+    ap.add_argument("--learned", nargs="+", required=True, help="benchmark-learned result files of the at-only model")
+    ap.add_argument("--learned-on", nargs="*", default=[], help="benchmark-learned result files of the rests-on model")
+    ap.add_argument("--benchmark", help="a symlearn benchmark file of the oracle and whole-code routes")
     ap.add_argument("--out", required=True)
     a = ap.parse_args()
     rows = []
-    for f in a.learned:
-        for r in json.loads(Path(f).read_text())["results"]:
-            opt = r["optimal_length"]
-            rows.append(("learned relations (fd-lama-first)", r["k"], opt, r["success"],
-                         len(r["actions"]) / opt if r["success"] and opt else None))
+    for route, files in (("learned at (fd-lama-first)", a.learned), ("learned at + on (fd-lama-first)", a.learned_on)):
+        for f in files:
+            for r in json.loads(Path(f).read_text())["results"]:
+                opt = r["optimal_length"]
+                rows.append((route, r["k"], opt, r["success"], len(r["actions"]) / opt if r["success"] and opt else None))
     names = {"fast-downward-lifted": "oracle predicates (fast-downward-lifted)",
              "astar-outcomes": "whole codes (astar-outcomes)"}
-    for r in json.loads(Path(a.benchmark).read_text())["rows"]:
+    for r in json.loads(Path(a.benchmark).read_text())["rows"] if a.benchmark else []:
         if r.get("closed_loop") and r["planner"] in names:
             opt = r.get("optimal_length")
             rows.append((names[r["planner"]], r["n_objects"], opt, r["success"],
                          r["executed_length"] / opt if r["success"] and opt and r.get("executed_length") else None))
-    atomic_write_json(Path(a.out), {"learned": a.learned, "benchmark": a.benchmark, "table": table(rows)})
+    atomic_write_json(Path(a.out), {"learned": a.learned, "learned_on": a.learned_on, "benchmark": a.benchmark,
+                                    "table": table(rows)})
 
 
 if __name__ == "__main__":

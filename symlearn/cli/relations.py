@@ -57,7 +57,7 @@ def cmd_carrying(args: argparse.Namespace) -> int:
     if operators_path(Path(args.run)).is_file():  # the carrying goals, planned and executed
         from symlearn.planning.learned_benchmark import carry_goals
 
-        res["goals"] = carry_goals(Path(args.run), tuple(args.goal_relations or ()))
+        res["goals"] = carry_goals(Path(args.run), tuple(args.goal_relations or ()), args.relax_unreachable)
         for g in res["goals"]:
             print(f"goal {g['name']}: {'built' if g['success'] else 'not built'} with actions {g['actions']} "
                   f"({g['stop']})")
@@ -119,6 +119,8 @@ def add_relations_commands(sub) -> None:
                                         "against the simulator's")
     c.add_argument("--run", required=True)
     c.add_argument("--goal-relations", nargs="*", help="with RUN/learned/: object-object heads the goals keep")
+    c.add_argument("--relax-unreachable", action="store_true",
+                   help="when a goal with its relations is proved unreachable, plan for its at atoms alone")
     c.set_defaults(func=cmd_carrying)
 
     x = sub.add_parser("export-learned", help="operators over the learned predicates, found from data, as PDDL "

@@ -54,7 +54,7 @@ def benchmark_learned(run_dir: Path, problems_dir: Path, out: Path, timeout_s: f
     return record()
 
 
-def carry_goals(run_dir: Path, goal_relations: tuple[str, ...] = ()) -> list[dict]:
+def carry_goals(run_dir: Path, goal_relations: tuple[str, ...] = (), relax_unreachable: bool = False) -> list[dict]:
     """Each carrying goal planned by stock Fast Downward on RUN/learned/domain.pddl and executed, closed loop."""
     from symlearn.learning.carrying import carry_problems
     from symlearn.sim.simulator import TabletopSimulator
@@ -62,5 +62,6 @@ def carry_goals(run_dir: Path, goal_relations: tuple[str, ...] = ()) -> list[dic
     model, blob = load_relational(Path(run_dir))
     ops = load_operators(run_dir)
     with TabletopSimulator() as sim:
-        return [run_learned(sim, model, blob, ops, p, LearnedLoopConfig(goal_relations=goal_relations)).to_json()
+        cfg = LearnedLoopConfig(goal_relations=goal_relations, relax_unreachable=relax_unreachable)
+        return [run_learned(sim, model, blob, ops, p, cfg).to_json()
                 for p in carry_problems(sim)]
