@@ -248,6 +248,14 @@ class Bound:
 TIMEOUT_S = Bound(0.0, MAX_TIMEOUT_S, lo_open=True)  # ExecutionConfig.timeout_s and --timeout
 
 
+def preset(presets: Mapping[str, T], name: str, what: str = "preset", **overrides: Any) -> T:
+    """The config `presets[name]` with field overrides; an unknown name is refused in one line that lists the known
+    ones ("unknown {what} 'x'; known: a, b"). Every config dataclass's from_preset goes through here."""
+    if name not in presets:
+        raise ValueError(f"unknown {what} {name!r}; known: {', '.join(presets)}")
+    return dataclasses.replace(presets[name], **overrides)
+
+
 def check_bounds(cfg: Any, bounds: Mapping[str, Bound]) -> None:
     """Refuse (ValueError, one line naming the field) a field of cfg outside its Bound; a tuple field's items each,
     and an empty tuple."""

@@ -20,7 +20,7 @@ from pddl_export.files import atomic_write_files, sha256_file
 from pddl_export.bounded_json import read_json_file
 from pddl_export.learned_domain import (Operator, Transition, coverage, domain_pddl, generalize, learn_operators,
                                         operators_from_json, operators_to_json, precision)
-from symlearn.config_file import Bound, check_bounds
+from symlearn.config_file import Bound, check_bounds, preset
 from symlearn.data.dataset import data_fingerprint
 from symlearn.learning.relational_training import CHECKPOINT, load_relational
 from symlearn.provenance import versions
@@ -56,9 +56,8 @@ class LearnedExportConfig:
 
     @staticmethod
     def from_preset(name: str, **overrides) -> "LearnedExportConfig":
-        if name not in EXPORT_PRESETS:
-            raise ValueError(f"unknown learned-export preset {name!r}; known: {', '.join(EXPORT_PRESETS)}")
-        return dataclasses.replace(EXPORT_PRESETS[name], **overrides)
+        """A named preset (EXPORT_PRESETS) with optional field overrides."""
+        return preset(EXPORT_PRESETS, name, "learned-export preset", **overrides)
 
 
 EXPORT_PRESETS = {

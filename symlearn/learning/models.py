@@ -24,7 +24,7 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
-from symlearn.config_file import Bound, check_bounds
+from symlearn.config_file import Bound, check_bounds, preset
 from symlearn.world import N_ACTIONS
 
 MAX_CODE_BITS = 16  # the longest learned code
@@ -66,9 +66,7 @@ class ModelConfig:
     @staticmethod
     def from_preset(name: str, **overrides) -> "ModelConfig":
         """A named preset (paper, quick, recommended) with optional field overrides."""
-        if name not in PRESETS:
-            raise ValueError(f"unknown preset {name!r}; known: {', '.join(PRESETS)}")
-        return dataclasses.replace(PRESETS[name], **overrides)
+        return preset(PRESETS, name, **overrides)
 
     def to_json(self) -> dict:
         """The config as plain JSON, as stored in checkpoints."""

@@ -39,7 +39,7 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
-from symlearn.config_file import Bound, check_bounds
+from symlearn.config_file import Bound, check_bounds, preset
 from symlearn.learning.models import gumbel_sigmoid, mlp
 from symlearn.world import N_LOCATIONS
 
@@ -74,9 +74,7 @@ class RelationalConfig:
     @staticmethod
     def from_preset(name: str, **overrides) -> "RelationalConfig":
         """A named preset with optional field overrides."""
-        if name not in RELATIONAL_PRESETS:
-            raise ValueError(f"unknown relational preset {name!r}; known: {', '.join(RELATIONAL_PRESETS)}")
-        return dataclasses.replace(RELATIONAL_PRESETS[name], **overrides)
+        return preset(RELATIONAL_PRESETS, name, "relational preset", **overrides)
 
     def to_json(self) -> dict:
         return dataclasses.asdict(self)

@@ -35,7 +35,7 @@ import torch
 import torch.nn.functional as F
 
 from pddl_export.files import atomic_write_bytes, atomic_write_text, sha256_file
-from symlearn.config_file import Bound, check_bounds
+from symlearn.config_file import Bound, check_bounds, preset
 from symlearn.data.dataset import InteractionData, data_fingerprint, load_manifest, load_split
 from symlearn.data.model_input import model_inputs
 from symlearn.data.statistics import rider_mask
@@ -88,9 +88,7 @@ class RelationalTrainConfig:
     @staticmethod
     def from_preset(name: str, **overrides) -> "RelationalTrainConfig":
         """A named preset (TRAIN_PRESETS) with optional field overrides."""
-        if name not in TRAIN_PRESETS:
-            raise ValueError(f"unknown relational training preset {name!r}; known: {', '.join(TRAIN_PRESETS)}")
-        return dataclasses.replace(TRAIN_PRESETS[name], **overrides)
+        return preset(TRAIN_PRESETS, name, "relational training preset", **overrides)
 
     def to_json(self) -> dict:
         d = dataclasses.asdict(self)

@@ -25,7 +25,7 @@ import torch.nn as nn
 import torch.nn.functional as F
 
 from pddl_export.location_codec import LOCATION_BITS
-from symlearn.config_file import RECIPE, Bound, check_bounds
+from symlearn.config_file import RECIPE, Bound, check_bounds, preset
 from symlearn.learning.models import MAX_CODE_BITS
 from symlearn.world import N_ACTIONS
 
@@ -82,9 +82,7 @@ class TransitionConfig:
     def from_preset(name: str = RECIPE, **overrides) -> "TransitionConfig":
         """A named preset (TRANSITION_PRESETS; by default the recipe's, what `symlearn train-transition` and the
         recommended pipeline train) with optional field overrides."""
-        if name not in TRANSITION_PRESETS:
-            raise ValueError(f"unknown preset {name!r}; known: {', '.join(TRANSITION_PRESETS)}")
-        return dataclasses.replace(TRANSITION_PRESETS[name], **overrides)
+        return preset(TRANSITION_PRESETS, name, **overrides)
 
     def to_json(self) -> dict:
         """The config as plain JSON, as stored in the checkpoint and the metrics, with the total width `bits`."""
