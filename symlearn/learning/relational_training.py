@@ -83,7 +83,8 @@ class RelationalTrainConfig:
     def __post_init__(self) -> None:
         check_bounds(self, TRAIN_BOUNDS)
         if (self.support_weight or self.post_support_weight or self.support_exclusive) and not self.model.support:
-            raise ValueError("support_weight and post_support_weight need a model with a rests-on head (model.support)")
+            raise ValueError("support_weight, post_support_weight and support_exclusive need a model with a rests-on "
+                             "head (model.support)")
 
     @staticmethod
     def from_preset(name: str, **overrides) -> "RelationalTrainConfig":
@@ -232,6 +233,11 @@ def ride_loss(logits: torch.Tensor, held: torch.Tensor, rider: torch.Tensor, mas
     return loss
 
 
+def log_prob_of(logp: torch.Tensor, members: torch.Tensor) -> torch.Tensor:
+    """log P(the choice is one of `members`) from log-probabilities over the last axis and a same-shape bool mask."""
+    return torch.logsumexp(logp.masked_fill(~members, -1e4), -1)
+
+
 def support_loss(logits: torch.Tensor, held: torch.Tensor, rider: torch.Tensor, mask: torch.Tensor,
                  at: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
     """Cross-entropy of the rests-on head (relation 1 of a model.support model) from what the robot saw its grasp do.
@@ -257,11 +263,11 @@ def support_loss(logits: torch.Tensor, held: torch.Tensor, rider: torch.Tensor, 
     pick = actions[rows] // N_LOCATIONS
     stayed = m & ~is_h & ~rid & (at[rows, :k, k:][ar, :, pick] > 0.5)  # (n, K)
     target_h = torch.where(stayed.any(1, keepdim=True), stayed, is_h)  # h's candidates (or itself: the table)
-    loss_h = -torch.logsumexp(logp[ar, h].masked_fill(~target_h, -1e4), -1)
+    loss_h = -log_prob_of(logp[ar, h], target_h)
     carried = is_h | rid  # (n, K): h and its riders
     loss = loss_h.mean()
     sets = carried[:, None, :] & ~eye  # (n, K, K): for object a, the carried objects other than itself
-    lse = torch.logsumexp(logp.masked_fill(~sets, -1e4), -1)  # (n, K): log P(a rests on a carried object)
+    lse = log_prob_of(logp, sets)  # (n, K): log P(a rests on a carried object)
     riders = rid & m
     if riders.any():
         loss = loss - lse[riders].mean()
@@ -297,7 +303,7 @@ def post_support_loss(pre_logits: torch.Tensor, post_logits: torch.Tensor, held:
         carried = is_h[rows] | rider[rows]
         below = mask[rows] & ~carried & (post_at[rows, :k, k:][ar, :, release] > 0.5)
         target = torch.where(below.any(1, keepdim=True), below, is_h[rows])
-        loss = loss - torch.logsumexp(post[rows][ar, h].masked_fill(~target, -1e4), -1).mean()
+        loss = loss - log_prob_of(post[rows][ar, h], target).mean()
     return loss
 
 
@@ -353,6 +359,39 @@ def epoch_order(split: EntitySplit, repeat: int, gen: torch.Generator) -> torch.
     return rows[torch.randperm(len(rows), generator=gen)]
 
 
+def batch_loss(model: RelationalDeepSym, cfg: RelationalTrainConfig, tr: EntitySplit, idx: torch.Tensor,
+               windows: torch.Tensor, gen: torch.Generator) -> torch.Tensor:
+    """One training batch's loss: the effect error plus each term of cfg whose weight is not zero."""
+    obj, mask, loc, act = tr.inputs(idx, windows)
+    out = model(obj, mask, loc, act, generator=gen)
+    loss = masked_mse(out.effect, tr.effect[idx], mask)
+    if cfg.code_stability:  # unary codes say what an object is: the same before and after the action
+        post = model_inputs(tr.post_depth[idx].float(), tr.post_origin[idx])
+        loss = loss + cfg.code_stability * code_stability_loss(
+            model.object_logits(obj, mask), model.object_logits(post, mask), mask)
+    if cfg.grasp_weight:
+        loss = loss + cfg.grasp_weight * grasp_loss(out.relation_logits, tr.held[idx], act, mask.shape[1])
+    if cfg.ride_weight:
+        loss = loss + cfg.ride_weight * ride_loss(out.relation_logits, tr.held[idx], tr.rider[idx], mask,
+                                                  out.relations[:, 0].detach(), act)
+    if cfg.support_weight:
+        loss = loss + cfg.support_weight * support_loss(out.relation_logits, tr.held[idx], tr.rider[idx],
+                                                        mask, out.relations[:, 0].detach(), act)
+    if cfg.support_exclusive:
+        loss = loss + cfg.support_exclusive * support_exclusion(out.relation_logits, mask)
+    if cfg.post_support_weight:
+        p_obj, _, p_loc = tr.post_inputs(idx, windows)
+        _, _, p_rel, p_logits, _ = model.symbols(p_obj, mask, p_loc, generator=gen)
+        loss = loss + cfg.post_support_weight * post_support_loss(
+            out.relation_logits, p_logits, tr.held[idx], tr.rider[idx], mask, p_rel[:, 0].detach(), act)
+    if cfg.relation_sparsity:  # the free heads only: a rests-on head makes one choice per object anyway
+        free = out.relation_logits[:, 1 + int(cfg.model.support):]
+        if free.shape[1]:
+            loss = loss + cfg.relation_sparsity * relation_density(
+                torch.cat([out.relation_logits[:, :1], free], 1), mask)
+    return loss
+
+
 def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainConfig, show: bool = True,
                     init: Path | None = None) -> dict:
     """Train (or resume) the relational model on the data sets `roots`; returns the final metrics. With `init`, a
@@ -402,33 +441,7 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
         order = epoch_order(tr, cfg.rider_scene_repeat, gen)
         for a in range(0, len(order), cfg.batch_size):
             idx = order[a:a + cfg.batch_size]
-            obj, mask, loc, act = tr.inputs(idx, windows)
-            out = model(obj, mask, loc, act, generator=gen)
-            loss = masked_mse(out.effect, tr.effect[idx], mask)
-            if cfg.code_stability:  # unary codes say what an object is: the same before and after the action
-                post = model_inputs(tr.post_depth[idx].float(), tr.post_origin[idx])
-                loss = loss + cfg.code_stability * code_stability_loss(
-                    model.object_logits(obj, mask), model.object_logits(post, mask), mask)
-            if cfg.grasp_weight:
-                loss = loss + cfg.grasp_weight * grasp_loss(out.relation_logits, tr.held[idx], act, mask.shape[1])
-            if cfg.ride_weight:
-                loss = loss + cfg.ride_weight * ride_loss(out.relation_logits, tr.held[idx], tr.rider[idx], mask,
-                                                          out.relations[:, 0].detach(), act)
-            if cfg.support_weight:
-                loss = loss + cfg.support_weight * support_loss(out.relation_logits, tr.held[idx], tr.rider[idx],
-                                                                mask, out.relations[:, 0].detach(), act)
-            if cfg.support_exclusive:
-                loss = loss + cfg.support_exclusive * support_exclusion(out.relation_logits, mask)
-            if cfg.post_support_weight:
-                p_obj, _, p_loc = tr.post_inputs(idx, windows)
-                _, _, p_rel, p_logits, _ = model.symbols(p_obj, mask, p_loc, generator=gen)
-                loss = loss + cfg.post_support_weight * post_support_loss(
-                    out.relation_logits, p_logits, tr.held[idx], tr.rider[idx], mask, p_rel[:, 0].detach(), act)
-            if cfg.relation_sparsity:  # the free heads only: a rests-on head makes one choice per object anyway
-                free = out.relation_logits[:, 1 + int(cfg.model.support):]
-                if free.shape[1]:
-                    loss = loss + cfg.relation_sparsity * relation_density(
-                        torch.cat([out.relation_logits[:, :1], free], 1), mask)
+            loss = batch_loss(model, cfg, tr, idx, windows, gen)
             opt.zero_grad(set_to_none=True)
             loss.backward()
             opt.step()
