@@ -183,7 +183,7 @@ class RelationalDeepSym(nn.Module):
             self.table = nn.Linear(f, 1)
         width = max(cfg.bits, cfg.location_bits)
         self.token = nn.Linear(width + 4, h)  # code, kind (2), is the pick location, is the release location
-        heads = r + 1 + int(cfg.support)  # rests-on carries messages both ways, as two heads
+        self.heads = heads = r + 1 + int(cfg.support)  # message heads: rests-on carries messages both ways, as two
         self.values = nn.ModuleList(nn.Linear(h, heads * h) for _ in range(cfg.rounds))
         self.updates = nn.ModuleList(nn.Sequential(nn.Linear(heads * h + h, h), nn.ReLU(), nn.Linear(h, h))
                                      for _ in range(cfg.rounds))
@@ -266,7 +266,7 @@ class RelationalDeepSym(nn.Module):
         flags[rows, k + pick, 0] = 1.0
         flags[rows, k + release, 1] = 1.0
         tok = self.token(torch.cat([z, kind, flags], -1)) * ent[..., None]
-        heads, h = self.cfg.n_relations + 1 + int(self.cfg.support), self.cfg.hidden
+        heads, h = self.heads, self.cfg.hidden
         # at(o, l) carries messages both ways: an object hears its location, a location the objects at it
         links = torch.cat([rel[:, :1] + rel[:, :1].transpose(-1, -2), rel[:, 1:]], 1)
         if self.cfg.support:  # a support hears what rests on it: the object under the held one is not picked

@@ -127,6 +127,7 @@ def run_learned(sim, model, blob: dict, ops: Sequence[Operator], problem: Proble
     if goal is None:
         goal = goal_atoms(sim, model, blob, problem, cfg.goal_relations)
     goal = frozenset(a for a in goal if a[0] not in cfg.drop)
+    located = frozenset(a for a in goal if a[0] == "at")  # what relax_unreachable plans for
     sim.reset(problem.initial)
     objects = [f"o{i + 1}" for i in range(problem.initial.k)]
     res = LoopResult(problem.name, problem.initial.k, problem.optimal_length, False)
@@ -144,7 +145,6 @@ def run_learned(sim, model, blob: dict, ops: Sequence[Operator], problem: Proble
             return res
         t0 = time.perf_counter()
         plan = solve_texts(domain, problem_pddl("p", objects, state, goal, predicates), cfg.planner, cfg.timeout_s)
-        located = frozenset(a for a in goal if a[0] == "at")
         if cfg.relax_unreachable and plan.status.name == "UNSOLVABLE" and located != goal:
             res.relaxed_calls += 1
             left = max(cfg.timeout_s - (time.perf_counter() - t0), 1.0)
