@@ -18,6 +18,7 @@ import numpy as np
 import torch
 
 from symlearn.learning.entities import entity_inputs, location_crops
+from symlearn.sim.scenarios import SCENARIO_BY_NAME
 from symlearn.world import Action, ObjectType
 
 C, S = ObjectType.CUBE, ObjectType.STICK
@@ -38,13 +39,17 @@ class CarryProbe:
     order: tuple[int, ...] | None = None
 
 
+def _table1(name: str, description: str) -> CarryProbe:
+    """One of Table I's cases, its objects and action as the simulator's scenario table (symlearn.sim.scenarios)
+    sets it up."""
+    sc = SCENARIO_BY_NAME[name]
+    return CarryProbe(sc.name, description, sc.spec, sc.action)
+
+
 CARRY_PROBES: tuple[CarryProbe, ...] = (
-    CarryProbe("table1_case1", "Table I: stick moved one location right, both cubes elsewhere",
-               ((S, 1), (C, 3), (C, 5)), Action(1, 2)),
-    CarryProbe("table1_case2", "Table I: stick moved right, one cube on its left end",
-               ((S, 1), (C, 3), (C, 0)), Action(1, 2)),
-    CarryProbe("table1_case3", "Table I: stick moved right, a cube on each end",
-               ((S, 1), (C, 0), (C, 2)), Action(1, 2)),
+    _table1("table1_case1", "Table I: stick moved one location right, both cubes elsewhere"),
+    _table1("table1_case2", "Table I: stick moved right, one cube on its left end"),
+    _table1("table1_case3", "Table I: stick moved right, a cube on each end"),
     CarryProbe("mirrored", "stick moved one location left, one cube on its right end, one elsewhere",
                ((S, 1), (C, 2), (C, 5)), Action(1, 0)),
     CarryProbe("to_near_row", "stick with a cube on each end carried to the near row's middle",
