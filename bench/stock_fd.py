@@ -12,6 +12,16 @@ again with the same arguments keeps the rows it has (same domain, planners, time
     python bench/stock_fd.py --domain RUN/pddl/lifted/domain.pddl --problems RUN/pddl/lifted \
         --out bench/results/stock_fd.json
     python bench/stock_fd.py --domain d.pddl --problems p01.pddl,p02.pddl --planners fd-lama-first --out x.json
+
+The unified-planning route runs beside them under the names `up-fast-downward`, `up-pyperplan` and `up-symk`
+(search.classical.solve_pddl: OneshotPlanner, every plan checked by UP's PlanValidator). With `--shortest
+OUT/problems.json` (symlearn export-learned-problems), each row gets the simulator's shortest plan length and each
+planner's summary counts the reachable goals it reported unsolvable and its mean plan length over the shortest:
+
+    symlearn export-learned-problems --run pretrained/relations_on --problems problems/rel_test3 --out lp3 \
+        --goal-relations on
+    python bench/stock_fd.py --domain lp3/domain.pddl --problems lp3 --shortest lp3/problems.json \
+        --planners fd-lama-first,fd-lmcut,pyperplan,up-fast-downward,up-pyperplan --out x.json
 """
 from __future__ import annotations
 
@@ -22,6 +32,8 @@ import sys
 from pathlib import Path
 
 DEFAULT_PLANNERS = ("fd-lama-first", "fd-lmcut")
+UP_PLANNERS = {"up-fast-downward": "fast-downward", "up-pyperplan": "pyperplan", "up-symk": "symk"}
+MAX_MANIFEST_BYTES = 16 << 20
 
 
 def problem_files(domain: Path, specs: list[str]) -> list[Path]:
@@ -45,19 +57,50 @@ def problem_files(domain: Path, specs: list[str]) -> list[Path]:
     return out
 
 
+def read_shortest(path: Path) -> dict[str, int | None]:
+    """Problem file name -> the simulator's shortest plan length, from export-learned-problems' problems.json.
+
+    SystemExit (one line) for a file that is missing, too large or not such a manifest."""
+    try:
+        if path.stat().st_size > MAX_MANIFEST_BYTES:
+            raise SystemExit(f"stock_fd: {path} is larger than {MAX_MANIFEST_BYTES} bytes")
+        man = json.loads(path.read_text(encoding="utf-8"))
+        return {str(r["file"]): (None if r["shortest"] is None else int(r["shortest"])) for r in man["rows"]}
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        raise SystemExit(f"stock_fd: {path} is not a problems.json of symlearn export-learned-problems ({e})") from None
+
+
 def summarize(rows: list[dict], planners: list[str]) -> dict:
-    """Per planner: counts by status, and median / max of translate + search and of the whole call."""
+    """Per planner: counts by status, and median / max of translate + search and of the whole call; with the
+    shortest plan lengths, the reachable goals reported unsolvable and the mean plan length over the shortest."""
     out = {}
     for name in planners:
         runs = [r["planners"][name] for r in rows if name in r["planners"]]
         counts = {s: sum(x["status"] == s for x in runs) for s in ("solved", "unsolvable", "timeout", "error")}
         entry: dict = {"problems": len(runs), **counts}
+        known = [(r["planners"][name], r["shortest"]) for r in rows if name in r["planners"] and "shortest" in r]
+        if known:
+            entry["reachable_reported_unsolvable"] = sum(x["status"] == "unsolvable" for x, _ in known)
+            ratios = [x["plan_length"] / n for x, n in known if x["status"] == "solved" and n]
+            entry["plan_over_shortest"] = round(statistics.mean(ratios), 4) if ratios else None
         for key in ("translate_plus_search_s", "fd_translate_time_s", "fd_total_time_s", "call_time_s"):
             vals = [x[key] for x in runs if x.get(key) is not None]
             if vals:
                 entry[key] = {"median": round(statistics.median(vals), 4), "max": round(max(vals), 4)}
         out[name] = entry
     return out
+
+
+def solve(domain: Path, problem: Path, planner: str, timeout_s: float):
+    """One call: a stock planner on the files, or a unified-planning engine on their texts (validated)."""
+    from search.stock_planners import solve_files
+
+    if planner in UP_PLANNERS:
+        from search.classical import solve_pddl
+
+        return solve_pddl(domain.read_text(encoding="utf-8"), problem.read_text(encoding="utf-8"),
+                          UP_PLANNERS[planner], timeout_s)
+    return solve_files(domain, problem, planner, timeout_s)
 
 
 def _previous(out: Path, key: dict) -> dict[str, dict]:
@@ -80,15 +123,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", required=True, type=Path, help="JSON file to write")
     ap.add_argument("--planners", default=",".join(DEFAULT_PLANNERS), help="search.stock_planners names")
     ap.add_argument("--timeout", type=float, default=10.0, help="seconds per call (translate + search)")
+    ap.add_argument("--shortest", type=Path, help="problems.json of symlearn export-learned-problems: the "
+                                                  "simulator's shortest plan length of each problem")
     args = ap.parse_args(argv)
-    from search.stock_planners import STOCK_PLANNERS, call_record, solve_files
+    from search.stock_planners import STOCK_PLANNERS, call_record
     from symlearn.provenance import atomic_write_json, bench_context, sha256_file
 
     try:
         planners = [p for p in args.planners.split(",") if p]
-        bad = [p for p in planners if p not in STOCK_PLANNERS]
+        bad = [p for p in planners if p not in STOCK_PLANNERS and p not in UP_PLANNERS]
         if bad or not planners:
-            raise SystemExit(f"stock_fd: unknown planner(s) {bad or planners}; known: {', '.join(STOCK_PLANNERS)}")
+            raise SystemExit(f"stock_fd: unknown planner(s) {bad or planners}; known: "
+                             f"{', '.join([*STOCK_PLANNERS, *UP_PLANNERS])}")
         if not args.domain.is_file():
             raise SystemExit(f"stock_fd: domain file not found: {args.domain}")
         if not (args.timeout > 0 and args.timeout < float("inf")):
@@ -96,11 +142,15 @@ def main(argv: list[str] | None = None) -> int:
         if not args.out.parent.is_dir() or args.out.is_dir():
             raise SystemExit(f"stock_fd: cannot write {args.out} (its folder does not exist, or it is a folder)")
         problems = problem_files(args.domain, args.problems)
+        shortest = read_shortest(args.shortest) if args.shortest else None
+        missing = [p.name for p in problems if shortest is not None and p.name not in shortest]
+        if missing:
+            raise SystemExit(f"stock_fd: {args.shortest} has no shortest length for {missing[0]}")
     except SystemExit as e:
         print(e, file=sys.stderr)
         return 2
     key = {"domain": str(args.domain), "domain_sha256": sha256_file(args.domain), "planners": planners,
-           "timeout_s": args.timeout}
+           "timeout_s": args.timeout, **({"shortest": str(args.shortest)} if args.shortest else {})}
     done = _previous(args.out, key)
     rows = []
     for problem in problems:
@@ -110,8 +160,10 @@ def main(argv: list[str] | None = None) -> int:
             rows.append(old)
             continue
         rec = {"problem": str(problem), "sha256": digest, "planners": {}}
+        if shortest is not None:
+            rec["shortest"] = shortest[problem.name]
         for name in planners:
-            rec["planners"][name] = call_record(solve_files(args.domain, problem, name, args.timeout))
+            rec["planners"][name] = call_record(solve(args.domain, problem, name, args.timeout))
         rows.append(rec)
         print(f"{problem.name}: " + ", ".join(f"{n} {r['status']} {r['call_time_s']:.2f}s"
                                              for n, r in rec["planners"].items()), flush=True)

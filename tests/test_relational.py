@@ -421,3 +421,42 @@ def test_a_tower_written_by_hand_for_the_rests_on_domain_is_solved_by_stock_plan
     assert len(plans["fd-lmcut"].steps) == 5 and all(len(r.steps) >= 5 for r in plans.values())
     up = solve_pddl(domain, problem, "fast-downward", 60.0)
     assert up.status.name == "SOLVED" and len(up.steps) >= 5, up.message  # UP's validator accepted it
+
+
+def test_exported_learned_problems_are_solvable_wherever_the_simulator_reaches_the_goal(tmp_path, capsys):
+    # a sample of fresh located walks, read by the shipped rests-on model and written as PDDL problems: every goal the
+    # simulator reaches (its shortest plan is known) is solved by stock lama-first and LM-cut on the folder's domain,
+    # LM-cut's plans no longer than the simulator's shortest but by a misread, and the folder re-reads as it was written
+    import pddl as pddl_lib
+
+    from search.stock_planners import solve_files
+
+    rc, _ = cli("problems", "--out", tmp_path / "walks", "--kind", "located-walks", "--n", "6", "--objects", "1-4",
+                "--length", "1-3", "--seed", "11")
+    assert rc == 0
+    out = tmp_path / "lp"
+    rc, printed = cli("export-learned-problems", "--run", SHIPPED_ON, "--problems", tmp_path / "walks", "--out", out,
+                      "--goal-relations", "on")
+    assert rc == 0 and printed.startswith("6 problems written")
+    man = json.loads((out / "problems.json").read_text())
+    assert man["goal_relations"] == ["on"] and len(man["rows"]) == 6
+    domain = pddl_lib.parse_domain(out / "domain.pddl")
+    assert {p.name for p in domain.predicates} >= {"at", "on", "clear", "on-table", "empty"}
+    for row in man["rows"]:
+        problem = pddl_lib.parse_problem(out / row["file"])
+        assert len(problem.objects) == row["k"]  # o1..ok, the locations are the domain's constants
+        walks = json.loads((tmp_path / "walks" / f"{row['name']}.json").read_text())
+        assert row["shortest"] is not None and row["shortest"] <= len(walks["actions"])
+        for planner in ("fd-lama-first", "fd-lmcut"):
+            res = solve_files(out / "domain.pddl", out / row["file"], planner, 60.0)
+            assert res.status.name == "SOLVED", (row["name"], planner, res.message)
+        assert 1 <= len(res.steps) <= row["shortest"] + 1, (row["name"], res.steps)
+    # never over an existing folder, and a relation no operator reads is refused, both in one line
+    capsys.readouterr()
+    rc, _ = cli("export-learned-problems", "--run", SHIPPED_ON, "--problems", tmp_path / "walks", "--out", out)
+    err = capsys.readouterr().err
+    assert rc == 2 and f"{out} exists" in err and len(err.strip().splitlines()) == 1
+    rc, _ = cli("export-learned-problems", "--run", SHIPPED_ON, "--problems", tmp_path / "walks",
+                "--out", tmp_path / "lp2", "--goal-relations", "r7")
+    err = capsys.readouterr().err
+    assert rc == 2 and "r7" in err and "operators.json" in err and not (tmp_path / "lp2").exists()

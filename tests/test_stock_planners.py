@@ -350,3 +350,32 @@ def test_the_stock_fd_bench_records_each_problem_and_resumes(toy, tmp_path, monk
     capsys.readouterr()
     assert bench.main(["--domain", str(tmp_path / "none.pddl"), "--problems", str(toy), "--out", str(out)]) == 2
     assert capsys.readouterr().err.strip() == f"stock_fd: domain file not found: {tmp_path / 'none.pddl'}"
+
+
+def test_the_stock_fd_bench_runs_the_up_route_and_counts_reachable_goals_reported_unsolvable(toy, tmp_path, capsys):
+    import json
+
+    bench, out = _bench(), tmp_path / "stock.json"
+    # as export-learned-problems writes it: the simulator's shortest length per problem file (here: the unsolvable
+    # problem is said to be reachable, as a misread learned state would make it)
+    man = tmp_path / "problems.json"
+    man.write_text(json.dumps({"rows": [{"file": "reverse.pddl", "shortest": 7}, {"file": "unsolvable.pddl",
+                                                                                  "shortest": 3}]}))
+    argv = ["--domain", str(toy / "domain.pddl"), "--problems", f"{toy / 'reverse.pddl'},{toy / 'unsolvable.pddl'}",
+            "--planners", "fd-lmcut,up-fast-downward", "--shortest", str(man), "--out", str(out)]
+    assert bench.main(argv) == 0
+    rec = json.loads(out.read_text())
+    assert [r["shortest"] for r in rec["rows"]] == [7, 3]
+    for name in ("fd-lmcut", "up-fast-downward"):
+        s = rec["summary"][name]
+        assert (s["solved"], s["unsolvable"], s["reachable_reported_unsolvable"]) == (1, 1, 1), (name, s)
+    assert rec["summary"]["fd-lmcut"]["plan_over_shortest"] == pytest.approx(1.0)
+    assert rec["rows"][0]["planners"]["up-fast-downward"]["plan_length"] >= 7  # validated by UP's PlanValidator
+    capsys.readouterr()
+    man.write_text(json.dumps({"rows": [{"file": "reverse.pddl", "shortest": 7}]}))
+    assert bench.main([*argv[:-2], "--out", str(tmp_path / "other.json")]) == 2
+    assert capsys.readouterr().err.strip() == f"stock_fd: {man} has no shortest length for unsolvable.pddl"
+    man.write_text("[1, 2]")
+    assert bench.main([*argv[:-2], "--out", str(tmp_path / "other.json")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"stock_fd: {man} is not a problems.json") and not (tmp_path / "other.json").exists()

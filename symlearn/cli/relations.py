@@ -5,6 +5,7 @@
     symlearn carrying --run RUN                           # Table I and its variants, predicted and executed
     symlearn export-learned --run RUN --data data/paper_a data/k15   # RUN/learned/domain.pddl
     symlearn benchmark-learned --run RUN --problems DIR --out FILE  # closed loop with stock Fast Downward
+    symlearn export-learned-problems --run RUN --problems DIR --out OUT   # OUT/*.pddl for planners outside
 """
 from __future__ import annotations
 
@@ -91,6 +92,18 @@ def cmd_benchmark_learned(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_export_learned_problems(args: argparse.Namespace) -> int:
+    from symlearn.planning.learned_problems import export_learned_problems
+
+    set_threads(args.threads)
+    man = export_learned_problems(Path(args.run), Path(args.problems), Path(args.out),
+                                  tuple(args.goal_relations or ()))
+    believed = sum(r["goal_believed_reached"] for r in man["rows"])
+    print(f"{len(man['rows'])} problems written to {args.out} (domain.pddl, NAME.pddl, problems.json); "
+          f"{believed} goals already hold in the initial state as read")
+    return 0
+
+
 def add_relations_commands(sub) -> None:
     """Add `train-relations` and `relations` to the CLI's sub-parsers."""
     t = sub.add_parser("train-relations", help="train the relational effect model: unary and relational bits "
@@ -148,3 +161,12 @@ def add_relations_commands(sub) -> None:
                    help="when the goal with its relations is proved unreachable, plan for its at atoms alone")
     b.add_argument("--threads", type=thread_count)
     b.set_defaults(func=cmd_benchmark_learned)
+
+    q = sub.add_parser("export-learned-problems", help="a problem set read by the learned model, written as PDDL "
+                       "problems of RUN/learned/domain.pddl (OUT/*.pddl, OUT/problems.json with shortest lengths)")
+    q.add_argument("--run", required=True)
+    q.add_argument("--problems", required=True, help="a folder of symlearn problems (symlearn problems)")
+    q.add_argument("--out", required=True, help="a new folder (never written over)")
+    q.add_argument("--goal-relations", nargs="*", help="object-object relations the goals keep beside at, e.g. on")
+    q.add_argument("--threads", type=thread_count)
+    q.set_defaults(func=cmd_export_learned_problems)

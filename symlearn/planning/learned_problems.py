@@ -1,0 +1,71 @@
+"""A problem set written as PDDL problems of a run's learned domain, for planners run outside the project.
+
+    symlearn export-learned-problems --run pretrained/relations_on --problems problems/rel_test3 \
+        --out out/rel_test3 --goal-relations on
+
+Each problem's initial scene and goal scene are placed in the simulator and read by the relational model,
+exactly as the closed loop reads them (symlearn.planning.learned_loop: `observe_atoms`, `goal_atoms`), and
+written as OUT/NAME.pddl over OUT/domain.pddl, the domain the closed loop plans with. OUT/problems.json records,
+per problem, the simulator's shortest plan length (the generator's), so that a planner run on the folder
+(bench/stock_fd.py --shortest OUT/problems.json) can tell a reachable goal reported unsolvable, and how long its
+plans are against the shortest; with the run, model and operator hashes, the settings and the versions.
+
+The folder is written whole at the end (atomic_write_folder) and never over an existing one.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from pddl_export.files import atomic_write_folder, sha256_file
+from pddl_export.learned_domain import domain_pddl, predicates_of, problem_pddl
+from symlearn.export.learned_export import load_operators, operators_path
+from symlearn.learning.relational_training import CHECKPOINT, load_relational
+from symlearn.planning.learned_loop import goal_atoms, observe_atoms
+from symlearn.problems.problem import load_problems
+from symlearn.provenance import versions
+
+MANIFEST = "problems.json"
+FORMAT = "symlearn-learned-problems"
+
+
+def export_learned_problems(run_dir: Path, problems_dir: Path, out: Path,
+                            goal_relations: tuple[str, ...] = ()) -> dict:
+    """Write OUT/domain.pddl, OUT/NAME.pddl for every problem of problems_dir and OUT/problems.json; returns the
+    manifest. Refused in one line, before the simulator starts, when OUT exists or a input is missing."""
+    from symlearn.sim.simulator import TabletopSimulator
+
+    run_dir, problems_dir, out = Path(run_dir), Path(problems_dir), Path(out)
+    if out.exists():
+        raise ValueError(f"{out} exists; choose another --out (nothing is written over it)")
+    if not out.parent.is_dir():
+        raise ValueError(f"cannot write {out}: its folder {out.parent} does not exist")
+    ops = load_operators(run_dir)
+    model, blob = load_relational(run_dir)
+    heads = {p for o in ops for a in (*o.precondition, *o.add, *o.delete) for p in [a[0]]}
+    unknown = [r for r in goal_relations if r not in heads]
+    if unknown:
+        raise ValueError(f"{operators_path(run_dir)}: no operator reads or changes {unknown}; "
+                         f"relations of this domain: {sorted(heads - {'at', 'empty'})}")
+    problems = load_problems(problems_dir)
+    domain = domain_pddl(ops)
+    predicates = predicates_of(ops)
+    files: dict[str, str] = {"domain.pddl": domain}
+    rows = []
+    with TabletopSimulator() as sim:
+        for path, problem in problems:
+            goal = goal_atoms(sim, model, blob, problem, goal_relations)
+            sim.reset(problem.initial)
+            init = observe_atoms(sim, model, blob)
+            objects = [f"o{i + 1}" for i in range(problem.initial.k)]
+            files[f"{problem.name}.pddl"] = problem_pddl(problem.name, objects, init, goal, predicates)
+            rows.append({"name": problem.name, "file": f"{problem.name}.pddl", "k": problem.initial.k,
+                         "shortest": problem.optimal_length, "generator_length": problem.generator_length,
+                         "goal_atoms": len(goal), "goal_believed_reached": goal <= init,
+                         "problem_sha256": sha256_file(path)})
+    manifest = {"format": FORMAT, "run": str(run_dir), "model_sha256": sha256_file(run_dir / CHECKPOINT),
+                "operators_sha256": sha256_file(operators_path(run_dir)), "problems": str(problems_dir),
+                "goal_relations": list(goal_relations), "rows": rows, "versions": versions()}
+    files[MANIFEST] = json.dumps(manifest, indent=1)
+    atomic_write_folder(out, files)
+    return manifest
