@@ -169,3 +169,20 @@ def test_a_goal_keeps_only_the_on_atoms_its_at_atoms_allow():
     assert consistent_goal(goal) == goal - {("on", "c", "b"), ("on", "d", "b")}  # d has no location in the goal: dropped too
     two = frozenset({("at", "a", "l1"), ("at", "b", "l1"), ("at", "c", "l1"), ("on", "a", "c"), ("on", "b", "c")})
     assert consistent_goal(two) == two - {("on", "a", "c"), ("on", "b", "c")}  # two on one: the order is left open
+
+
+def test_the_confidence_bound_drops_an_operator_whose_precision_rests_on_few_groundings():
+    from symlearn.export.learned_export import LearnedExportConfig, find_operators, wilson_lower
+
+    assert wilson_lower(4, 16, 0.0) == 0.25 and wilson_lower(0, 0, 1.96) == 0.0
+    assert abs(wilson_lower(4, 16, 1.96) - 0.1017) < 1e-3 and abs(wilson_lower(950, 1385, 1.96) - 0.661) < 1e-3
+    onto, _, _ = _stack_world()
+    # both operators predicted every grounding they had: 20 of 20 (onto a block on the table) and 10 of 10 (lifted
+    # off a block); at 95% confidence only the first shows a precision of 0.8
+    kept = {}
+    for z in (0.0, 1.96):
+        ops, notes = find_operators(onto, LearnedExportConfig(min_count=3, share=0.85, min_precision=0.8,
+                                                              confidence_z=z))
+        kept[z] = [(n["applies"], n["predicts"]) for n in notes if n["kept"]]
+        assert [n["precision"] for n in notes] == [1.0, 1.0] and len(ops) == len(kept[z])
+    assert kept == {0.0: [(20, 20), (10, 10)], 1.96: [(20, 20)]}

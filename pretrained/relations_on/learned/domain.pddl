@@ -13,7 +13,6 @@
     (u2 ?x0 - item)
     (u4 ?x0 - item)
     (u5 ?x0 - item)
-    (u6 ?x0 - item)
     (u7 ?x0 - item)
   )
   (:action move-0  ; seen 4769 times
@@ -52,36 +51,8 @@
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
     :precondition (and (at ?o1 l1) (at ?o2 ?to) (clear ?o1) (empty ?from) (u0 ?o1) (u1 ?o2) (not (= ?from ?to)) (not (= ?o1 ?o2)))
     :effect (and (at ?o1 ?to) (empty l1) (on ?o1 ?o2) (not (at ?o1 l1)) (not (clear ?o2)) (not (on-table ?o1))))
-  (:action move-21  ; seen 41 times
-    :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
-    :precondition (and (at ?o1 ?from) (at ?o2 l1) (empty ?to) (on-table ?o1) (u5 ?o1) (u7 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)))
-    :effect (and (at ?o1 ?to) (at ?o2 ?to) (empty ?from) (empty l1) (not (at ?o1 ?from)) (not (at ?o2 l1)) (not (empty ?to))))
   (:action move-22  ; seen 39 times
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
     :precondition (and (at ?o1 ?from) (at ?o2 ?to) (clear ?o1) (empty l0) (u0 ?o1) (u5 ?o2) (u7 ?o1) (u7 ?o2) (not (= ?from ?to)) (not (= ?o1 ?o2)))
     :effect (and (at ?o1 l0) (empty ?from) (on ?o1 ?o2) (not (at ?o1 ?from)) (not (clear ?o2)) (not (empty l0)) (not (on-table ?o1))))
-  (:action move-26  ; seen 35 times
-    :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
-    :precondition (and (at ?o1 l0) (at ?o2 ?to) (clear ?o1) (clear ?o2) (empty ?from) (on-table ?o1) (u5 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)))
-    :effect (and (at ?o1 ?to) (empty l0) (on ?o1 ?o2) (not (at ?o1 l0)) (not (clear ?o2)) (not (on-table ?o1))))
-  (:action move-27  ; seen 32 times
-    :parameters (?from - location ?o1 - item ?to - location)
-    :precondition (and (at ?o1 ?to) (clear ?o1) (empty ?from) (empty l2) (u0 ?o1) (u6 ?o1) (u7 ?o1) (not (= ?from ?to)))
-    :effect (and (at ?o1 ?from) (empty ?to) (not (at ?o1 ?to)) (not (empty ?from))))
-  (:action move-30  ; seen 30 times
-    :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
-    :precondition (and (at ?o1 ?from) (at ?o2 ?to) (clear ?o2) (empty l0) (on-table ?o1) (u0 ?o2) (u5 ?o2) (u7 ?o2) (not (= ?from ?to)) (not (= ?o1 ?o2)))
-    :effect (and (at ?o1 ?to) (at ?o2 l0) (empty ?from) (on ?o1 ?o2) (not (at ?o1 ?from)) (not (at ?o2 ?to)) (not (clear ?o2)) (not (empty l0)) (not (on-table ?o1))))
-  (:action move-32  ; seen 30 times
-    :parameters (?from - location ?o1 - item ?o2 - item ?o3 - item ?to - location)
-    :precondition (and (at ?o1 ?from) (at ?o3 ?to) (clear ?o1) (clear ?o3) (empty l1) (on ?o1 ?o2) (on-table ?o2) (on-table ?o3) (u0 ?o1) (u2 ?o2) (u2 ?o3) (not (= ?from ?to)) (not (= ?o1 ?o2)) (not (= ?o1 ?o3)) (not (= ?o2 ?o3)))
-    :effect (and (at ?o1 l1) (clear ?o2) (on ?o1 ?o3) (not (at ?o1 ?from)) (not (clear ?o3)) (not (empty l1)) (not (on ?o1 ?o2))))
-  (:action move-37  ; seen 28 times
-    :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
-    :precondition (and (at ?o1 ?from) (at ?o2 ?to) (clear ?o2) (empty l1) (on-table ?o2) (u1 ?o1) (u5 ?o2) (u7 ?o2) (not (= ?from ?to)) (not (= ?o1 ?o2)))
-    :effect (and (at ?o1 ?to) (at ?o2 l1) (empty ?from) (on ?o1 ?o2) (not (at ?o1 ?from)) (not (at ?o2 ?to)) (not (clear ?o2)) (not (empty l1)) (not (on-table ?o1))))
-  (:action move-41  ; seen 26 times
-    :parameters (?from - location ?o1 - item ?o2 - item ?o3 - item ?to - location)
-    :precondition (and (at ?o1 ?from) (at ?o2 ?from) (on ?o1 ?o3) (on ?o2 ?o1) (u5 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)) (not (= ?o1 ?o3)) (not (= ?o2 ?o3)))
-    :effect (and (at ?o1 ?to) (at ?o2 ?to) (clear ?o3) (on-table ?o1) (not (at ?o1 ?from)) (not (at ?o2 ?from)) (not (empty ?to)) (not (on ?o1 ?o3))))
 )
