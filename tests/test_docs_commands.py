@@ -57,6 +57,19 @@ def _script_flags(script: Path) -> set[str]:
     return flags
 
 
+def _script_planner_names(script: Path) -> set[str]:
+    """The keys of the bench script's UP_PLANNERS map: the unified-planning engines it runs beside the stock ones
+    (read from its source, nothing imported)."""
+    for node in ast.walk(ast.parse(script.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Assign) and any(getattr(t, "id", "") == "UP_PLANNERS" for t in node.targets):
+            return {k.value for k in node.value.keys if isinstance(k, ast.Constant)}
+    return set()
+
+
+STOCK_FD_PLANNERS = set(STOCK_PLANNERS) | _script_planner_names(Path(__file__).resolve().parents[1] / "bench" /
+                                                                 "stock_fd.py")
+
+
 def command_problems(command: str, subcommands: dict[str, argparse.ArgumentParser]) -> list[str]:
     """What in one documented command the code would refuse; [] when nothing."""
     toks = [t.strip("[]") for t in command.split()]
@@ -79,7 +92,7 @@ def command_problems(command: str, subcommands: dict[str, argparse.ArgumentParse
             problems.append(f"unknown flag {flag}")
             continue
         if flag == "--planners" and not _placeholder(value):
-            known = STOCK_PLANNERS if toks[1] == "bench/stock_fd.py" else PLANNERS  # it runs stock configurations
+            known = STOCK_FD_PLANNERS if toks[1] == "bench/stock_fd.py" else PLANNERS  # it runs stock configurations
             problems += [f"unknown planner {n!r}" for n in value.split(",") if n and n not in known]
         action = actions[flag]
         if action is not None and action.choices and value and not _placeholder(value):

@@ -1,14 +1,17 @@
 """A problem set written as PDDL problems of a run's learned domain, for planners run outside the project.
 
-    symlearn export-learned-problems --run pretrained/relations_on --problems problems/rel_test3 \
-        --out out/rel_test3 --goal-relations on
+    symlearn export-learned-problems --run pretrained/relations_on --problems problems/rel_test4 \\
+        --out out/rel_test4 --goal-relations on
 
 Each problem's initial scene and goal scene are placed in the simulator and read by the relational model,
 exactly as the closed loop reads them (symlearn.planning.learned_loop: `observe_atoms`, `goal_atoms`), and
 written as OUT/NAME.pddl over OUT/domain.pddl, the domain the closed loop plans with. OUT/problems.json records,
-per problem, the simulator's shortest plan length (the generator's), so that a planner run on the folder
-(bench/stock_fd.py --shortest OUT/problems.json) can tell a reachable goal reported unsolvable, and how long its
-plans are against the shortest; with the run, model and operator hashes, the settings and the versions.
+per problem, its shortest plan in the simulator (the problem's `optimal_length`), so that a planner run on the
+folder can tell a reachable goal reported unsolvable and how long its plans are against the shortest:
+
+    python bench/stock_fd.py --domain OUT/domain.pddl --problems OUT --shortest OUT/problems.json --out x.json
+
+It also records the run, model and operator hashes, the settings and the versions.
 
 The folder is written whole at the end (atomic_write_folder) and never over an existing one.
 """
@@ -32,7 +35,7 @@ FORMAT = "symlearn-learned-problems"
 def export_learned_problems(run_dir: Path, problems_dir: Path, out: Path,
                             goal_relations: tuple[str, ...] = ()) -> dict:
     """Write OUT/domain.pddl, OUT/NAME.pddl for every problem of problems_dir and OUT/problems.json; returns the
-    manifest. Refused in one line, before the simulator starts, when OUT exists or a input is missing."""
+    manifest. Refused in one line, before the simulator starts, when OUT exists or an input is missing."""
     from symlearn.sim.simulator import TabletopSimulator
 
     run_dir, problems_dir, out = Path(run_dir), Path(problems_dir), Path(out)
