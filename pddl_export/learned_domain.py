@@ -72,10 +72,16 @@ def changes(t: Transition) -> tuple[frozenset[Atom], frozenset[Atom]]:
     return add, delete
 
 
+def location_binding(t: Transition) -> dict[str, str]:
+    """The action's location variables and their locations: ?at when it releases where it picked, else ?from and
+    ?to."""
+    return {"?at": t.pick} if t.pick == t.release else {"?from": t.pick, "?to": t.release}
+
+
 def lift(t: Transition) -> tuple[tuple, dict[str, str]]:
     """A transition's lifted effect key ((location variables), add, delete) and the names it gave."""
     add, delete = changes(t)
-    locs = {t.pick: "?at"} if t.pick == t.release else {t.pick: "?from", t.release: "?to"}
+    locs = {loc: var for var, loc in location_binding(t).items()}
     objs = sorted({a for atom in add | delete for a in atom[1:] if a not in locs and not a.startswith("l")})
     best = None
     for perm in itertools.permutations(objs) if len(objs) <= 4 else [tuple(objs)]:
@@ -156,7 +162,7 @@ def precision(ops: Sequence[Operator], transitions: Sequence[Transition]) -> lis
         loc_vars = {v for v, t in op.parameters if t == "location"}
         applies = hits = 0
         for t in transitions:
-            fixed = {"?at": t.pick} if t.pick == t.release else {"?from": t.pick, "?to": t.release}
+            fixed = location_binding(t)
             if set(fixed) != loc_vars:
                 continue
             add, delete = changes(t)

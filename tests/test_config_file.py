@@ -102,6 +102,13 @@ def test_the_presets_the_cli_lists_are_the_configs_presets():
     train, transition = (next(a for a in sub[c]._actions if a.dest == "preset") for c in ("train", "train-transition"))
     assert list(train.choices) == list(TRAIN_PRESETS) and list(transition.choices) == list(TRANSITION_PRESETS)
     assert set(TRAIN_PRESETS) == set(TRANSITION_PRESETS) == set(PRESETS)
+    # the learned relational route's presets, written out in the CLI so that it loads without torch
+    from symlearn.export.learned_export import EXPORT_PRESETS
+    from symlearn.learning.relational_training import TRAIN_PRESETS as RELATIONAL_PRESETS
+
+    relational, export = (next(a for a in sub[c]._actions if a.dest == "preset")
+                          for c in ("train-relations", "export-learned"))
+    assert set(relational.choices) == set(RELATIONAL_PRESETS) and set(export.choices) == set(EXPORT_PRESETS)
     rec = TrainConfig.from_preset("recommended")
     quick = TrainConfig.from_preset("quick")
     # the recipe: the stability loss, the action on the held object, rider scenes three times an epoch, float32

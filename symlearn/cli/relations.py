@@ -17,7 +17,8 @@ from pathlib import Path
 from symlearn.cli.args import non_negative_int, positive_int, set_threads, thread_count
 from symlearn.outputs import folder_output
 
-TRAIN_PRESET_NAMES = ("attention", "support", "support-post", "support-exclusive")  # symlearn.learning.relational_training.TRAIN_PRESETS (kept torch-free)
+# the keys of symlearn.learning.relational_training.TRAIN_PRESETS, written here so that the CLI loads without torch
+TRAIN_PRESET_NAMES = ("attention", "support", "support-post", "support-exclusive")
 
 
 def cmd_train_relations(args: argparse.Namespace) -> int:

@@ -57,8 +57,8 @@ class LearnedExportConfig:
     def __post_init__(self) -> None:
         check_bounds(self, {"min_count": Bound(1, 2**62, integer=True), "share": Bound(0.0, 1.0, lo_open=True),
                             "max_objects": Bound(1, 8, integer=True), "min_precision": Bound(0.0, 1.0),
-                            "slack": Bound(-1.0, 1.0), "confidence_z": Bound(0.0, 10.0), "sample": Bound(1, 2**31, integer=True),
-                            "seed": Bound(0, 2**63 - 1, integer=True)})
+                            "slack": Bound(-1.0, 1.0), "confidence_z": Bound(0.0, 10.0),
+                            "sample": Bound(1, 2**31, integer=True), "seed": Bound(0, 2**63 - 1, integer=True)})
 
     @staticmethod
     def from_preset(name: str, **overrides) -> "LearnedExportConfig":
@@ -86,9 +86,9 @@ def wilson_lower(hits: int, n: int, z: float) -> float:
 
 
 def prune_dead_relations(transitions: list[Transition]) -> list[Transition]:
-    """The transitions without the `nothing-rK` atoms (`clear`, `on-table` for `on`) of every head K that holds for no pair in any state: such a
-    head learned nothing (training switched it off), and its negation, true of every object, only clutters the
-    domain."""
+    """The transitions without the `nothing-rK` atoms (`clear`, `on-table` for `on`) of every head K that holds for no
+    pair in any state: such a head learned nothing (training switched it off), and its negation, true of every
+    object, only clutters the domain."""
     alive = {a[0] for t in transitions for a in t.pre | t.post}
     dead = {p for p in alive if p.startswith("nothing-") and p[len("nothing-"):] not in alive}
     if "on" not in alive:  # a rests-on head that never fired: clear and on-table are true of every object
@@ -147,6 +147,12 @@ def export_learned(run_dir: Path, roots: Sequence[Path], cfg: LearnedExportConfi
 def operators_path(run_dir: Path) -> Path:
     """RUN/learned/operators.json."""
     return Path(run_dir) / LEARNED_DIR / OPERATORS
+
+
+def run_hashes(run_dir: Path) -> dict[str, str]:
+    """The sha256 of a run's relational model and of its learned operators: what a result read from them names."""
+    return {"model_sha256": sha256_file(Path(run_dir) / CHECKPOINT),
+            "operators_sha256": sha256_file(operators_path(run_dir))}
 
 
 def load_operators(run_dir: Path) -> list[Operator]:

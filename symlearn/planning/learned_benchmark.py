@@ -8,9 +8,9 @@ import json
 from pathlib import Path
 
 from pddl_export.bounded_json import read_json_file
-from pddl_export.files import atomic_write_text, sha256_file
-from symlearn.export.learned_export import load_operators, operators_path
-from symlearn.learning.relational_training import CHECKPOINT, load_relational
+from pddl_export.files import atomic_write_text
+from symlearn.export.learned_export import load_operators, run_hashes
+from symlearn.learning.relational_training import load_relational
 from symlearn.planning.learned_loop import LearnedLoopConfig, LoopResult, run_learned, summarize
 from symlearn.problems.problem import load_problems
 from symlearn.provenance import versions
@@ -27,8 +27,7 @@ def benchmark_learned(run_dir: Path, problems_dir: Path, out: Path, timeout_s: f
                             relax_unreachable=relax_unreachable)
     ops = load_operators(run_dir)
     model, blob = load_relational(Path(run_dir))
-    settings = {"run": str(run_dir), "model_sha256": sha256_file(Path(run_dir) / CHECKPOINT),
-                "operators_sha256": sha256_file(operators_path(run_dir)), "problems": str(problems_dir),
+    settings = {"run": str(run_dir), **run_hashes(run_dir), "problems": str(problems_dir),
                 "config": {**cfg.__dict__, "goal_relations": list(cfg.goal_relations), "drop": list(cfg.drop)}}
     done: dict[str, dict] = {}
     if out.is_file():

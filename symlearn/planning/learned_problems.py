@@ -22,8 +22,8 @@ from pathlib import Path
 
 from pddl_export.files import atomic_write_folder, sha256_file
 from pddl_export.learned_domain import domain_pddl, predicates_of, problem_pddl
-from symlearn.export.learned_export import load_operators, operators_path
-from symlearn.learning.relational_training import CHECKPOINT, load_relational
+from symlearn.export.learned_export import load_operators, operators_path, run_hashes
+from symlearn.learning.relational_training import load_relational
 from symlearn.planning.learned_loop import goal_atoms, observe_atoms
 from symlearn.problems.problem import load_problems
 from symlearn.provenance import versions
@@ -45,15 +45,13 @@ def export_learned_problems(run_dir: Path, problems_dir: Path, out: Path,
         raise ValueError(f"cannot write {out}: its folder {out.parent} does not exist")
     ops = load_operators(run_dir)
     model, blob = load_relational(run_dir)
-    heads = {p for o in ops for a in (*o.precondition, *o.add, *o.delete) for p in [a[0]]}
-    unknown = [r for r in goal_relations if r not in heads]
+    predicates = predicates_of(ops)
+    unknown = [r for r in goal_relations if r not in predicates]
     if unknown:
         raise ValueError(f"{operators_path(run_dir)}: no operator reads or changes {unknown}; "
-                         f"relations of this domain: {sorted(heads - {'at', 'empty'})}")
+                         f"relations of this domain: {sorted(set(predicates) - {'at', 'empty'})}")
     problems = load_problems(problems_dir)
-    domain = domain_pddl(ops)
-    predicates = predicates_of(ops)
-    files: dict[str, str] = {"domain.pddl": domain}
+    files: dict[str, str] = {"domain.pddl": domain_pddl(ops)}
     rows = []
     with TabletopSimulator() as sim:
         for path, problem in problems:
@@ -66,8 +64,7 @@ def export_learned_problems(run_dir: Path, problems_dir: Path, out: Path,
                          "shortest": problem.optimal_length, "generator_length": problem.generator_length,
                          "goal_atoms": len(goal), "goal_believed_reached": goal <= init,
                          "problem_sha256": sha256_file(path)})
-    manifest = {"format": FORMAT, "run": str(run_dir), "model_sha256": sha256_file(run_dir / CHECKPOINT),
-                "operators_sha256": sha256_file(operators_path(run_dir)), "problems": str(problems_dir),
+    manifest = {"format": FORMAT, "run": str(run_dir), **run_hashes(run_dir), "problems": str(problems_dir),
                 "goal_relations": list(goal_relations), "rows": rows, "versions": versions()}
     files[MANIFEST] = json.dumps(manifest, indent=1)
     atomic_write_folder(out, files)

@@ -79,6 +79,6 @@ def data_transitions(model, blob: dict, roots: Sequence[Path], split: str) -> li
         post = scene_symbols(model, windows, d.post_depth, d.post_origin, d.n_objects)
         for i in range(len(d)):
             n, a = int(d.n_objects[i]), int(d.action[i])
-            out.append(Transition(atoms_of(pre[0][i], pre[1][i], n, support), atoms_of(post[0][i], post[1][i], n, support),
-                                  f"l{a // 6}", f"l{a % 6}"))
+            out.append(Transition(atoms_of(pre[0][i], pre[1][i], n, support),
+                                  atoms_of(post[0][i], post[1][i], n, support), f"l{a // 6}", f"l{a % 6}"))
     return out
