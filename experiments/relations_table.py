@@ -2,7 +2,8 @@
 whole-code route on the same problems, closed loop, by objects x shortest-plan length.
 
     python experiments/relations_table.py --learned RUN/learned/test.json RUN/learned/test68.json \\
-        [--learned-on RUN_ON/learned/test.json ...] [--benchmark ORACLE.json] --out bench/results/relations_test_table.json
+        [--learned-on RUN_ON/learned/test.json ...] [--learned-cover RUN_COVER/learned/test.json ...] \
+        [--benchmark ORACLE.json] --out bench/results/relations_test_table.json
 
 ORACLE.json is `symlearn benchmark --run pretrained/recommended --problems A,B --planners
 fast-downward-lifted,astar-outcomes` on the same sets (its closed-loop rows are read).
@@ -46,11 +47,13 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--learned", nargs="+", required=True, help="benchmark-learned result files of the at-only model")
     ap.add_argument("--learned-on", nargs="*", default=[], help="benchmark-learned result files of the rests-on model")
+    ap.add_argument("--learned-cover", nargs="*", default=[], help="benchmark-learned result files of the cover model")
     ap.add_argument("--benchmark", help="a symlearn benchmark file of the oracle and whole-code routes")
     ap.add_argument("--out", required=True)
     a = ap.parse_args()
     rows = []
-    for route, files in (("learned at (fd-lama-first)", a.learned), ("learned at + on (fd-lama-first)", a.learned_on)):
+    for route, files in (("learned at (fd-lama-first)", a.learned), ("learned at + on (fd-lama-first)", a.learned_on),
+                         ("learned cover at + on (fd-lama-first)", a.learned_cover)):
         for f in files:
             for r in json.loads(Path(f).read_text())["results"]:
                 opt = r["optimal_length"]
@@ -62,7 +65,8 @@ def main() -> None:
             opt = r.get("optimal_length")
             rows.append((names[r["planner"]], r["n_objects"], opt, r["success"],
                          r["executed_length"] / opt if r["success"] and opt and r.get("executed_length") else None))
-    atomic_write_json(Path(a.out), {"learned": a.learned, "learned_on": a.learned_on, "benchmark": a.benchmark,
+    atomic_write_json(Path(a.out), {"learned": a.learned, "learned_on": a.learned_on, "learned_cover": a.learned_cover,
+                                    "benchmark": a.benchmark,
                                     "table": table(rows)})
 
 

@@ -78,10 +78,20 @@ def location_binding(t: Transition) -> dict[str, str]:
     return {"?at": t.pick} if t.pick == t.release else {"?from": t.pick, "?to": t.release}
 
 
-def lift(t: Transition) -> tuple[tuple, dict[str, str]]:
-    """A transition's lifted effect key ((location variables), add, delete) and the names it gave."""
+def names_a_place(atoms: Iterable[Atom]) -> bool:
+    """Whether lifted atoms name a location constant (a location outside the action's two arguments)."""
+    return any(not x.startswith("?") and x.startswith("l") for a in atoms for x in a[1:])
+
+
+def lift(t: Transition, placed: bool = False) -> tuple[tuple, dict[str, str]]:
+    """A transition's lifted effect key ((location variables), add, delete, where) and the names it gave. With
+    `placed`, an effect that names a location outside the action's two arguments is keyed by where the action
+    was too (`where`: ((variable, location), ...); () otherwise): such an effect depends on the place (a stick
+    released at l1 covers l0 and l2 as well, one released at l4 does not), so its operator is for that place. A
+    location it adds pins the release location (`?to`), one it deletes the pick location (`?from`)."""
     add, delete = changes(t)
-    locs = {loc: var for var, loc in location_binding(t).items()}
+    binding = location_binding(t)
+    locs = {loc: var for var, loc in binding.items()}
     objs = sorted({a for atom in add | delete for a in atom[1:] if a not in locs and not a.startswith("l")})
     best = None
     for perm in itertools.permutations(objs) if len(objs) <= 4 else [tuple(objs)]:
@@ -90,29 +100,40 @@ def lift(t: Transition) -> tuple[tuple, dict[str, str]]:
                tuple(sorted(_lift(a, names) for a in delete)))
         if best is None or key < best[0]:
             best = (key, names)
-    return best
+    key, names = best
+    where = ()
+    if placed:  # a place it adds depends on where it let go, a place it deletes on where it picked
+        add, delete = key[1], key[2]  # (empty l) is "nothing at l": its deletion is an arrival, its addition a leaving
+        arrives = [a for a in add if a[0] != "empty"] + [a for a in delete if a[0] == "empty"]
+        leaves = [a for a in delete if a[0] != "empty"] + [a for a in add if a[0] == "empty"]
+        pinned = {"?to", "?at"} if names_a_place(arrives) else set()
+        pinned |= {"?from", "?at"} if names_a_place(leaves) else set()
+        where = tuple(sorted((v, loc) for v, loc in binding.items() if v in pinned))
+    return (*key, where), names
 
 
 def learn_operators(transitions: Iterable[Transition], min_count: int = 3, share: float = 1.0,
-                    max_objects: int = 4) -> list[Operator]:
+                    max_objects: int = 4, placed: bool = False) -> list[Operator]:
     """Operators over the transitions' atoms, most supported first (see the module docstring). A precondition
     atom must hold in at least `share` of its group's pre-states (1: in all); an effect naming more than
-    `max_objects` objects is dropped (it grounds into too many actions to be worth its rare use)."""
+    `max_objects` objects is dropped (it grounds into too many actions to be worth its rare use). With `placed`,
+    an effect naming another location is grouped per place of the action (lift), and its operator binds its
+    location variables there: `(= ?to l1)` in its precondition."""
     groups: dict[tuple, list[frozenset[Atom]]] = defaultdict(list)
     for t in transitions:
         if not any(changes(t)):
             continue  # nothing changed: no operator needed (the planner never needs a no-op)
-        key, names = lift(t)
+        key, names = lift(t, placed)
         groups[key].append(frozenset(x for x in (_lift(a, names) for a in t.pre) if x is not None))
     ops = []
     for key, pres in sorted(groups.items(), key=lambda kv: -len(kv[1])):
         if len(pres) < min_count:
             continue
-        loc_vars, add, delete = key
+        loc_vars, add, delete, where = key
         if len({v for a in add + delete for v in a[1:] if v.startswith("?o")}) > max_objects:
             continue
         counts = Counter(a for p in pres for a in p)
-        pre = frozenset(a for a, c in counts.items() if c >= share * len(pres))
+        pre = frozenset(a for a, c in counts.items() if c >= share * len(pres)) | {("=", v, loc) for v, loc in where}
         variables = sorted({v for a in (*add, *delete, *pre) for v in a[1:] if v.startswith("?")} | set(loc_vars))
         params = tuple((v, "location" if v in ("?at", "?from", "?to") else "item") for v in variables)
         ops.append(Operator(f"move-{len(ops)}", params, tuple(sorted(pre)), add, delete, len(pres)))
@@ -126,7 +147,11 @@ def bindings(op: Operator, state: frozenset[Atom], fixed: dict[str, str]) -> Ite
     by_pred: dict[str, list[Atom]] = defaultdict(list)
     for a in state:
         by_pred[a[0]].append(a)
-    pre = sorted(op.precondition, key=lambda a: len(by_pred.get(a[0], ())))
+    fixed = dict(fixed)
+    for _, var, loc in (a for a in op.precondition if a[0] == "="):  # a placed operator: its variable is that place
+        if fixed.setdefault(var, loc) != loc:
+            return
+    pre = sorted((a for a in op.precondition if a[0] != "="), key=lambda a: len(by_pred.get(a[0], ())))
 
     def extend(i: int, b: dict[str, str]):
         if i == len(pre):
@@ -188,7 +213,7 @@ def generalize(op: Operator, transitions: Sequence[Transition], slack: float = 0
 
     base = prec(op)
     for atom in sorted(op.precondition, key=lambda a: (a[0].startswith(STATIC_PREFIX) is False, a)):
-        if atom[0] == "at" and atom in op.delete:
+        if (atom[0] == "at" and atom in op.delete) or atom[0] == "=":
             continue
         trial = dataclasses.replace(op, precondition=tuple(a for a in op.precondition if a != atom))
         if prec(trial) >= base - slack:
@@ -200,13 +225,15 @@ def coverage(ops: Sequence[Operator], transitions: Iterable[Transition]) -> dict
     """How many changing transitions fall in a kept operator's group, and of those, how many satisfy its
     precondition (the precondition is an intersection, so all do on the data it was learned from)."""
     keys = Counter()
-    kept = {(tuple(sorted({v for v, t in o.parameters if t == "location"})), o.add, o.delete) for o in ops}
+    kept = {(tuple(sorted({v for v, t in o.parameters if t == "location"})), o.add, o.delete,
+             tuple(sorted((a[1], a[2]) for a in o.precondition if a[0] == "="))) for o in ops}
+    placed = any(k[3] for k in kept)
     for t in transitions:
         if not any(changes(t)):
             keys["unchanged"] += 1
             continue
         keys["changed"] += 1
-        keys["covered"] += lift(t)[0] in kept
+        keys["covered"] += lift(t, placed)[0] in kept
     return dict(keys)
 
 
@@ -214,7 +241,7 @@ def predicates_of(ops: Sequence[Operator], extra: Iterable[Atom] = ()) -> dict[s
     """Each predicate's argument types, from the atoms the operators and `extra` name."""
     out: dict[str, tuple[str, ...]] = {"at": ("item", "location")}
     for a in itertools.chain((a for o in ops for a in (*o.precondition, *o.add, *o.delete)), extra):
-        if a[0] == "at":
+        if a[0] in ("at", "="):
             continue
         out.setdefault(a[0], ("location",) if a[0] == "empty" else ("item",) * (len(a) - 1))
     return dict(sorted(out.items()))

@@ -394,6 +394,7 @@ def test_benchmark_and_pipeline_are_split_by_job():
 
 # The learned relational route: what its planner reads is computed by the network from the depth crops.
 LEARNED_ROUTE = ("symlearn.learning.entities", "symlearn.learning.relational", "symlearn.learning.relational_training",
+                 "symlearn.learning.relational_losses",
                  "symlearn.symbolic.learned_state", "pddl_export.learned_domain", "symlearn.export.learned_export",
                  "symlearn.planning.learned_loop", "symlearn.planning.learned_benchmark", "symlearn.learning.carrying",
                  "symlearn.planning.learned_problems")

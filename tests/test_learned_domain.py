@@ -23,7 +23,7 @@ CARRY = [_t({("at", "o1", "l1"), ("u1", "o1"), ("at", "o2", "l0"), ("r1", "o2", 
 def test_lifting_names_objects_by_role_not_by_name():
     a, _ = lift(MOVES[0])
     b, _ = lift(MOVES[1])
-    assert a == b == (("?from", "?to"), (("at", "?o1", "?to"),), (("at", "?o1", "?from"),))
+    assert a == b == (("?from", "?to"), (("at", "?o1", "?to"),), (("at", "?o1", "?from"),), ())
 
 
 def test_operators_group_by_effect_and_intersect_preconditions():
@@ -164,11 +164,18 @@ def test_generalize_drops_a_correlate_the_data_do_not_need_and_keeps_what_they_d
 def test_a_goal_keeps_only_the_on_atoms_its_at_atoms_allow():
     from symlearn.planning.learned_loop import consistent_goal
 
-    goal = frozenset({("at", "a", "l1"), ("at", "b", "l1"), ("at", "c", "l2"), ("on", "a", "b"), ("on", "c", "b"),
-                      ("on", "d", "b")})
-    assert consistent_goal(goal) == goal - {("on", "c", "b"), ("on", "d", "b")}  # d has no location in the goal: dropped too
+    goal = frozenset({("at", "a", "l1"), ("at", "b", "l1"), ("at", "c", "l2"), ("on", "a", "b"), ("on", "c", "b")})
+    assert consistent_goal(goal) == goal - {("on", "c", "b")}
     two = frozenset({("at", "a", "l1"), ("at", "b", "l1"), ("at", "c", "l1"), ("on", "a", "c"), ("on", "b", "c")})
     assert consistent_goal(two) == two - {("on", "a", "c"), ("on", "b", "c")}  # two on one: the order is left open
+    # a cover model: a stick covers three cells; a cube on its end shares one of them, one beside it none
+    cover = frozenset({("at", "s", "l0"), ("at", "s", "l1"), ("at", "s", "l2"), ("at", "a", "l0"), ("at", "b", "l4"),
+                       ("on", "a", "s"), ("on", "b", "s")})
+    assert consistent_goal(cover) == cover - {("on", "b", "s")}
+    tower = frozenset({("at", "a", "l4"), ("on", "a", "b"), ("on", "b", "c")})  # b and c under a: at no location
+    assert consistent_goal(tower) == tower
+    cycle = frozenset({("at", "a", "l4"), ("at", "b", "l4"), ("on", "a", "b"), ("on", "b", "a")})
+    assert consistent_goal(cycle) == cycle - {("on", "a", "b"), ("on", "b", "a")}
 
 
 def test_the_confidence_bound_drops_an_operator_whose_precision_rests_on_few_groundings():
@@ -186,3 +193,27 @@ def test_the_confidence_bound_drops_an_operator_whose_precision_rests_on_few_gro
         kept[z] = [(n["applies"], n["predicts"]) for n in notes if n["kept"]]
         assert [n["precision"] for n in notes] == [1.0, 1.0] and len(ops) == len(kept[z])
     assert kept == {0.0: [(20, 20), (10, 10)], 1.96: [(20, 20)]}
+
+
+def test_a_placed_effect_gets_an_operator_bound_to_where_the_action_let_go():
+    from pddl_export.learned_domain import bindings, precision
+
+    # a stick (u7) released at l1 covers l0 and l2 too, from wherever it was picked; a cube released there covers l1
+    stick = [_t({("at", "o1", f), ("u7", "o1"), ("empty", "l0"), ("empty", "l1"), ("empty", "l2")},
+                {("at", "o1", "l0"), ("at", "o1", "l1"), ("at", "o1", "l2"), ("u7", "o1"), ("empty", f)}, f, "l1")
+             for f in ("l3", "l4", "l5")] * 2
+    cube = [_t({("at", "o1", "l4"), ("empty", "l1")}, {("at", "o1", "l1"), ("empty", "l4")}, "l4", "l1")] * 2
+    assert lift(stick[0], placed=True)[0][3] == (("?to", "l1"),)  # pinned where it let go, ?from left free
+    assert lift(stick[0])[0][3] == () and lift(cube[0], placed=True)[0][3] == ()  # a lifted effect stays lifted
+    ops = learn_operators(stick + cube, min_count=2, placed=True)
+    placed = next(o for o in ops if ("at", "?o1", "l0") in o.add)
+    assert ("=", "?to", "l1") in placed.precondition and placed.count == 6
+    assert "(= ?to l1)" in domain_pddl(ops) and "=" not in predicates_of(ops)
+    state = frozenset({("at", "o1", "l3"), ("u7", "o1"), ("empty", "l0"), ("empty", "l1"), ("empty", "l2")})
+    assert [b["?o1"] for b in bindings(placed, state, {"?from": "l3", "?to": "l1"})] == ["o1"]
+    assert list(bindings(placed, state, {"?from": "l3", "?to": "l2"})) == []  # only where the data showed it
+    assert precision([placed], stick + cube) == [(6, 6)]
+    # stock Fast Downward reads the bound operator and lets go at l1 to cover the three cells
+    problem = problem_pddl("p", ["o1"], state, {("at", "o1", "l0"), ("at", "o1", "l2")}, predicates_of(ops))
+    plan = solve_texts(domain_pddl(ops), problem, "fd-lama-first", 30)
+    assert plan.status.name == "SOLVED" and len(plan.steps) == 1 and plan.steps[0].endswith("l3 o1 l1)")

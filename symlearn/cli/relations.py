@@ -18,7 +18,7 @@ from symlearn.cli.args import non_negative_int, positive_int, set_threads, threa
 from symlearn.outputs import folder_output
 
 # the keys of symlearn.learning.relational_training.TRAIN_PRESETS, written here so that the CLI loads without torch
-TRAIN_PRESET_NAMES = ("attention", "support", "support-post", "support-exclusive")
+TRAIN_PRESET_NAMES = ("attention", "support", "support-post", "support-exclusive", "cover")
 
 
 def cmd_train_relations(args: argparse.Namespace) -> int:
@@ -114,7 +114,7 @@ def add_relations_commands(sub) -> None:
     t.add_argument("--preset", default="attention", choices=sorted(TRAIN_PRESET_NAMES),
                    help="attention: three free object-object heads; support: one rests-on head; support-post: "
                         "and its reading after the action; support-exclusive: and one object on each "
-                        "(docs/RELATIONS.md; default attention)")
+                        "cover: and at(o, l) for every cell whose pick lifts o (docs/RELATIONS.md; default attention)")
     t.add_argument("--epochs", type=positive_int, help="default 30")
     t.add_argument("--init", help="start a new run from the weights of this run's relations.pt (same preset)")
     t.add_argument("--seed", type=non_negative_int, help="default 0")
@@ -141,8 +141,9 @@ def add_relations_commands(sub) -> None:
                                               "(RUN/learned/domain.pddl)")
     x.add_argument("--run", required=True)
     x.add_argument("--data", required=True, nargs="+")
-    x.add_argument("--preset", default="intersection", choices=("intersection", "precise"),
-                   help="intersection: preconditions every group member holds; precise: for a noisy rests-on head "
+    x.add_argument("--preset", default="intersection", choices=("intersection", "precise", "placed"),
+                   help="intersection: preconditions every group member holds; precise: for a noisy rests-on head; "
+                        "placed: and an operator per place for an effect naming other locations (a cover model) "
                         "(learned_export.EXPORT_PRESETS; default intersection)")
     x.add_argument("--min-count", type=positive_int, help="drop a lifted effect seen fewer times (default "
                                                           "learned_export.MIN_COUNT)")

@@ -53,6 +53,7 @@ class LearnedExportConfig:
     confidence_z: float = 0.0
     sample: int = 4000
     seed: int = 0
+    placed: bool = False  # an effect naming a location besides the action's two gets an operator per place (lift)
 
     def __post_init__(self) -> None:
         check_bounds(self, {"min_count": Bound(1, 2**62, integer=True), "share": Bound(0.0, 1.0, lo_open=True),
@@ -72,6 +73,8 @@ EXPORT_PRESETS = {
     # dropped. On dev the confidence bound kept the success (0.825 / 0.85) and dropped 7 rare operators of 17,
     # a quarter of the ground operators at 8 objects
     "precise": LearnedExportConfig(share=0.9, min_precision=0.25, slack=0.05, confidence_z=1.96),
+    # and an operator per place for an effect that names other locations: a stick let go at l1 covers l0 and l2 too
+    "placed": LearnedExportConfig(share=0.9, min_precision=0.25, slack=0.05, confidence_z=1.96, placed=True),
 }
 
 
@@ -101,7 +104,7 @@ def prune_dead_relations(transitions: list[Transition]) -> list[Transition]:
 
 def find_operators(transitions: Sequence[Transition], cfg: LearnedExportConfig) -> tuple[list[Operator], list[dict]]:
     """The operators of `transitions` (see LearnedExportConfig) and, per operator found, what became of it."""
-    ops = learn_operators(transitions, cfg.min_count, cfg.share, cfg.max_objects)
+    ops = learn_operators(transitions, cfg.min_count, cfg.share, cfg.max_objects, cfg.placed)
     sample = list(transitions)
     if len(sample) > cfg.sample:
         sample = random.Random(cfg.seed).sample(sample, cfg.sample)

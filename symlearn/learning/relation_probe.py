@@ -6,6 +6,8 @@ relation head of a trained relational model against them over the pairs of a spl
 
 - `at(o, l)`: object o's centre lies within AT_M of table location l (horizontally); `nearest(o, l)`: l is the
   table location nearest o's centre (every object has one, also one standing off the locations);
+- `covers(o, l)`: table location l lies within o's footprint (its extents turned by its yaw, plus a margin):
+  a pick at l would meet o, if nothing stood on it there (a far-row stick covers two or three locations);
 - `on(a, b)`: object a rests on object b: a's bottom within CONTACT_M of b's top and a's centre over b's
   footprint (b's extents turned by its yaw, plus a margin).
 
@@ -45,6 +47,23 @@ def oracle_nearest(pose: np.ndarray, mask: np.ndarray) -> np.ndarray:
     """(N, K, L) bool: the location nearest each object's centre (one per real object)."""
     d = np.linalg.norm(pose[..., None, :2] - np.array(LOCATIONS)[None, None], axis=-1)
     return (np.arange(len(LOCATIONS))[None, None] == d.argmin(-1)[..., None]) & mask[..., None]
+
+
+def footprint_contains(pose: np.ndarray, types: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(N, K, P) bool: each of P table points (x, y) lies within the object's footprint turned by its yaw, plus
+    FOOTPRINT_MARGIN_M."""
+    half = np.where(types[..., None] == ObjectType.STICK, _HALF[1], _HALF[0])  # (N, K, 3)
+    yaw = yaw_of(pose[..., 3:])[..., None]
+    dx = points[None, None, :, 0] - pose[..., None, 0]
+    dy = points[None, None, :, 1] - pose[..., None, 1]
+    c, s = np.cos(yaw), np.sin(yaw)
+    u, v = c * dx + s * dy, -s * dx + c * dy
+    return (np.abs(u) < half[..., None, 0] + FOOTPRINT_MARGIN_M) & (np.abs(v) < half[..., None, 1] + FOOTPRINT_MARGIN_M)
+
+
+def oracle_covers(pose: np.ndarray, types: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(N, K, L) bool: each table location within the object's footprint."""
+    return footprint_contains(pose, types, np.array(LOCATIONS)) & mask[..., None]
 
 
 def oracle_on(pose: np.ndarray, types: np.ndarray, mask: np.ndarray) -> np.ndarray:
@@ -107,7 +126,8 @@ def probe(run_dir: Path, roots: Sequence[Path], split: str = "val") -> dict:
         lo = bits[:, h, k:k + n_loc, :k].transpose(0, 2, 1)
         heads.append({"head": h,
                       "object_location": {"at": score(ol, at, obj_loc_valid),
-                                          "nearest": score(ol, oracle_nearest(pose, mask), obj_loc_valid)},
+                                          "nearest": score(ol, oracle_nearest(pose, mask), obj_loc_valid),
+                                          "covers": score(ol, oracle_covers(pose, types, mask), obj_loc_valid)},
                       "location_object": {"at": score(lo, at, obj_loc_valid)},
                       "object_object": {"on": score(oo, on, obj_obj_valid),
                                         "under": score(oo, on.transpose(0, 2, 1), obj_obj_valid)}})

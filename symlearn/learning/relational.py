@@ -7,8 +7,10 @@ window of the depth image over each table cell). Two convolutional trunks read t
   evaluation) comes from a trunk that sees only the crop's depth relative to its nearest pixel: what the
   object looks like, never where it is or how high it stands;
 - a location's code and every relation come from a trunk that sees depth and image position;
-- relation head 0, at(o, l): each object relates to exactly one location, the scaled dot product of a query
-  of the object with a key of each location through a hard Gumbel-softmax (the follow-up's softmax variant);
+- relation head 0, at(o, l): each object relates to exactly one location, a pair network's score of the object
+  and each location through a hard Gumbel-softmax (the follow-up's softmax variant); with `cover`, to every
+  location whose pick would lift it, a Gumbel-sigmoid per pair: a stick in the far row spans two or three
+  cells and is lifted from any, so one location cannot say where it lies, while the set of cells it covers can;
 - relation heads 1..n_relations, between objects: r_k(a, b) is the scaled dot product of a query of a with a
   key of b, minus a learned per-head bias, through a Gumbel-sigmoid (the authors' follow-up, arXiv
   2401.01123: binarized attention instead of a softmax). A pair holds two real, distinct objects.
@@ -64,6 +66,7 @@ class RelationalConfig:
     depth_ref: float = 2.0  # as ModelConfig: input depth d becomes (depth_ref - d) / depth_scale on seen pixels
     depth_scale: float = 0.5
     support: bool = False  # head 1 is rests-on: each object rests on one other object or on the table
+    cover: bool = False  # head 0 is at(o, l) for every location whose pick would lift o, not one choice per object
 
 
     def __post_init__(self) -> None:
@@ -97,7 +100,9 @@ RELATIONAL_BOUNDS = {"bits": Bound(1, 16, integer=True), "location_bits": Bound(
                      "depth_scale": Bound(0.0, 100.0, lo_open=True)}
 RELATIONAL_PRESETS = {"quick": RelationalConfig(),
                       # one object-object head, rests-on, as a hard attention over the other objects and the table
-                      "support": RelationalConfig(n_relations=1, rounds=3, support=True)}
+                      "support": RelationalConfig(n_relations=1, rounds=3, support=True),
+                      # and at(o, l) holds for every cell a pick at which lifts o (a far-row stick: two or three)
+                      "cover": RelationalConfig(n_relations=1, rounds=3, support=True, cover=True)}
 
 
 def hard_softmax(logits: torch.Tensor, tau: float, training: bool,
@@ -228,8 +233,12 @@ class RelationalDeepSym(nn.Module):
         pair = torch.cat([feats[:, :k, None].expand(b, k, n_loc, -1), feats[:, None, k:].expand(b, k, n_loc, -1)], -1)
         at_logits = self.at_pair(pair).squeeze(-1)  # (B, K, L)
         logits[:, 0, :k, k:] = at_logits
-        at = torch.softmax(at_logits, -1) if (training and self.soft_at) else hard_softmax(at_logits, tau, training,
-                                                                                            generator)
+        if self.cfg.cover:  # every location whose pick lifts o: one binary choice per pair
+            at = gumbel_sigmoid(at_logits, tau, training, generator)
+        elif training and self.soft_at:
+            at = torch.softmax(at_logits, -1)
+        else:
+            at = hard_softmax(at_logits, tau, training, generator)
         rel[:, 0, :k, k:] = at * mask[..., None]
         # heads 1..r, between objects: free binary relations (Gumbel-sigmoid)
         obj = feats[:, :k]

@@ -2,12 +2,14 @@
 
 One or more data sets (symlearn collect) are read, padded to one object count, and every scene gets the
 six location crops (symlearn.learning.entities). The loss is the mean squared error of the normalized
-displacement of every real object, plus three terms that shape the symbols:
+displacement of every real object, plus terms that shape the symbols (symlearn.learning.relational_losses):
 
 - grasp (`grasp_weight`): when the robot's suction tool held an object, that object's at(o, .) is pulled
-  to the pick location (cross-entropy). The robot knows what it grasped and where; this ties the learned
-  at(o, l) to a place, and the shared pair network carries it to every other object (without it, at(o, l)
-  stayed at chance for 5 epochs on 1-5-object data and the effect error at 37 mm);
+  to the pick location (cross-entropy; for a cover model, `cover_loss`: it covers the pick and the release
+  location, and no object covers a location where a pick lifted nothing). The robot knows what it grasped and
+  where; this ties the learned at(o, l) to a place, and the shared pair network carries it to every other object
+  (without it, at(o, l) stayed at chance for 5 epochs on 1-5-object data and the effect error at 37 mm);
+- rests-on (`support_weight`, `post_support_weight`, `support_exclusive`): what the grasp showed about supports;
 - code stability (`code_stability`): an object's unary code is the same before and after the action, so
   unary bits say what an object is, and relations say where it is and on what;
 - relation sparsity (`relation_sparsity`): object-object relations stay off where they do not help.
@@ -32,7 +34,6 @@ from typing import Sequence
 
 import numpy as np
 import torch
-import torch.nn.functional as F
 
 from pddl_export.files import atomic_write_bytes, atomic_write_text, sha256_file
 from symlearn.config_file import Bound, check_bounds, preset
@@ -43,6 +44,8 @@ from symlearn.learning.checkpoint import BlobKind, guarded_blob
 from symlearn.learning.entities import entity_inputs, location_crops, location_windows
 from symlearn.learning.models import code_stability_loss, masked_mse
 from symlearn.learning.relational import RelationalConfig, RelationalDeepSym
+from symlearn.learning.relational_losses import (cover_loss, grasp_loss, post_support_loss, relation_density, ride_loss,
+                                                 support_exclusion, support_loss)
 from symlearn.provenance import versions
 from symlearn.sim.camera import CameraConfig
 from symlearn.world import N_LOCATIONS
@@ -121,6 +124,9 @@ TRAIN_PRESETS = {
     # and at most one object on each: the top of a three-object stack rests on the middle one, not the bottom
     "support-exclusive": RelationalTrainConfig(model=RelationalConfig.from_preset("support"), support_weight=1.0,
                                                post_support_weight=1.0, support_exclusive=1.0),
+    # as support-exclusive, with at(o, l) for every cell whose pick lifts o (cover_loss), read before and after
+    "cover": RelationalTrainConfig(model=RelationalConfig.from_preset("cover"), support_weight=1.0,
+                                   post_support_weight=1.0, support_exclusive=1.0),
 }
 
 
@@ -191,143 +197,6 @@ def entity_split(datas: Sequence[InteractionData], windows: np.ndarray, k: int,
                        if post else None), mean, std
 
 
-def grasp_loss(logits: torch.Tensor, held: torch.Tensor, actions: torch.Tensor, k: int) -> torch.Tensor:
-    """Cross-entropy of at(o, .) for the object the robot grasped, against the action's pick location.
-
-    The robot knows what it did: when its suction tool held an object, that object stood at the pick location.
-    This is the one signal that ties the learned at(o, l) to a place; every other object's at(o, l) comes from
-    the same pair network, never from a label."""
-    rows = torch.nonzero(held >= 0).squeeze(-1)
-    if not len(rows):
-        return logits.new_zeros(())
-    at_logits = logits[rows, 0, held[rows], k:]  # (n, L)
-    return F.cross_entropy(at_logits, actions[rows] // N_LOCATIONS)
-
-
-def ride_loss(logits: torch.Tensor, held: torch.Tensor, rider: torch.Tensor, mask: torch.Tensor,
-              at: torch.Tensor | None = None, actions: torch.Tensor | None = None) -> torch.Tensor:
-    """Binary cross-entropy that makes r1(a, b) say "a rests on b", from what the robot saw its grasp do.
-
-    - r1(a, held): whether object a rode along with the held object (an effect the robot saw; a stack beside
-      the stick that did not move is a negative example);
-    - r1(held, b) = 1 for every object b that stayed at the pick location, as the model's own at(o, l) places
-      them (`at`, (B, K+L, K+L) relation 0, detached; `actions` give the pick location): a pick lifts the top
-      object, so whatever stays where it was picked lay under it.
-    """
-    rows = torch.nonzero(held >= 0).squeeze(-1)
-    if not len(rows):
-        return logits.new_zeros(())
-    k = mask.shape[1]
-    h = held[rows]
-    row_logits = logits[rows, 1, :k, h]  # (n, K): r1(a, held) for every a of the scene
-    others = mask[rows] & (torch.arange(k, device=mask.device)[None] != h[:, None])
-    loss = F.binary_cross_entropy_with_logits(row_logits[others], rider[rows][others].to(logits.dtype))
-    if at is None or actions is None:
-        return loss
-    pick = actions[rows] // N_LOCATIONS
-    at_pick = at[rows, :k, k:][torch.arange(len(rows)), :, pick] > 0.5  # (n, K): placed at the pick location
-    under = others & at_pick & ~rider[rows]
-    if under.any():
-        col_logits = logits[rows, 1, h, :k]  # (n, K): r1(held, b)
-        loss = loss + F.binary_cross_entropy_with_logits(col_logits[under], torch.ones_like(col_logits[under]))
-    return loss
-
-
-def log_prob_of(logp: torch.Tensor, members: torch.Tensor) -> torch.Tensor:
-    """log P(the choice is one of `members`) from log-probabilities over the last axis and a same-shape bool mask."""
-    return torch.logsumexp(logp.masked_fill(~members, -1e4), -1)
-
-
-def support_loss(logits: torch.Tensor, held: torch.Tensor, rider: torch.Tensor, mask: torch.Tensor,
-                 at: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
-    """Cross-entropy of the rests-on head (relation 1 of a model.support model) from what the robot saw its grasp do.
-
-    Head 1 picks, for each object a, one support: another object b (logits[.., 1, a, b]) or the table (the
-    diagonal). In a scene where the suction tool held object h (picked at location p):
-    - h rests on one of the objects that stayed at p (the model's own at, detached), or on the table if none did:
-      a pick lifts the top object, so what stays where it was picked lay under it;
-    - an object that rode along rests on h or on another rider;
-    - an object that did not ride rests on neither h nor a rider.
-    Each is a set-valued target (the log of the probability summed over the set), so a three-object stack does
-    not have to say which of the two below it h touches; the network learns that from two-object stacks."""
-    rows = torch.nonzero(held >= 0).squeeze(-1)
-    if not len(rows):
-        return logits.new_zeros(())
-    k = mask.shape[1]
-    n = len(rows)
-    ar = torch.arange(n, device=mask.device)
-    h, m, rid = held[rows], mask[rows], rider[rows]
-    logp = torch.log_softmax(logits[rows, 1, :k, :k], -1)  # (n, K, K); the diagonal is "on the table"
-    eye = torch.eye(k, dtype=torch.bool, device=mask.device)[None]
-    is_h = F.one_hot(h, k).bool()
-    pick = actions[rows] // N_LOCATIONS
-    stayed = m & ~is_h & ~rid & (at[rows, :k, k:][ar, :, pick] > 0.5)  # (n, K)
-    target_h = torch.where(stayed.any(1, keepdim=True), stayed, is_h)  # h's candidates (or itself: the table)
-    loss_h = -log_prob_of(logp[ar, h], target_h)
-    carried = is_h | rid  # (n, K): h and its riders
-    loss = loss_h.mean()
-    sets = carried[:, None, :] & ~eye  # (n, K, K): for object a, the carried objects other than itself
-    lse = log_prob_of(logp, sets)  # (n, K): log P(a rests on a carried object)
-    riders = rid & m
-    if riders.any():
-        loss = loss - lse[riders].mean()
-    still = m & ~carried
-    if still.any():
-        loss = loss - torch.log1p(-lse[still].exp().clamp(max=1 - 1e-6)).mean()
-    return loss
-
-
-def post_support_loss(pre_logits: torch.Tensor, post_logits: torch.Tensor, held: torch.Tensor, rider: torch.Tensor,
-                      mask: torch.Tensor, post_at: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
-    """The rests-on head read on the scene after the action (model.support), from what the robot did:
-    - where it released the held object h (location r), h now rests on one of the objects at r that it did not
-      carry there (the model's own at on the scene after, detached), or on the table if there is none;
-    - every other object rests on what it rested on before (a pick-and-place moves only h and its riders, which
-      keep their supports): the cross-entropy of its support after against its support before, both ways.
-    Scenes where nothing was held (a pick at an empty location) change nothing: every object keeps its support."""
-    k = mask.shape[1]
-    eye = torch.eye(k, dtype=torch.bool, device=mask.device)[None]
-    pre = torch.log_softmax(pre_logits[:, 1, :k, :k], -1)
-    post = torch.log_softmax(post_logits[:, 1, :k, :k], -1)
-    is_h = F.one_hot(held.clamp_min(0), k).bool() & (held >= 0)[:, None]
-    keep = mask & ~is_h  # (B, K)
-    loss = pre.new_zeros(())
-    if keep.any():  # symmetric cross-entropy of the two supports (each side detached in turn)
-        ce = -(pre.exp().detach() * post).sum(-1) - (post.exp().detach() * pre).sum(-1)
-        loss = loss + ce[keep].mean() / 2
-    rows = torch.nonzero(held >= 0).squeeze(-1)
-    if len(rows):
-        ar = torch.arange(len(rows), device=mask.device)
-        h = held[rows]
-        release = actions[rows] % N_LOCATIONS
-        carried = is_h[rows] | rider[rows]
-        below = mask[rows] & ~carried & (post_at[rows, :k, k:][ar, :, release] > 0.5)
-        target = torch.where(below.any(1, keepdim=True), below, is_h[rows])
-        loss = loss - log_prob_of(post[rows][ar, h], target).mean()
-    return loss
-
-
-def support_exclusion(logits: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
-    """Mean squared excess over one of the objects resting on each object (rests-on probabilities summed per
-    support): in a three-object stack the top rests on the middle one, not also on the bottom one, which the
-    grasp alone cannot tell (both stayed where the top was picked). A stick with a cube on each end is the
-    exception the penalty pays for; it is rare in the data."""
-    k = mask.shape[1]
-    eye = torch.eye(k, dtype=torch.bool, device=mask.device)[None]
-    p = torch.softmax(logits[:, 1, :k, :k], -1).masked_fill(eye, 0.0) * mask[:, :, None]
-    excess = F.relu(p.sum(1) - 1.0) * mask
-    return (excess ** 2).sum() / mask.sum().clamp_min(1)
-
-
-def relation_density(logits: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
-    """Mean probability of the object-object relations (heads 1.. of (B, R, E, E) logits) over the real pairs: a
-    penalty that keeps a relation off where it does not help predict effects."""
-    k = mask.shape[1]
-    pairs = (mask[:, :, None] & mask[:, None, :] & ~torch.eye(k, dtype=torch.bool, device=mask.device)[None])
-    p = torch.sigmoid(logits[:, 1:, :k, :k]) * pairs[:, None]
-    return p.sum() / (pairs.sum() * (logits.shape[1] - 1)).clamp_min(1)
-
-
 @torch.no_grad()
 def evaluate(model: RelationalDeepSym, split: EntitySplit, windows: torch.Tensor, std: np.ndarray,
              batch_size: int = 256) -> dict:
@@ -369,7 +238,9 @@ def batch_loss(model: RelationalDeepSym, cfg: RelationalTrainConfig, tr: EntityS
         post = model_inputs(tr.post_depth[idx].float(), tr.post_origin[idx])
         loss = loss + cfg.code_stability * code_stability_loss(
             model.object_logits(obj, mask), model.object_logits(post, mask), mask)
-    if cfg.grasp_weight:
+    if cfg.grasp_weight and cfg.model.cover:
+        loss = loss + cfg.grasp_weight * cover_loss(out.relation_logits, tr.held[idx], act // N_LOCATIONS, mask)
+    elif cfg.grasp_weight:
         loss = loss + cfg.grasp_weight * grasp_loss(out.relation_logits, tr.held[idx], act, mask.shape[1])
     if cfg.ride_weight:
         loss = loss + cfg.ride_weight * ride_loss(out.relation_logits, tr.held[idx], tr.rider[idx], mask,
@@ -384,6 +255,9 @@ def batch_loss(model: RelationalDeepSym, cfg: RelationalTrainConfig, tr: EntityS
         _, _, p_rel, p_logits, _ = model.symbols(p_obj, mask, p_loc, generator=gen)
         loss = loss + cfg.post_support_weight * post_support_loss(
             out.relation_logits, p_logits, tr.held[idx], tr.rider[idx], mask, p_rel[:, 0].detach(), act)
+        if cfg.grasp_weight and cfg.model.cover:  # the held object covers where it was let go; an empty pick changed nothing
+            where = torch.where(tr.held[idx] >= 0, act % N_LOCATIONS, act // N_LOCATIONS)
+            loss = loss + cfg.grasp_weight * cover_loss(p_logits, tr.held[idx], where, mask)
     if cfg.relation_sparsity:  # the free heads only: a rests-on head makes one choice per object anyway
         free = out.relation_logits[:, 1 + int(cfg.model.support):]
         if free.shape[1]:
@@ -407,7 +281,9 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
     inputs = [{"data": str(r), "data_fingerprint": data_fingerprint(r)} for r in roots]
     if init is not None:
         init_blob = guarded_blob(Path(init) / CHECKPOINT, RELATIONAL_MODEL)
-        if RelationalConfig.from_json(init_blob["config"]["model"]) != cfg.model:
+        # at(o, l) as one choice or as a cover has the same weights: a cover run may start from a one-location run
+        init_model = dataclasses.replace(RelationalConfig.from_json(init_blob["config"]["model"]), cover=cfg.model.cover)
+        if init_model != cfg.model:
             raise ValueError(f"{Path(init) / CHECKPOINT} holds another architecture than --preset asks for")
         inputs.append({"init": str(Path(init) / CHECKPOINT), "sha256": sha256_file(Path(init) / CHECKPOINT)})
     run_dir.mkdir(parents=True, exist_ok=True)

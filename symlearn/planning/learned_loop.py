@@ -75,23 +75,31 @@ def observe_atoms(sim, model, blob: dict) -> frozenset[Atom]:
 
 def goal_atoms(sim, model, blob: dict, problem: Problem, relations: Sequence[str]) -> frozenset[Atom]:
     """The goal scene's learned atoms: `at` and the named relation heads, for the objects the goal fixes, without
-    the `on` atoms that contradict its `at` atoms (consistent_goal)."""
+    the `on` atoms that contradict its `at` atoms (consistent_goal). With a cover model (model.cfg.cover) and no free
+    object, also its `empty` atoms: a far-row stick at l0 covers l0 and l1, one at l1 covers l0 and l2 as well, so
+    the cells it leaves empty are part of where it lies (with one location per object they follow from `at`)."""
     sim.reset(problem.goal)
     free = {f"o{i + 1}" for i in problem.free}
-    keep = {"at", *relations}
+    keep = {"at", *relations} | ({"empty"} if getattr(model.cfg, "cover", False) and not free else set())
     return consistent_goal(frozenset(a for a in observe_atoms(sim, model, blob)
                                      if a[0] in keep and not free & set(a[1:])))
 
 
 def consistent_goal(goal: frozenset[Atom]) -> frozenset[Atom]:
-    """The goal without `(on a b)` where the goal puts a and b at different locations: a release puts an object at
+    """The goal without `(on a b)` where the goal puts a and b at no common location (an object of a cover model
+    that something stands on is at none: the tool meets what is on top; its `on` atoms stay): a release puts an object at
     the location of what it lands on, so no plan of the learned domain reaches both, and a planner would spend its
     whole time limit finding that out. Such an atom is the rests-on head misreading the goal scene (a cube beside
     a tower read as resting on it), or a cube on a stick's end over the next cell, which the `at` atoms still fix.
     Likewise every `(on a b)` of a b that two goal objects rest on: the domain puts one object on a clear one, and
-    the head reads the top of a three-cube tower as resting on the bottom now and then."""
-    where = {a[1]: a[2] for a in goal if a[0] == "at"}
-    kept = [a for a in goal if a[0] != "on" or where.get(a[1], "?") == where.get(a[2], "?")]
+    the head reads the top of a three-cube tower as resting on the bottom now and then. And both of `(on a b)`,
+    `(on b a)`: no scene holds them, and proving that takes a planner longer than its time limit at 7 objects."""
+    where: dict[str, set[str]] = {}
+    for a in goal:
+        if a[0] == "at":  # one location each, or every cell an object covers (a cover model)
+            where.setdefault(a[1], set()).add(a[2])
+    apart = lambda a, b: a in where and b in where and not where[a] & where[b]  # noqa: E731
+    kept = [a for a in goal if a[0] != "on" or not (apart(a[1], a[2]) or ("on", a[2], a[1]) in goal)]
     supports = Counter(a[2] for a in kept if a[0] == "on")
     return frozenset(a for a in kept if a[0] != "on" or supports[a[2]] == 1)
 
