@@ -156,7 +156,7 @@ def test_train_relations_trains_resumes_and_refuses_other_settings(tiny_data, tm
 
 
 def test_the_grasp_loss_pulls_the_held_object_to_the_pick_location_only():
-    from symlearn.learning.relational_training import grasp_loss
+    from symlearn.learning.relational_losses import grasp_loss
 
     k = 3
     logits = torch.zeros(2, 4, k + 6, k + 6, requires_grad=True)
@@ -168,6 +168,43 @@ def test_the_grasp_loss_pulls_the_held_object_to_the_pick_location_only():
     assert g[0, 0, 1, k + 4] < 0 and (g[0, 0, 1, k:k + 4] > 0).all()  # raise l4, lower the others
     assert g[1].abs().sum() == 0 and g[0, 0, [0, 2]].abs().sum() == 0 and g[:, 1:].abs().sum() == 0
     assert grasp_loss(logits, torch.tensor([-1, -1]), actions, k) == 0
+
+
+def test_the_cover_loss_marks_the_held_object_and_clears_an_empty_pick_and_says_nothing_else():
+    from symlearn.learning.relational_losses import cover_loss
+
+    k = 3
+    logits = torch.zeros(3, 2, k + 6, k + 6, requires_grad=True)
+    mask = torch.tensor([[1, 1, 1], [1, 1, 0], [1, 0, 0]]).bool()
+    held, where = torch.tensor([1, -1, 0]), torch.tensor([4, 2, 0])  # scene 1: a pick at l2 lifted nothing
+    loss = cover_loss(logits, held, where, mask)
+    assert torch.isclose(loss, torch.log(torch.tensor(2.0)))  # every labelled pair at p = 0.5
+    loss.backward()
+    g = logits.grad
+    assert g[0, 0, 1, k + 4] < 0 and g[2, 0, 0, k + 0] < 0  # the held object: raise at(o, where)
+    assert (g[1, 0, :2, k + 2] > 0).all() and g[1, 0, 2].abs().sum() == 0  # empty pick: lower, padding untouched
+    assert g[0, 0, [0, 2]].abs().sum() == 0 and g[0, 0, 1, k:k + 4].abs().sum() == 0  # nothing said of the rest
+    assert g[:, 1].abs().sum() == 0
+    assert cover_loss(logits, torch.tensor([-1, -1, -1]), where, torch.zeros(3, 3, dtype=torch.bool)) == 0
+
+
+def test_a_cover_head_lets_an_object_hold_several_locations_and_starts_from_a_one_location_run():
+    from symlearn.learning.relational import RelationalConfig, RelationalDeepSym
+    from symlearn.symbolic.learned_state import atoms_of
+
+    torch.manual_seed(0)
+    model = RelationalDeepSym(RelationalConfig.from_preset("cover")).eval()
+    with torch.no_grad():
+        model.at_pair[-1].bias.fill_(50.0)  # every pair scores high: a cover says yes to all, a choice to one
+    obj, loc, mask = torch.rand(1, 2, 3, 64, 64), torch.rand(1, 6, 3, 64, 64), torch.ones(1, 2, dtype=torch.bool)
+    _, _, rel, _, _ = model.symbols(obj, mask, loc)
+    assert rel[0, 0, :2, 2:].sum() == 12
+    atoms = atoms_of(np.zeros((2, 8)), rel[0].numpy(), 2, support=True)
+    assert {a for a in atoms if a[0] == "at" and a[1] == "o1"} == {("at", "o1", f"l{j}") for j in range(6)}
+    one = RelationalDeepSym(RelationalConfig.from_preset("support")).eval()
+    one.load_state_dict(model.state_dict())  # the same weights: a cover run may start from a one-location run
+    _, _, rel1, _, _ = one.symbols(obj, mask, loc)
+    assert (rel1[0, 0, :2, 2:].sum(-1) == 1).all()
 
 
 def test_the_learned_route_end_to_end_exports_a_domain_and_benchmarks_closed_loop(tiny_data, tmp_path, capsys):
@@ -204,7 +241,7 @@ def test_the_learned_route_end_to_end_exports_a_domain_and_benchmarks_closed_loo
 
 
 def test_the_ride_loss_reads_r1_of_every_object_against_the_held_one():
-    from symlearn.learning.relational_training import ride_loss
+    from symlearn.learning.relational_losses import ride_loss
 
     k = 3
     logits = torch.zeros(1, 4, k + 6, k + 6, requires_grad=True)
@@ -217,7 +254,7 @@ def test_the_ride_loss_reads_r1_of_every_object_against_the_held_one():
 
 
 def test_the_ride_loss_puts_what_stayed_at_the_pick_location_under_the_held_object():
-    from symlearn.learning.relational_training import ride_loss
+    from symlearn.learning.relational_losses import ride_loss
 
     k = 3
     logits = torch.zeros(1, 4, k + 6, k + 6, requires_grad=True)
@@ -309,7 +346,7 @@ def test_the_rests_on_head_picks_at_most_one_support_among_real_objects():
 
 
 def test_the_support_loss_reads_what_the_grasp_showed():
-    from symlearn.learning.relational_training import support_loss
+    from symlearn.learning.relational_losses import support_loss
 
     k = 4
     logits = torch.zeros(1, 2, k + 6, k + 6, requires_grad=True)
@@ -343,7 +380,7 @@ def test_a_rests_on_head_is_written_as_on_clear_and_on_table():
 
 
 def test_the_post_support_loss_puts_the_released_object_on_what_stood_there_and_keeps_the_rest():
-    from symlearn.learning.relational_training import post_support_loss
+    from symlearn.learning.relational_losses import post_support_loss
 
     k = 3
     pre = torch.zeros(1, 2, k + 6, k + 6)
@@ -460,3 +497,44 @@ def test_exported_learned_problems_are_solvable_wherever_the_simulator_reaches_t
                 "--out", tmp_path / "lp2", "--goal-relations", "r7")
     err = capsys.readouterr().err
     assert rc == 2 and "r7" in err and "operators.json" in err and not (tmp_path / "lp2").exists()
+
+
+SHIPPED_COVER = Path(__file__).resolve().parents[1] / "pretrained" / "relations_cover"
+
+
+def test_the_shipped_cover_model_reads_every_cell_a_stick_spans_and_one_for_a_cube(sim):
+    from symlearn.learning.relational_training import load_relational
+    from symlearn.planning.learned_loop import observe_atoms
+
+    model, blob = load_relational(SHIPPED_COVER)
+    spans = {0: {0, 1}, 1: {0, 1, 2}, 2: {1, 2}, 3: {3}, 4: {4}, 5: {5}}  # a 40 cm stick in the far row (18 cm apart)
+    for loc, cells in spans.items():
+        for kind, want in ((S, cells), (C, {loc})):
+            sim.build(((kind, loc),))
+            atoms = observe_atoms(sim, model, blob)
+            assert {a for a in atoms if a[0] == "at"} == {("at", "o1", f"l{j}") for j in want}, (kind, loc)
+            assert {a for a in atoms if a[0] == "empty"} == {("empty", f"l{j}") for j in range(6) if j not in want}
+    sim.build(((S, 1), (C, 0)))  # a cube on the stick's end over l0: a pick there meets the cube, not the stick
+    atoms = observe_atoms(sim, model, blob)
+    assert {a for a in atoms if a[0] in ("at", "on")} == {("at", "o1", "l1"), ("at", "o1", "l2"), ("at", "o2", "l0"),
+                                                          ("on", "o2", "o1")}
+
+
+def test_the_cover_domain_moves_a_stick_into_the_far_row_in_simulation(sim):
+    from symlearn.export.learned_export import load_operators
+    from symlearn.learning.relational_training import load_relational
+    from symlearn.planning.learned_loop import LearnedLoopConfig, run_learned
+    from symlearn.problems.problem import Problem
+
+    # the one-location model read a far-row stick one cell off (l1 as l0), so the goal named the wrong cell
+    model, blob = load_relational(SHIPPED_COVER)
+    for start, goal_at in ((3, 1), (5, 0)):
+        sim.build(((S, start),))
+        initial = sim.get_scene()
+        sim.build(((S, goal_at),))
+        problem = Problem(f"stick{start}{goal_at}", 0, ((S, start),), initial, (start * 6 + goal_at,), sim.get_scene(),
+                          task="stick")
+        res = run_learned(sim, model, blob, load_operators(SHIPPED_COVER), problem,
+                          LearnedLoopConfig(goal_relations=("on",), relax_unreachable=True))
+        assert res.success, (start, goal_at, res.stop, res.actions)  # the simulator's verdict: the stick's pose
+        assert len(res.actions) <= 2
