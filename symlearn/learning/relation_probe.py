@@ -50,14 +50,15 @@ def oracle_nearest(pose: np.ndarray, mask: np.ndarray) -> np.ndarray:
 
 
 def footprint_contains(pose: np.ndarray, types: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """(N, K, P) bool: each of P table points (x, y) lies within the object's footprint turned by its yaw, plus
-    FOOTPRINT_MARGIN_M."""
+    """(N, K, P) bool: each of P points (x, y) lies within the object's footprint turned by its yaw, plus
+    FOOTPRINT_MARGIN_M; `points` (P, 2) the same in every scene, or (N, P, 2) per scene."""
     half = np.where(types[..., None] == ObjectType.STICK, _HALF[1], _HALF[0])  # (N, K, 3)
+    points = np.broadcast_to(points, (pose.shape[0], *points.shape[-2:]))
     yaw = yaw_of(pose[..., 3:])[..., None]
-    dx = points[None, None, :, 0] - pose[..., None, 0]
-    dy = points[None, None, :, 1] - pose[..., None, 1]
+    dx = points[:, None, :, 0] - pose[..., None, 0]
+    dy = points[:, None, :, 1] - pose[..., None, 1]
     c, s = np.cos(yaw), np.sin(yaw)
-    u, v = c * dx + s * dy, -s * dx + c * dy
+    u, v = c * dx + s * dy, -s * dx + c * dy  # the point in the object's frame
     return (np.abs(u) < half[..., None, 0] + FOOTPRINT_MARGIN_M) & (np.abs(v) < half[..., None, 1] + FOOTPRINT_MARGIN_M)
 
 
@@ -72,12 +73,7 @@ def oracle_on(pose: np.ndarray, types: np.ndarray, mask: np.ndarray) -> np.ndarr
     bottom = pose[..., 2] - half[..., 2]
     top = pose[..., 2] + half[..., 2]
     touch = np.abs(bottom[:, :, None] - top[:, None, :]) < CONTACT_M
-    yaw = yaw_of(pose[..., 3:])
-    dx = pose[:, :, None, 0] - pose[:, None, :, 0]
-    dy = pose[:, :, None, 1] - pose[:, None, :, 1]
-    c, s = np.cos(yaw)[:, None, :], np.sin(yaw)[:, None, :]
-    u, v = c * dx + s * dy, -s * dx + c * dy  # a's centre in b's frame
-    over = (np.abs(u) < half[:, None, :, 0] + FOOTPRINT_MARGIN_M) & (np.abs(v) < half[:, None, :, 1] + FOOTPRINT_MARGIN_M)
+    over = footprint_contains(pose, types, pose[..., :2]).transpose(0, 2, 1)  # [a, b]: a's centre over b
     k = pose.shape[1]
     pair = mask[:, :, None] & mask[:, None, :] & ~np.eye(k, dtype=bool)[None]
     return touch & over & pair

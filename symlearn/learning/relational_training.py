@@ -124,10 +124,10 @@ TRAIN_PRESETS = {
     # and at most one object on each: the top of a three-object stack rests on the middle one, not the bottom
     "support-exclusive": RelationalTrainConfig(model=RelationalConfig.from_preset("support"), support_weight=1.0,
                                                post_support_weight=1.0, support_exclusive=1.0),
-    # as support-exclusive, with at(o, l) for every cell whose pick lifts o (cover_loss), read before and after
-    "cover": RelationalTrainConfig(model=RelationalConfig.from_preset("cover"), support_weight=1.0,
-                                   post_support_weight=1.0, support_exclusive=1.0),
 }
+# as support-exclusive, with at(o, l) for every cell whose pick lifts o (cover_loss), read before and after
+TRAIN_PRESETS["cover"] = dataclasses.replace(TRAIN_PRESETS["support-exclusive"],
+                                             model=RelationalConfig.from_preset("cover"))
 
 
 @dataclass

@@ -80,7 +80,7 @@ def goal_atoms(sim, model, blob: dict, problem: Problem, relations: Sequence[str
     the cells it leaves empty are part of where it lies (with one location per object they follow from `at`)."""
     sim.reset(problem.goal)
     free = {f"o{i + 1}" for i in problem.free}
-    keep = {"at", *relations} | ({"empty"} if getattr(model.cfg, "cover", False) and not free else set())
+    keep = {"at", *relations} | ({"empty"} if model.cfg.cover and not free else set())
     return consistent_goal(frozenset(a for a in observe_atoms(sim, model, blob)
                                      if a[0] in keep and not free & set(a[1:])))
 
