@@ -47,17 +47,21 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--learned", nargs="+", required=True, help="benchmark-learned result files of the at-only model")
     ap.add_argument("--learned-on", nargs="*", default=[], help="benchmark-learned result files of the rests-on model")
-    ap.add_argument("--learned-cover", nargs="*", default=[], help="benchmark-learned result files of the cover model")
+    ap.add_argument("--learned-cover", nargs="*", default=[], help="benchmark-learned result files of the cover model "
+                                                                   "(a route per planner their settings name)")
     ap.add_argument("--benchmark", help="a symlearn benchmark file of the oracle and whole-code routes")
     ap.add_argument("--out", required=True)
     a = ap.parse_args()
     rows = []
-    for route, files in (("learned at (fd-lama-first)", a.learned), ("learned at + on (fd-lama-first)", a.learned_on),
-                         ("learned cover at + on (fd-lama-first)", a.learned_cover)):
+    for route, files in (("learned at", a.learned), ("learned at + on", a.learned_on),
+                         ("learned cover at + on", a.learned_cover)):
         for f in files:
-            for r in json.loads(Path(f).read_text())["results"]:
+            res = json.loads(Path(f).read_text())
+            planner = res["settings"]["config"]["planner"]  # one route per planner: "learned at (fd-lama-first)"
+            for r in res["results"]:
                 opt = r["optimal_length"]
-                rows.append((route, r["k"], opt, r["success"], len(r["actions"]) / opt if r["success"] and opt else None))
+                rows.append((f"{route} ({planner})", r["k"], opt, r["success"],
+                             len(r["actions"]) / opt if r["success"] and opt else None))
     names = {"fast-downward-lifted": "oracle predicates (fast-downward-lifted)",
              "astar-outcomes": "whole codes (astar-outcomes)"}
     for r in json.loads(Path(a.benchmark).read_text())["rows"] if a.benchmark else []:

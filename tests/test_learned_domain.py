@@ -178,6 +178,21 @@ def test_a_goal_keeps_only_the_on_atoms_its_at_atoms_allow():
     assert consistent_goal(cycle) == cycle - {("on", "a", "b"), ("on", "b", "a")}
 
 
+def test_a_goal_puts_what_rests_on_an_object_at_that_objects_cells_alone():
+    from symlearn.planning.learned_loop import consistent_goal
+
+    # a tower's top read over the next cell too: the cells below fix it, through a middle read the same way
+    tower = frozenset({("at", "a", "l3"), ("at", "a", "l4"), ("at", "b", "l3"), ("at", "b", "l4"), ("at", "c", "l3"),
+                       ("on", "a", "b"), ("on", "b", "c")})
+    assert consistent_goal(tower) == tower - {("at", "a", "l4"), ("at", "b", "l4")}
+    # a stick on a cube: a release onto an object adds that object's cell alone
+    stick = frozenset({("at", "s", "l0"), ("at", "s", "l1"), ("at", "s", "l2"), ("at", "c", "l1"), ("on", "s", "c")})
+    assert consistent_goal(stick) == stick - {("at", "s", "l0"), ("at", "s", "l2")}
+    # what rests on nothing, or on an object at no cell, keeps every cell
+    free = frozenset({("at", "s", "l0"), ("at", "s", "l1"), ("at", "a", "l1"), ("on", "a", "b")})
+    assert consistent_goal(free) == free
+
+
 def test_the_confidence_bound_drops_an_operator_whose_precision_rests_on_few_groundings():
     from symlearn.export.learned_export import LearnedExportConfig, find_operators, wilson_lower
 
@@ -217,3 +232,14 @@ def test_a_placed_effect_gets_an_operator_bound_to_where_the_action_let_go():
     problem = problem_pddl("p", ["o1"], state, {("at", "o1", "l0"), ("at", "o1", "l2")}, predicates_of(ops))
     plan = solve_texts(domain_pddl(ops), problem, "fd-lama-first", 30)
     assert plan.status.name == "SOLVED" and len(plan.steps) == 1 and plan.steps[0].endswith("l3 o1 l1)")
+
+
+def test_the_relaxed_goal_keeps_an_object_at_the_goal_cells_it_covers_now():
+    from symlearn.planning.learned_loop import relaxed_goal
+
+    goal = frozenset({("at", "s", "l3"), ("at", "s", "l4"), ("at", "a", "l0"), ("at", "b", "l1"), ("at", "b", "l2")})
+    now = frozenset({("at", "s", "l3"), ("at", "a", "l5"), ("at", "b", "l4"), ("clear", "s")})
+    # s read over one more cell in the goal: the cell it covers now; b must move: both its goal cells stay
+    assert relaxed_goal(goal, now) == goal - {("at", "s", "l4")}
+    assert relaxed_goal(goal, frozenset()) == goal
+

@@ -5,6 +5,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 import torch
 
 from symlearn.learning.carrying import CARRY_PROBES, judge
@@ -313,6 +314,10 @@ def test_the_learned_commands_refuse_bad_input_in_one_line(tmp_path, capsys):
                 "--timeout", "-1")
     err = capsys.readouterr().err
     assert rc == 2 and "timeout_s=-1" in err and len(err.strip().splitlines()) == 1 and not (tmp_path / "b.json").exists()
+    from symlearn.planning.learned_loop import LearnedLoopConfig
+
+    with pytest.raises(ValueError, match="unknown planner 'lama'"):  # the library refuses what the CLI's choices do
+        LearnedLoopConfig(planner="lama")
     rc, _ = cli("export-learned", "--run", tmp_path, "--data", tmp_path)
     err = capsys.readouterr().err
     assert rc == 2 and "relations.pt" in err and not (tmp_path / "learned").exists()
@@ -538,3 +543,60 @@ def test_the_cover_domain_moves_a_stick_into_the_far_row_in_simulation(sim):
                           LearnedLoopConfig(goal_relations=("on",), relax_unreachable=True))
         assert res.success, (start, goal_at, res.stop, res.actions)  # the simulator's verdict: the stick's pose
         assert len(res.actions) <= 2
+
+
+def test_a_cube_put_on_a_near_row_tower_is_built_though_its_top_reads_over_two_cells(sim):
+    from symlearn.export.learned_export import load_operators
+    from symlearn.learning.relational_training import load_relational
+    from symlearn.planning.learned_loop import LearnedLoopConfig, goal_atoms, run_learned
+    from symlearn.problems.problem import Problem
+    from symlearn.world import Action
+
+    # problem 3 of problems/rel_dev68: the cube on the stick at l5 goes on top of the three-cube tower at l4; the
+    # goal scene reads that top at l4 and l5, and no release adds two cells: the tower's own cells fix it
+    model, blob = load_relational(SHIPPED_COVER)
+    spec = ((C, 4), (C, 3), (C, 5), (C, 4), (C, 4), (S, 5), (C, 3), (C, 5))
+    sim.build(spec)
+    initial = sim.get_scene()
+    sim.step(Action(5, 4))
+    problem = Problem("tower", 0, spec, initial, (34,), sim.get_scene(), task="tower")
+    assert {("at", "o8", "l4"), ("at", "o8", "l5")} <= observe_atoms_of_goal(sim, model, blob, problem)
+    goal = goal_atoms(sim, model, blob, problem, ("on",))
+    assert {a for a in goal if a[1] == "o8"} == {("at", "o8", "l4"), ("on", "o8", "o5")}
+    res = run_learned(sim, model, blob, load_operators(SHIPPED_COVER), problem,
+                      LearnedLoopConfig(goal_relations=("on",), relax_unreachable=True))
+    assert res.success and res.actions == [34], (res.stop, res.actions)
+
+
+def test_a_cube_beside_a_far_row_stick_stays_on_the_table_in_simulation(sim):
+    from symlearn.export.learned_export import load_operators
+    from symlearn.learning.relational_training import load_relational
+    from symlearn.planning.learned_loop import LearnedLoopConfig, goal_atoms, run_learned
+    from symlearn.problems.problem import Problem
+    from symlearn.world import Action
+
+    # the stick let go at l2 covers l1 and l2; a cube on the table at l0 beside it. A stick let go at l1 with the cube
+    # on its end over l0 reads the same cells (a pick at l0 meets the cube): only the goal's on-table atoms tell them
+    # apart, and without them LM-cut's shortest plan builds the other scene and believes the goal reached
+    model, blob = load_relational(SHIPPED_COVER)
+    ops = load_operators(SHIPPED_COVER)
+    spec = ((C, 4), (C, 5), (S, 3))
+    sim.build(spec)
+    initial = sim.get_scene()
+    sim.step(Action(3, 2))
+    sim.step(Action(5, 0))
+    problem = Problem("beside", 0, spec, initial, (20, 30), sim.get_scene(), task="beside")
+    goal = goal_atoms(sim, model, blob, problem, ("on",))
+    assert {("at", "o3", "l1"), ("at", "o3", "l2"), ("at", "o2", "l0"), ("on-table", "o2")} <= goal
+    cfg = LearnedLoopConfig(goal_relations=("on",), relax_unreachable=True)
+    res = run_learned(sim, model, blob, ops, problem, cfg)
+    assert res.success and len(res.actions) == 2, (res.stop, res.actions)
+    res = run_learned(sim, model, blob, ops, problem, cfg, frozenset(a for a in goal if a[0] != "on-table"))
+    assert not res.success and res.stop == "goal believed reached", (res.stop, res.actions)
+
+
+def observe_atoms_of_goal(sim, model, blob, problem) -> frozenset:
+    from symlearn.planning.learned_loop import observe_atoms
+
+    sim.reset(problem.goal)
+    return observe_atoms(sim, model, blob)

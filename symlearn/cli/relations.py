@@ -14,6 +14,7 @@ import json
 import sys
 from pathlib import Path
 
+from search.stock_planners import STOCK_PLANNERS
 from symlearn.cli.args import non_negative_int, positive_int, set_threads, thread_count
 from symlearn.outputs import folder_output
 
@@ -88,7 +89,8 @@ def cmd_benchmark_learned(args: argparse.Namespace) -> int:
 
     set_threads(args.threads)
     res = benchmark_learned(Path(args.run), Path(args.problems), Path(args.out), args.timeout,
-                            tuple(args.goal_relations or ()), tuple(args.drop or ()), args.relax_unreachable)
+                            tuple(args.goal_relations or ()), tuple(args.drop or ()), args.relax_unreachable,
+                            args.planner)
     print(json.dumps(res["summary"], indent=1))
     return 0
 
@@ -134,7 +136,8 @@ def add_relations_commands(sub) -> None:
     c.add_argument("--run", required=True)
     c.add_argument("--goal-relations", nargs="*", help="with RUN/learned/: object-object heads the goals keep")
     c.add_argument("--relax-unreachable", action="store_true",
-                   help="when a goal with its relations is proved unreachable, plan for its at atoms alone")
+                   help="when the goal with its relations is proved unreachable or 0.6 of the time limit "
+                        "passes, plan for its at atoms alone")
     c.set_defaults(func=cmd_carrying)
 
     x = sub.add_parser("export-learned", help="operators over the learned predicates, found from data, as PDDL "
@@ -156,11 +159,14 @@ def add_relations_commands(sub) -> None:
     b.add_argument("--problems", required=True)
     b.add_argument("--out", required=True, help="result JSON file (resumed: finished problems are kept)")
     b.add_argument("--timeout", type=float, default=10.0, help="seconds per planner call (10)")
+    b.add_argument("--planner", default="fd-lmcut", choices=sorted(STOCK_PLANNERS),
+                   help="the stock planner configuration of each call (search.stock_planners; default fd-lmcut)")
     b.add_argument("--goal-relations", nargs="*", help="object-object heads the goal keeps, e.g. r1")
     b.add_argument("--drop", nargs="*", help="the ablation: predicates removed from the domain, the states and the "
                                              "goal, e.g. r1 nothing-r1")
     b.add_argument("--relax-unreachable", action="store_true",
-                   help="when the goal with its relations is proved unreachable, plan for its at atoms alone")
+                   help="when the goal with its relations is proved unreachable or 0.6 of the time limit "
+                        "passes, plan for its at atoms alone")
     b.add_argument("--threads", type=thread_count)
     b.set_defaults(func=cmd_benchmark_learned)
 
