@@ -316,8 +316,12 @@ def test_the_learned_commands_refuse_bad_input_in_one_line(tmp_path, capsys):
     assert rc == 2 and "timeout_s=-1" in err and len(err.strip().splitlines()) == 1 and not (tmp_path / "b.json").exists()
     from symlearn.planning.learned_loop import LearnedLoopConfig
 
-    with pytest.raises(ValueError, match="unknown planner 'lama'"):  # the library refuses what the CLI's choices do
+    with pytest.raises(ValueError, match="unknown planner 'lama'"):
         LearnedLoopConfig(planner="lama")
+    rc, _ = cli("benchmark-learned", "--run", SHIPPED, "--problems", tmp_path, "--out", tmp_path / "b.json",
+                "--planner", "lama")
+    err = capsys.readouterr().err
+    assert rc == 2 and "unknown planner 'lama'; known: fd-lama-first, fd-lmcut" in err and len(err.strip().splitlines()) == 1
     rc, _ = cli("export-learned", "--run", tmp_path, "--data", tmp_path)
     err = capsys.readouterr().err
     assert rc == 2 and "relations.pt" in err and not (tmp_path / "learned").exists()

@@ -14,7 +14,6 @@ import json
 import sys
 from pathlib import Path
 
-from search.stock_planners import STOCK_PLANNERS
 from symlearn.cli.args import non_negative_int, positive_int, set_threads, thread_count
 from symlearn.outputs import folder_output
 
@@ -60,7 +59,8 @@ def cmd_carrying(args: argparse.Namespace) -> int:
     if operators_path(Path(args.run)).is_file():  # the carrying goals, planned and executed
         from symlearn.planning.learned_benchmark import carry_goals
 
-        res["goals"] = carry_goals(Path(args.run), tuple(args.goal_relations or ()), args.relax_unreachable)
+        relations = tuple(args.goal_relations or ())
+        res["goals"] = carry_goals(Path(args.run), relations, relax_unreachable=bool(relations))
         for g in res["goals"]:
             print(f"goal {g['name']}: {'built' if g['success'] else 'not built'} with actions {g['actions']} "
                   f"({g['stop']})")
@@ -88,9 +88,9 @@ def cmd_benchmark_learned(args: argparse.Namespace) -> int:
     from symlearn.planning.learned_benchmark import benchmark_learned
 
     set_threads(args.threads)
-    res = benchmark_learned(Path(args.run), Path(args.problems), Path(args.out), args.timeout,
-                            tuple(args.goal_relations or ()), tuple(args.drop or ()), args.relax_unreachable,
-                            args.planner)
+    relations = tuple(args.goal_relations or ())
+    res = benchmark_learned(Path(args.run), Path(args.problems), Path(args.out), args.timeout, relations,
+                            tuple(args.drop or ()), relax_unreachable=bool(relations), planner=args.planner)
     print(json.dumps(res["summary"], indent=1))
     return 0
 
@@ -134,10 +134,8 @@ def add_relations_commands(sub) -> None:
     c = sub.add_parser("carrying", help="Table I and carrying variants: the relational model's predictions "
                                         "against the simulator's")
     c.add_argument("--run", required=True)
-    c.add_argument("--goal-relations", nargs="*", help="with RUN/learned/: object-object heads the goals keep")
-    c.add_argument("--relax-unreachable", action="store_true",
-                   help="when the goal with its relations is proved unreachable or 0.6 of the time limit "
-                        "passes, plan for its at atoms alone")
+    c.add_argument("--goal-relations", nargs="*", help="with RUN/learned/: object-object heads the goals keep (and "
+                                                       "the relaxation benchmark-learned --help describes)")
     c.set_defaults(func=cmd_carrying)
 
     x = sub.add_parser("export-learned", help="operators over the learned predicates, found from data, as PDDL "
@@ -159,14 +157,14 @@ def add_relations_commands(sub) -> None:
     b.add_argument("--problems", required=True)
     b.add_argument("--out", required=True, help="result JSON file (resumed: finished problems are kept)")
     b.add_argument("--timeout", type=float, default=10.0, help="seconds per planner call (10)")
-    b.add_argument("--planner", default="fd-lmcut", choices=sorted(STOCK_PLANNERS),
-                   help="the stock planner configuration of each call (search.stock_planners; default fd-lmcut)")
-    b.add_argument("--goal-relations", nargs="*", help="object-object heads the goal keeps, e.g. r1")
+    b.add_argument("--planner", default="fd-lmcut",
+                   help="the stock planner configuration of each call: fd-lmcut (default), fd-lama-first, ... "
+                        "(search.stock_planners.STOCK_PLANNERS)")
+    b.add_argument("--goal-relations", nargs="*", help="object-object heads the goal keeps, e.g. on; with any, a "
+                   "goal proved unreachable or unsolved in 0.6 of the time limit is planned for its at atoms "
+                   "(learned_loop.relaxed_goal) in the time left")
     b.add_argument("--drop", nargs="*", help="the ablation: predicates removed from the domain, the states and the "
                                              "goal, e.g. r1 nothing-r1")
-    b.add_argument("--relax-unreachable", action="store_true",
-                   help="when the goal with its relations is proved unreachable or 0.6 of the time limit "
-                        "passes, plan for its at atoms alone")
     b.add_argument("--threads", type=thread_count)
     b.set_defaults(func=cmd_benchmark_learned)
 
