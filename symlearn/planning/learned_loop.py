@@ -16,7 +16,7 @@ import re
 from collections import Counter
 import time
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import Iterable, Sequence
 
 import numpy as np
 
@@ -107,10 +107,7 @@ def consistent_goal(goal: frozenset[Atom]) -> frozenset[Atom]:
     the head reads the top of a three-cube tower as resting on the bottom now and then. And both of `(on a b)`,
     `(on b a)`: no scene holds them, and proving that takes a planner longer than its time limit at 7 objects.
     Then what rests on an object is put at the cells it shares with it alone (_on_support_cells)."""
-    where: dict[str, set[str]] = {}
-    for a in goal:
-        if a[0] == "at":  # one location each, or every cell an object covers (a cover model)
-            where.setdefault(a[1], set()).add(a[2])
+    where = _cells_of(goal)  # one location each, or every cell an object covers (a cover model)
     apart = lambda a, b: a in where and b in where and not where[a] & where[b]  # noqa: E731
     kept = [a for a in goal if a[0] != "on" or not (apart(a[1], a[2]) or ("on", a[2], a[1]) in goal)]
     supports = Counter(a[2] for a in kept if a[0] == "on")
@@ -141,15 +138,18 @@ def relaxed_goal(located: frozenset[Atom], state: frozenset[Atom]) -> frozenset[
     """The goal's `at` atoms, with an object read over several goal cells kept at those it covers now, where it
     covers any: the same object, read over one more cell in the goal scene than now (a stick under a cube placed
     beside its end), asks for a cell no operator adds."""
-    now: dict[str, set[str]] = {}
-    for a in state:
-        if a[0] == "at":
-            now.setdefault(a[1], set()).add(a[2])
-    goal: dict[str, set[str]] = {}
-    for a in located:
-        goal.setdefault(a[1], set()).add(a[2])
-    keep = {o: (c & now[o] if len(c) > 1 and c & now.get(o, set()) else c) for o, c in goal.items()}
+    now = _cells_of(state)
+    keep = {o: (c & now[o] if len(c) > 1 and c & now.get(o, set()) else c) for o, c in _cells_of(located).items()}
     return frozenset(a for a in located if a[2] in keep[a[1]])
+
+
+def _cells_of(atoms: Iterable[Atom]) -> dict[str, set[str]]:
+    """Each object's locations among the `(at o l)` atoms."""
+    cells: dict[str, set[str]] = {}
+    for a in atoms:
+        if a[0] == "at":
+            cells.setdefault(a[1], set()).add(a[2])
+    return cells
 
 
 def step_action(step: str, ops: dict[str, Operator]) -> int:
@@ -202,8 +202,8 @@ def run_learned(sim, model, blob: dict, ops: Sequence[Operator], problem: Proble
         t0 = time.perf_counter()
         first = cfg.timeout_s * (RELAX_SHARE if cfg.relax_unreachable else 1.0)
         plan = solve_texts(domain, problem_pddl("p", objects, state, goal, predicates), cfg.planner, first)
-        relaxed = relaxed_goal(located, state)
-        if cfg.relax_unreachable and plan.status.name in ("UNSOLVABLE", "TIMEOUT") and relaxed != goal:
+        relaxed = relaxed_goal(located, state) if cfg.relax_unreachable else goal
+        if plan.status.name in ("UNSOLVABLE", "TIMEOUT") and relaxed != goal:
             res.relaxed_calls += 1
             left = max(cfg.timeout_s - (time.perf_counter() - t0), 1.0)
             plan = solve_texts(domain, problem_pddl("p", objects, state, relaxed, predicates), cfg.planner, left)
