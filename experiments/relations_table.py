@@ -3,9 +3,9 @@ whole-code route on the same problems, closed loop, by objects x shortest-plan l
 
     python experiments/relations_table.py --learned RUN/learned/test.json RUN/learned/test68.json \\
         [--learned-on RUN_ON/learned/test.json ...] [--learned-cover RUN_COVER/learned/test.json ...] \
-        [--benchmark ORACLE.json] --out bench/results/relations_test_table.json
+        [--benchmark ORACLE.json ...] --out bench/results/relations_test_table.json
 
-ORACLE.json is `symlearn benchmark --run pretrained/recommended --problems A,B --planners
+Each ORACLE.json is `symlearn benchmark --run pretrained/recommended --problems A,B --planners
 fast-downward-lifted,astar-outcomes` on the same sets (its closed-loop rows are read).
 """
 from __future__ import annotations
@@ -19,7 +19,7 @@ import numpy as np
 
 from pddl_export.files import atomic_write_json
 
-BANDS = (("1-5", 1, 5), ("6-8", 6, 8))
+BANDS = (("1-5", 1, 5), ("6-8", 6, 8), ("9-10", 9, 10), ("6-10", 6, 10))
 LENGTHS = (("1", 1, 1), ("2", 2, 2), ("3+", 3, 99))
 
 
@@ -49,7 +49,8 @@ def main() -> None:
     ap.add_argument("--learned-on", nargs="*", default=[], help="benchmark-learned result files of the rests-on model")
     ap.add_argument("--learned-cover", nargs="*", default=[], help="benchmark-learned result files of the cover model "
                                                                    "(a route per planner their settings name)")
-    ap.add_argument("--benchmark", help="a symlearn benchmark file of the oracle and whole-code routes")
+    ap.add_argument("--benchmark", nargs="*", default=[],
+                    help="symlearn benchmark files of the oracle and whole-code routes")
     ap.add_argument("--out", required=True)
     a = ap.parse_args()
     rows = []
@@ -64,7 +65,7 @@ def main() -> None:
                              len(r["actions"]) / opt if r["success"] and opt else None))
     names = {"fast-downward-lifted": "oracle predicates (fast-downward-lifted)",
              "astar-outcomes": "whole codes (astar-outcomes)"}
-    for r in json.loads(Path(a.benchmark).read_text())["rows"] if a.benchmark else []:
+    for r in (r for f in a.benchmark for r in json.loads(Path(f).read_text())["rows"]):
         if r.get("closed_loop") and r["planner"] in names:
             opt = r.get("optimal_length")
             rows.append((names[r["planner"]], r["n_objects"], opt, r["success"],

@@ -115,7 +115,7 @@ def test_missing_foreign_and_old_format_refused(tmp_path):
         load_split(tmp_path, "dev")
 
 
-@pytest.mark.parametrize("kw,msg", [({"k_values": (9,), "k_probs": (1.0,)}, "out of range"),
+@pytest.mark.parametrize("kw,msg", [({"k_values": (11,), "k_probs": (1.0,)}, "out of range"),
                                     ({"k_values": (0, 1), "k_probs": (0.5, 0.5)}, "out of range"),
                                     ({"k_probs": (0.5, 0.5, 0.5)}, "sum to 1")])
 def test_bad_exploration_settings_refused(kw, msg):

@@ -226,7 +226,7 @@ def test_problems_refuse_a_folder_without_manifest(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("args", [("--seed", "-1"), ("--n", "0"), ("--n", "-3"), ("--objects", "0-2"),
-                                  ("--length", "0-1"), ("--objects", "3-9")])
+                                  ("--length", "0-1"), ("--objects", "3-11")])
 def test_problems_bad_settings_create_nothing(tmp_path, capsys, args):
     out = tmp_path / "p"
     try:

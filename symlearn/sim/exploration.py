@@ -21,8 +21,8 @@ import numpy as np
 from symlearn.config_file import Bound, check_bounds
 from symlearn.world import N_LOCATIONS, NEAR_ROW, Action, ObjectType
 
-MAX_OBJECTS = 8  # the largest scene the simulator builds, a problem holds and the planners take; the data sets
-# are collected at 1-5 objects, so 6-8-object scenes are zero-shot for every learned model
+MAX_OBJECTS = 10  # the largest scene the simulator builds, a problem holds and the planners take; the data sets
+# are collected at 1-5 objects, so 6-10-object scenes are zero-shot for every learned model
 TYPE_DRAWS = ("authors", "independent")
 
 
