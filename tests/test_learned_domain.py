@@ -1,6 +1,7 @@
 """Operators found from transitions over learned predicates, and their PDDL: lifting, grouping, planning."""
 from __future__ import annotations
 
+from pathlib import Path
 import pddl
 
 from pddl_export.learned_domain import (Transition, coverage, domain_pddl, learn_operators, lift, predicates_of,
@@ -243,3 +244,58 @@ def test_the_relaxed_goal_keeps_an_object_at_the_goal_cells_it_covers_now():
     assert relaxed_goal(goal, now) == goal - {("at", "s", "l4")}
     assert relaxed_goal(goal, frozenset()) == goal
 
+
+
+def test_the_focus_objects_are_what_the_goal_moves_and_what_stands_in_its_way():
+    from symlearn.planning.learned_loop import focus_objects
+
+    state = frozenset([("at", "a", "l0"), ("at", "b", "l0"), ("on", "b", "a"), ("clear", "b"), ("on-table", "a"),
+                       ("at", "c", "l3"), ("clear", "c"), ("on-table", "c"), ("at", "d", "l4"), ("clear", "d"),
+                       ("on-table", "d"), ("empty", "l1"), ("empty", "l2"), ("empty", "l5")])
+    done = {("at", "a", "l0"), ("at", "b", "l0"), ("at", "d", "l4")}
+    assert focus_objects(state, frozenset(done | {("at", "c", "l1")})) == {"c"}
+    # a moves: b rests on it; c to d's cell: d is in the way
+    assert focus_objects(state, frozenset({("at", "a", "l5"), ("at", "c", "l4")})) == {"a", "b", "c", "d"}
+    # a goal relation names its other object; a cell the goal wants empty names what covers it
+    assert focus_objects(state, frozenset(done | {("on", "c", "d")})) == {"c", "d"}
+    assert focus_objects(state, frozenset(done | {("empty", "l3")})) == {"c"}
+    # b lifted off a names both; what a rests on does not matter to that plan
+    tower = state | {("on", "a", "e"), ("at", "e", "l0")}
+    assert focus_objects(tower, frozenset({("at", "b", "l1")})) == {"a", "b"}
+
+
+def test_a_plan_over_the_focus_objects_is_a_plan_of_the_whole_state():
+    import dataclasses
+    import re
+
+    from symlearn.export.learned_export import load_operators
+    from symlearn.planning.learned_loop import LearnedLoopConfig, _solve, focus_objects
+
+    ops = load_operators(Path("pretrained/relations_cover"))
+    by_name = {o.name: o for o in ops}
+    # nine cubes: towers at l3, l4, l5 and one cube at l0; the goal moves the cube at l0 onto the l4 tower
+    towers = {"l3": ["o1", "o2", "o3"], "l4": ["o4", "o5", "o6"], "l5": ["o7", "o8"]}
+    state = {("at", "o9", "l0"), ("clear", "o9"), ("on-table", "o9"), ("empty", "l1"), ("empty", "l2")}
+    for cell, tower in towers.items():
+        state |= {("at", o, cell) for o in tower} | {("on-table", tower[0]), ("clear", tower[-1])}
+        state |= {("on", up, down) for down, up in zip(tower, tower[1:])}
+    state = frozenset(state)
+    goal = frozenset({a for a in state if a[0] == "at" and a[1] != "o9"} | {("at", "o9", "l4"), ("on", "o9", "o6")})
+    assert focus_objects(state, goal) == {"o5", "o6", "o9"}  # the top at the goal cell, and what it rests on
+    objects = [f"o{i}" for i in range(1, 10)]
+    cfg = LearnedLoopConfig(planner="fd-lmcut")  # optimal: the focus objects cost no action here
+    plan = _solve(domain_pddl(ops), predicates_of(ops), objects, state, goal, cfg, 20.0)
+    assert plan.status.name == "SOLVED" and plan.steps
+    now = set(state)
+    for step in plan.steps:  # every step applies to the whole state, and the goal holds after the last
+        name, *args = re.findall(r"[\w-]+", step)
+        op = by_name[name]
+        b = dict(zip([v for v, _ in op.parameters], args))
+        ground = lambda atoms: {tuple([a[0], *(b.get(x, x) for x in a[1:])]) for a in atoms}  # noqa: E731
+        assert all(a[1] == a[2] for a in ground(a for a in op.precondition if a[0] == "=")), step
+        assert ground(a for a in op.precondition if a[0] != "=") <= now, step
+        now = (now - ground(op.delete)) | ground(op.add)
+    assert goal <= now
+    full = _solve(domain_pddl(ops), predicates_of(ops), objects, state, goal,
+                  dataclasses.replace(cfg, focus=False), 20.0)
+    assert full.status.name == "SOLVED" and len(plan.steps) == len(full.steps)
