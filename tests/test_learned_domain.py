@@ -254,6 +254,7 @@ def test_the_focus_objects_are_what_the_goal_moves_and_what_stands_in_its_way():
                        ("on-table", "d"), ("empty", "l1"), ("empty", "l2"), ("empty", "l5")])
     done = {("at", "a", "l0"), ("at", "b", "l0"), ("at", "d", "l4")}
     assert focus_objects(state, frozenset(done | {("at", "c", "l1")})) == {"c"}
+    assert focus_objects(state, frozenset(done)) == set()  # the goal holds: nothing to plan over
     # a moves: b rests on it; c to d's cell: d is in the way
     assert focus_objects(state, frozenset({("at", "a", "l5"), ("at", "c", "l4")})) == {"a", "b", "c", "d"}
     # a goal relation names its other object; a cell the goal wants empty names what covers it

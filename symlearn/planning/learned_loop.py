@@ -262,7 +262,7 @@ def _solve(domain: str, predicates: dict, objects: list[str], state: frozenset[A
     t0 = time.perf_counter()
     if cfg.focus:
         few = focus_objects(state, goal)
-        if len(few) < len(objects):
+        if 0 < len(few) < len(objects):  # none: the goal holds, and the whole problem says so at once
             keep = lambda atoms: [a for a in atoms if all(x in few for x in a[1:] if x not in LOCATIONS)]  # noqa: E731
             names = [o for o in objects if o in few]
             plan = solve_texts(domain, problem_pddl("p", names, keep(state), keep(goal), predicates), cfg.planner,
