@@ -265,15 +265,17 @@ def test_the_focus_objects_are_what_the_goal_moves_and_what_stands_in_its_way():
     assert focus_objects(tower, frozenset({("at", "b", "l1")})) == {"a", "b"}
 
 
-def test_a_plan_over_the_focus_objects_is_a_plan_of_the_whole_state():
+def test_a_plan_over_the_focus_objects_is_a_plan_of_the_whole_state(tmp_path):
     import dataclasses
-    import re
+
+    from unified_planning.engines import ValidationResultStatus
+    from unified_planning.io import PDDLReader
+    from unified_planning.shortcuts import PlanValidator
 
     from symlearn.export.learned_export import load_operators
     from symlearn.planning.learned_loop import LearnedLoopConfig, _solve, focus_objects
 
     ops = load_operators(Path("pretrained/relations_cover"))
-    by_name = {o.name: o for o in ops}
     # nine cubes: towers at l3, l4, l5 and one cube at l0; the goal moves the cube at l0 onto the l4 tower
     towers = {"l3": ["o1", "o2", "o3"], "l4": ["o4", "o5", "o6"], "l5": ["o7", "o8"]}
     state = {("at", "o9", "l0"), ("clear", "o9"), ("on-table", "o9"), ("empty", "l1"), ("empty", "l2")}
@@ -287,16 +289,14 @@ def test_a_plan_over_the_focus_objects_is_a_plan_of_the_whole_state():
     cfg = LearnedLoopConfig(planner="fd-lmcut")  # optimal: the focus objects cost no action here
     plan = _solve(domain_pddl(ops), predicates_of(ops), objects, state, goal, cfg, 20.0)
     assert plan.status.name == "SOLVED" and plan.steps
-    now = set(state)
-    for step in plan.steps:  # every step applies to the whole state, and the goal holds after the last
-        name, *args = re.findall(r"[\w-]+", step)
-        op = by_name[name]
-        b = dict(zip([v for v, _ in op.parameters], args))
-        ground = lambda atoms: {tuple([a[0], *(b.get(x, x) for x in a[1:])]) for a in atoms}  # noqa: E731
-        assert all(a[1] == a[2] for a in ground(a for a in op.precondition if a[0] == "=")), step
-        assert ground(a for a in op.precondition if a[0] != "=") <= now, step
-        now = (now - ground(op.delete)) | ground(op.add)
-    assert goal <= now
+    # unified-planning's validator: every step applies to the whole state, and the whole goal holds after the last
+    (tmp_path / "d.pddl").write_text(domain_pddl(ops))
+    (tmp_path / "p.pddl").write_text(problem_pddl("whole", objects, state, goal, predicates_of(ops)))
+    reader = PDDLReader()
+    whole = reader.parse_problem(str(tmp_path / "d.pddl"), str(tmp_path / "p.pddl"))
+    up_plan = reader.parse_plan_string(whole, "\n".join(plan.steps))
+    with PlanValidator(problem_kind=whole.kind, plan_kind=up_plan.kind) as validator:
+        assert validator.validate(whole, up_plan).status == ValidationResultStatus.VALID
     full = _solve(domain_pddl(ops), predicates_of(ops), objects, state, goal,
                   dataclasses.replace(cfg, focus=False), 20.0)
     assert full.status.name == "SOLVED" and len(plan.steps) == len(full.steps)
