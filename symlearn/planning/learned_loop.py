@@ -210,11 +210,12 @@ def run_learned(sim, model, blob: dict, ops: Sequence[Operator], problem: Proble
         t0 = time.perf_counter()
         first = cfg.timeout_s * (RELAX_SHARE if cfg.relax_unreachable else 1.0)
         plan = _solve(domain, predicates, objects, state, goal, cfg, first)
-        relaxed = relaxed_goal(located, state) if cfg.relax_unreachable else goal
-        if plan.status.name in ("UNSOLVABLE", "TIMEOUT") and relaxed != goal:
-            res.relaxed_calls += 1
-            left = max(cfg.timeout_s - (time.perf_counter() - t0), 1.0)
-            plan = _solve(domain, predicates, objects, state, relaxed, cfg, left)
+        if cfg.relax_unreachable and plan.status.name in ("UNSOLVABLE", "TIMEOUT"):
+            relaxed = relaxed_goal(located, state)
+            if relaxed != goal:
+                res.relaxed_calls += 1
+                left = max(cfg.timeout_s - (time.perf_counter() - t0), 1.0)
+                plan = _solve(domain, predicates, objects, state, relaxed, cfg, left)
         res.plan_times_s.append(round(time.perf_counter() - t0, 3))
         if plan.status.name != "SOLVED" or not plan.steps:
             res.stop = f"planner: {plan.status.name.lower()} {plan.message}"[:200]
