@@ -22,6 +22,14 @@ planner's summary counts the reachable goals it reported unsolvable and its mean
         --goal-relations on
     python bench/stock_fd.py --domain lp3/domain.pddl --problems lp3 --shortest lp3/problems.json \
         --planners fd-lama-first,fd-lmcut,pyperplan,up-fast-downward,up-pyperplan --out x.json
+
+With `--focus DIR` (export-learned-problems --focus writes OUT/focus), a problem with a file of the same name in DIR
+is planned as the closed loop plans: that focus problem first, in half the time limit, and where it yields no plan
+the whole problem in the time left. The row's status and plan are the last call's; its times are the two calls'
+sums (a call that reported no Fast Downward clocks adds its whole call time), and `focus` says how the first ended.
+
+    python bench/stock_fd.py --domain lp3/domain.pddl --problems lp3 --focus lp3/focus --shortest lp3/problems.json \
+        --out x.json
 """
 from __future__ import annotations
 
@@ -32,6 +40,8 @@ import sys
 from pathlib import Path
 
 DEFAULT_PLANNERS = ("fd-lama-first", "fd-lmcut")
+FOCUS_SHARE = 0.5  # of the time limit for a focus problem, as symlearn.planning.learned_loop.FOCUS_SHARE
+SUMMED = ("call_time_s", "fd_translate_time_s", "fd_total_time_s", "translate_plus_search_s")
 UP_PLANNERS = {"up-fast-downward": "fast-downward", "up-pyperplan": "pyperplan", "up-symk": "symk"}
 MAX_MANIFEST_BYTES = 16 << 20
 
@@ -78,6 +88,8 @@ def summarize(rows: list[dict], planners: list[str]) -> dict:
         runs = [r["planners"][name] for r in rows if name in r["planners"]]
         counts = {s: sum(x["status"] == s for x in runs) for s in ("solved", "unsolvable", "timeout", "error")}
         entry: dict = {"problems": len(runs), **counts}
+        if any("focus" in x for x in runs):
+            entry["focus_solved"] = sum(x.get("focus") == "solved" for x in runs)
         known = [(r["planners"][name], r["shortest"]) for r in rows if name in r["planners"] and "shortest" in r]
         if known:
             entry["reachable_reported_unsolvable"] = sum(x["status"] == "unsolvable" for x, _ in known)
@@ -103,6 +115,22 @@ def solve(domain: Path, problem: Path, planner: str, timeout_s: float):
     return solve_files(domain, problem, planner, timeout_s)
 
 
+def solve_focused(domain: Path, problem: Path, focus_dir: Path | None, planner: str, timeout_s: float) -> dict:
+    """One row's record: the problem alone, or where focus_dir holds a problem of the same name, that one first in
+    FOCUS_SHARE of the time and the whole problem in the time left where it finds no plan."""
+    from search.stock_planners import call_record
+
+    few = focus_dir / problem.name if focus_dir is not None else None
+    if few is None or not few.is_file():
+        return call_record(solve(domain, problem, planner, timeout_s))
+    first = call_record(solve(domain, few, planner, timeout_s * FOCUS_SHARE))
+    if first["status"] == "solved":
+        return {**first, "focus": "solved"}
+    second = call_record(solve(domain, problem, planner, max(timeout_s - first["call_time_s"], 1.0)))
+    sums = {k: round(first.get(k, first["call_time_s"]) + second[k], 4) for k in SUMMED if k in second}
+    return {**second, **sums, "focus": first["status"]}
+
+
 def _previous(out: Path, key: dict) -> dict[str, dict]:
     """Rows of an earlier run of the same benchmark at out (problem path -> row), or {}."""
     if not out.is_file() or out.stat().st_size > 64 << 20:
@@ -125,8 +153,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--timeout", type=float, default=10.0, help="seconds per call (translate + search)")
     ap.add_argument("--shortest", type=Path, help="problems.json of symlearn export-learned-problems: the "
                                                   "simulator's shortest plan length of each problem")
+    ap.add_argument("--focus", type=Path, help="folder of focus problems (export-learned-problems --focus): each "
+                                               "planned first, the whole problem where it finds no plan")
     args = ap.parse_args(argv)
-    from search.stock_planners import STOCK_PLANNERS, call_record
+    from search.stock_planners import STOCK_PLANNERS
     from symlearn.provenance import atomic_write_json, bench_context, sha256_file
 
     try:
@@ -139,6 +169,8 @@ def main(argv: list[str] | None = None) -> int:
             raise SystemExit(f"stock_fd: domain file not found: {args.domain}")
         if not (args.timeout > 0 and args.timeout < float("inf")):
             raise SystemExit(f"stock_fd: --timeout must be a positive number of seconds, got {args.timeout}")
+        if args.focus is not None and not args.focus.is_dir():
+            raise SystemExit(f"stock_fd: --focus folder not found: {args.focus}")
         if not args.out.parent.is_dir() or args.out.is_dir():
             raise SystemExit(f"stock_fd: cannot write {args.out} (its folder does not exist, or it is a folder)")
         problems = problem_files(args.domain, args.problems)
@@ -150,11 +182,13 @@ def main(argv: list[str] | None = None) -> int:
         print(e, file=sys.stderr)
         return 2
     key = {"domain": str(args.domain), "domain_sha256": sha256_file(args.domain), "planners": planners,
-           "timeout_s": args.timeout, **({"shortest": str(args.shortest)} if args.shortest else {})}
+           "timeout_s": args.timeout, **({"shortest": str(args.shortest)} if args.shortest else {}),
+           **({"focus": str(args.focus)} if args.focus else {})}
     done = _previous(args.out, key)
     rows = []
     for problem in problems:
-        digest = sha256_file(problem)
+        few = args.focus / problem.name if args.focus is not None else None
+        digest = sha256_file(problem) + (f"+{sha256_file(few)}" if few is not None and few.is_file() else "")
         old = done.get(str(problem))
         if old is not None and old.get("sha256") == digest and set(old.get("planners", {})) == set(planners):
             rows.append(old)
@@ -163,7 +197,7 @@ def main(argv: list[str] | None = None) -> int:
         if shortest is not None:
             rec["shortest"] = shortest[problem.name]
         for name in planners:
-            rec["planners"][name] = call_record(solve(args.domain, problem, name, args.timeout))
+            rec["planners"][name] = solve_focused(args.domain, problem, args.focus, name, args.timeout)
         rows.append(rec)
         print(f"{problem.name}: " + ", ".join(f"{n} {r['status']} {r['call_time_s']:.2f}s"
                                              for n, r in rec["planners"].items()), flush=True)

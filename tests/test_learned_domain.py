@@ -265,6 +265,19 @@ def test_the_focus_objects_are_what_the_goal_moves_and_what_stands_in_its_way():
     assert focus_objects(tower, frozenset({("at", "b", "l1")})) == {"a", "b"}
 
 
+def test_the_focus_problem_keeps_the_atoms_of_the_focus_objects_and_the_cells_the_others_fill():
+    from symlearn.planning.learned_loop import focus_problem
+
+    state = frozenset([("at", "a", "l0"), ("at", "b", "l0"), ("on", "b", "a"), ("clear", "b"), ("on-table", "a"),
+                       ("at", "c", "l3"), ("clear", "c"), ("on-table", "c"), ("empty", "l1"), ("empty", "l2")])
+    names, init, goal = focus_problem(["a", "b", "c"], state, frozenset({("at", "c", "l1"), ("at", "a", "l0")}))
+    assert names == ["c"] and goal == {("at", "c", "l1")}
+    # l0 stays filled (not empty) and a, b are nowhere in the problem
+    assert init == {("at", "c", "l3"), ("clear", "c"), ("on-table", "c"), ("empty", "l1"), ("empty", "l2")}
+    assert focus_problem(["a", "b", "c"], state, frozenset({("at", "c", "l3")})) is None  # the goal holds
+    assert focus_problem(["a", "b", "c"], state, frozenset({("at", "a", "l1"), ("at", "c", "l2")})) is None  # all
+
+
 def test_a_plan_over_the_focus_objects_is_a_plan_of_the_whole_state(tmp_path):
     import dataclasses
 

@@ -482,10 +482,13 @@ def test_exported_learned_problems_are_solvable_wherever_the_simulator_reaches_t
     assert rc == 0
     out = tmp_path / "lp"
     rc, printed = cli("export-learned-problems", "--run", SHIPPED_ON, "--problems", tmp_path / "walks", "--out", out,
-                      "--goal-relations", "on")
+                      "--goal-relations", "on", "--focus")
     assert rc == 0 and printed.startswith("6 problems written")
     man = json.loads((out / "problems.json").read_text())
-    assert man["goal_relations"] == ["on"] and len(man["rows"]) == 6
+    assert man["goal_relations"] == ["on"] and len(man["rows"]) == 6 and man["focus"] is True
+    focused = [r for r in man["rows"] if "focus_file" in r]
+    assert focused and sorted(p.name for p in (out / "focus").iterdir()) == sorted(
+        Path(r["focus_file"]).name for r in focused)
     domain = pddl_lib.parse_domain(out / "domain.pddl")
     assert {p.name for p in domain.predicates} >= {"at", "on", "clear", "on-table", "empty"}
     for row in man["rows"]:
@@ -497,6 +500,12 @@ def test_exported_learned_problems_are_solvable_wherever_the_simulator_reaches_t
             res = solve_files(out / "domain.pddl", out / row["file"], planner, 60.0)
             assert res.status.name == "SOLVED", (row["name"], planner, res.message)
         assert 1 <= len(res.steps) <= row["shortest"] + 1, (row["name"], res.steps)
+        if "focus_file" in row:  # fewer objects, and each plan of it a plan of the whole problem (UP's validator)
+            few = pddl_lib.parse_problem(out / row["focus_file"])
+            assert {o.name for o in few.objects} == set(row["focus_objects"]) and len(few.objects) < row["k"]
+            plan = solve_files(out / "domain.pddl", out / row["focus_file"], "fd-lmcut", 60.0)
+            assert plan.status.name == "SOLVED", (row["name"], plan.message)
+            _assert_valid(out / "domain.pddl", out / row["file"], plan.steps)
     # never over an existing folder, and a relation no operator reads is refused, both in one line
     capsys.readouterr()
     rc, _ = cli("export-learned-problems", "--run", SHIPPED_ON, "--problems", tmp_path / "walks", "--out", out)
@@ -506,6 +515,19 @@ def test_exported_learned_problems_are_solvable_wherever_the_simulator_reaches_t
                 "--out", tmp_path / "lp2", "--goal-relations", "r7")
     err = capsys.readouterr().err
     assert rc == 2 and "r7" in err and "operators.json" in err and not (tmp_path / "lp2").exists()
+
+
+def _assert_valid(domain: Path, problem: Path, steps) -> None:
+    """unified-planning's validator accepts the plan on the problem."""
+    from unified_planning.engines import ValidationResultStatus
+    from unified_planning.io import PDDLReader
+    from unified_planning.shortcuts import PlanValidator
+
+    reader = PDDLReader()
+    whole = reader.parse_problem(str(domain), str(problem))
+    plan = reader.parse_plan_string(whole, "\n".join(steps))
+    with PlanValidator(problem_kind=whole.kind, plan_kind=plan.kind) as validator:
+        assert validator.validate(whole, plan).status == ValidationResultStatus.VALID, (problem, steps)
 
 
 SHIPPED_COVER = Path(__file__).resolve().parents[1] / "pretrained" / "relations_cover"

@@ -379,3 +379,29 @@ def test_the_stock_fd_bench_runs_the_up_route_and_counts_reachable_goals_reporte
     assert bench.main([*argv[:-2], "--out", str(tmp_path / "other.json")]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"stock_fd: {man} is not a problems.json") and not (tmp_path / "other.json").exists()
+
+
+def test_the_stock_fd_bench_plans_a_focus_problem_first_and_the_whole_one_where_it_finds_none(toy, tmp_path):
+    import json
+    import shutil
+
+    bench, out, focus = _bench(), tmp_path / "stock.json", tmp_path / "focus"
+    focus.mkdir()
+    # a focus problem of reverse.pddl that has no plan (as one whose goal needs another object moved would):
+    # the whole problem is planned in the time left; unsolvable.pddl has no focus problem and is planned alone
+    shutil.copy(toy / "unsolvable.pddl", focus / "reverse.pddl")
+    argv = ["--domain", str(toy / "domain.pddl"), "--problems", f"{toy / 'reverse.pddl'},{toy / 'unsolvable.pddl'}",
+            "--planners", "fd-lmcut", "--focus", str(focus), "--out", str(out)]
+    assert bench.main(argv) == 0
+    rows = json.loads(out.read_text())["rows"]
+    first, second = (r["planners"]["fd-lmcut"] for r in rows)
+    assert first["focus"] == "unsolvable" and first["status"] == "solved" and first["plan_length"] == 7
+    assert first["call_time_s"] > first["fd_translate_time_s"] > 0  # two calls' clocks summed
+    assert second["status"] == "unsolvable" and "focus" not in second
+    # a focus problem that plans: its plan stands, and the row's key records the focus file
+    shutil.copy(toy / "reverse.pddl", focus / "reverse.pddl")
+    assert bench.main([*argv[:-2], "--out", str(tmp_path / "b.json")]) == 0
+    rec = json.loads((tmp_path / "b.json").read_text())
+    assert rec["rows"][0]["planners"]["fd-lmcut"]["focus"] == "solved" and "+" in rec["rows"][0]["sha256"]
+    assert rec["summary"]["fd-lmcut"]["focus_solved"] == 1 and rec["focus"] == str(focus)
+    assert bench.main([*argv[:-3], str(tmp_path / "none"), "--out", str(tmp_path / "c.json")]) == 2

@@ -100,10 +100,12 @@ def cmd_export_learned_problems(args: argparse.Namespace) -> int:
 
     set_threads(args.threads)
     man = export_learned_problems(Path(args.run), Path(args.problems), Path(args.out),
-                                  tuple(args.goal_relations or ()))
+                                  tuple(args.goal_relations or ()), focus=args.focus)
     believed = sum(r["goal_believed_reached"] for r in man["rows"])
-    print(f"{len(man['rows'])} problems written to {args.out} (domain.pddl, NAME.pddl, problems.json); "
-          f"{believed} goals already hold in the initial state as read")
+    focused = sum("focus_file" in r for r in man["rows"])
+    print(f"{len(man['rows'])} problems written to {args.out} (domain.pddl, NAME.pddl, problems.json"
+          + (f", focus/NAME.pddl for {focused}" if args.focus else "")
+          + f"); {believed} goals already hold in the initial state as read")
     return 0
 
 
@@ -174,5 +176,7 @@ def add_relations_commands(sub) -> None:
     q.add_argument("--problems", required=True, help="a folder of symlearn problems (symlearn problems)")
     q.add_argument("--out", required=True, help="a new folder (never written over)")
     q.add_argument("--goal-relations", nargs="*", help="object-object relations the goals keep beside at, e.g. on")
+    q.add_argument("--focus", action="store_true", help="also write OUT/focus/NAME.pddl over the objects the goal "
+                   "needs alone (the closed loop's first call): each of its plans is a plan of OUT/NAME.pddl")
     q.add_argument("--threads", type=thread_count)
     q.set_defaults(func=cmd_export_learned_problems)

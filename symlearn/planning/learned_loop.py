@@ -256,21 +256,31 @@ def focus_objects(state: frozenset[Atom], goal: frozenset[Atom]) -> set[str]:
         focus |= more
 
 
+def focus_problem(objects: Sequence[str], state: frozenset[Atom], goal: frozenset[Atom]
+                  ) -> tuple[list[str], frozenset[Atom], frozenset[Atom]] | None:
+    """The problem over focus_objects alone: those objects (in the order of `objects`), and the atoms of state and
+    goal that name no other object. None where the focus is every object (nothing to gain) or none (the goal holds
+    now, and the whole problem says so at once). Every plan of it is a plan of the whole problem (focus_objects)."""
+    few = focus_objects(state, goal)
+    if not 0 < len(few) < len(objects):
+        return None
+    keep = lambda atoms: frozenset(a for a in atoms if all(x in few for x in a[1:] if x not in LOCATIONS))  # noqa: E731
+    return [o for o in objects if o in few], keep(state), keep(goal)
+
+
 def _solve(domain: str, predicates: dict, objects: list[str], state: frozenset[Atom], goal: frozenset[Atom],
            cfg: LearnedLoopConfig, timeout_s: float):
     """A plan for `goal` from `state`: with cfg.focus, first over focus_objects alone in FOCUS_SHARE of the time,
     then, where none is found there, over every object in the time left."""
     t0 = time.perf_counter()
-    if cfg.focus:
-        few = focus_objects(state, goal)
-        if 0 < len(few) < len(objects):  # none: the goal holds, and the whole problem says so at once
-            keep = lambda atoms: [a for a in atoms if all(x in few for x in a[1:] if x not in LOCATIONS)]  # noqa: E731
-            names = [o for o in objects if o in few]
-            plan = solve_texts(domain, problem_pddl("p", names, keep(state), keep(goal), predicates), cfg.planner,
-                               timeout_s * FOCUS_SHARE)
-            if plan.status.name == "SOLVED":
-                return plan
-            timeout_s = max(timeout_s - (time.perf_counter() - t0), 1.0)
+    few = focus_problem(objects, state, goal) if cfg.focus else None
+    if few is not None:
+        names, few_state, few_goal = few
+        plan = solve_texts(domain, problem_pddl("p", names, few_state, few_goal, predicates), cfg.planner,
+                           timeout_s * FOCUS_SHARE)
+        if plan.status.name == "SOLVED":
+            return plan
+        timeout_s = max(timeout_s - (time.perf_counter() - t0), 1.0)
     return solve_texts(domain, problem_pddl("p", objects, state, goal, predicates), cfg.planner, timeout_s)
 
 
