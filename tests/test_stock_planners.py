@@ -385,7 +385,10 @@ def test_the_stock_fd_bench_plans_a_focus_problem_first_and_the_whole_one_where_
     import json
     import shutil
 
+    from symlearn.planning.learned_loop import FOCUS_SHARE
+
     bench, out, focus = _bench(), tmp_path / "stock.json", tmp_path / "focus"
+    assert bench.FOCUS_SHARE == FOCUS_SHARE  # outside the loop as inside it
     focus.mkdir()
     # a focus problem of reverse.pddl that has no plan (as one whose goal needs another object moved would):
     # the whole problem is planned in the time left; unsolvable.pddl has no focus problem and is planned alone
