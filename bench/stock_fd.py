@@ -178,6 +178,12 @@ def main(argv: list[str] | None = None) -> int:
         missing = [p.name for p in problems if shortest is not None and p.name not in shortest]
         if missing:
             raise SystemExit(f"stock_fd: {args.shortest} has no shortest length for {missing[0]}")
+        if args.focus is not None:
+            if any(p.parent.resolve() == args.focus.resolve() for p in problems):
+                raise SystemExit(f"stock_fd: --focus {args.focus} holds the problems themselves; name the folder of "
+                                 "their focus problems (export-learned-problems --focus writes OUT/focus)")
+            if not any((args.focus / p.name).is_file() for p in problems):
+                raise SystemExit(f"stock_fd: no file in --focus {args.focus} has the name of a problem")
     except SystemExit as e:
         print(e, file=sys.stderr)
         return 2

@@ -381,7 +381,7 @@ def test_the_stock_fd_bench_runs_the_up_route_and_counts_reachable_goals_reporte
     assert err.startswith(f"stock_fd: {man} is not a problems.json") and not (tmp_path / "other.json").exists()
 
 
-def test_the_stock_fd_bench_plans_a_focus_problem_first_and_the_whole_one_where_it_finds_none(toy, tmp_path):
+def test_the_stock_fd_bench_plans_a_focus_problem_first_and_the_whole_one_where_it_finds_none(toy, tmp_path, capsys):
     import json
     import shutil
 
@@ -407,4 +407,12 @@ def test_the_stock_fd_bench_plans_a_focus_problem_first_and_the_whole_one_where_
     rec = json.loads((tmp_path / "b.json").read_text())
     assert rec["rows"][0]["planners"]["fd-lmcut"]["focus"] == "solved" and "+" in rec["rows"][0]["sha256"]
     assert rec["summary"]["fd-lmcut"]["focus_solved"] == 1 and rec["focus"] == str(focus)
+    capsys.readouterr()
     assert bench.main([*argv[:-3], str(tmp_path / "none"), "--out", str(tmp_path / "c.json")]) == 2
+    assert capsys.readouterr().err.strip() == f"stock_fd: --focus folder not found: {tmp_path / 'none'}"
+    # the problems' own folder, or one with no file of a problem's name: refused in one line, nothing planned
+    assert bench.main([*argv[:-3], str(toy), "--out", str(tmp_path / "c.json")]) == 2
+    assert "holds the problems themselves" in capsys.readouterr().err
+    (tmp_path / "other").mkdir()
+    assert bench.main([*argv[:-3], str(tmp_path / "other"), "--out", str(tmp_path / "c.json")]) == 2
+    assert "has the name of a problem" in capsys.readouterr().err and not (tmp_path / "c.json").exists()
