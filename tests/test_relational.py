@@ -469,11 +469,15 @@ def test_a_tower_written_by_hand_for_the_rests_on_domain_is_solved_by_stock_plan
     assert up.status.name == "SOLVED" and len(up.steps) >= 5, up.message  # UP's validator accepted it
 
 
-def test_exported_learned_problems_are_solvable_wherever_the_simulator_reaches_the_goal(tmp_path, capsys):
-    # a sample of fresh located walks, read by the shipped rests-on model and written as PDDL problems: every goal the
-    # simulator reaches (its shortest plan is known) is solved by stock lama-first and LM-cut on the folder's domain,
-    # LM-cut's plans no longer than the simulator's shortest but by a misread, and the folder re-reads as it was written
+@pytest.mark.parametrize("run", ["relations_on", "relations_cover"])
+def test_exported_learned_problems_are_solvable_wherever_the_simulator_reaches_the_goal(run, tmp_path, capsys):
+    # a sample of fresh located walks, read by a shipped model (rests-on, cover) and written as PDDL problems: every
+    # goal the simulator reaches (its shortest plan is known) is solved by stock lama-first and LM-cut on the folder's
+    # domain, LM-cut's plans no longer than the simulator's shortest but by a misread, the folder re-reads as it was
+    # written, and a focus problem's plan is one of the whole problem
     import pddl as pddl_lib
+
+    shipped = Path(__file__).resolve().parents[1] / "pretrained" / run
 
     from search.stock_planners import solve_files
 
@@ -481,7 +485,7 @@ def test_exported_learned_problems_are_solvable_wherever_the_simulator_reaches_t
                 "--length", "1-3", "--seed", "11")
     assert rc == 0
     out = tmp_path / "lp"
-    rc, printed = cli("export-learned-problems", "--run", SHIPPED_ON, "--problems", tmp_path / "walks", "--out", out,
+    rc, printed = cli("export-learned-problems", "--run", shipped, "--problems", tmp_path / "walks", "--out", out,
                       "--goal-relations", "on", "--focus")
     assert rc == 0 and printed.startswith("6 problems written")
     man = json.loads((out / "problems.json").read_text())
@@ -508,10 +512,10 @@ def test_exported_learned_problems_are_solvable_wherever_the_simulator_reaches_t
             _assert_valid(out / "domain.pddl", out / row["file"], plan.steps)
     # never over an existing folder, and a relation no operator reads is refused, both in one line
     capsys.readouterr()
-    rc, _ = cli("export-learned-problems", "--run", SHIPPED_ON, "--problems", tmp_path / "walks", "--out", out)
+    rc, _ = cli("export-learned-problems", "--run", shipped, "--problems", tmp_path / "walks", "--out", out)
     err = capsys.readouterr().err
     assert rc == 2 and f"{out} exists" in err and len(err.strip().splitlines()) == 1
-    rc, _ = cli("export-learned-problems", "--run", SHIPPED_ON, "--problems", tmp_path / "walks",
+    rc, _ = cli("export-learned-problems", "--run", shipped, "--problems", tmp_path / "walks",
                 "--out", tmp_path / "lp2", "--goal-relations", "r7")
     err = capsys.readouterr().err
     assert rc == 2 and "r7" in err and "operators.json" in err and not (tmp_path / "lp2").exists()
