@@ -115,13 +115,12 @@ def solve(domain: Path, problem: Path, planner: str, timeout_s: float):
     return solve_files(domain, problem, planner, timeout_s)
 
 
-def solve_focused(domain: Path, problem: Path, focus_dir: Path | None, planner: str, timeout_s: float) -> dict:
-    """One row's record: the problem alone, or where focus_dir holds a problem of the same name, that one first in
-    FOCUS_SHARE of the time and the whole problem in the time left where it finds no plan."""
+def solve_focused(domain: Path, problem: Path, few: Path | None, planner: str, timeout_s: float) -> dict:
+    """One row's record: the problem alone, or with its focus problem `few`, that one first in FOCUS_SHARE of the
+    time and the whole problem in the time left where it finds no plan."""
     from search.stock_planners import call_record
 
-    few = focus_dir / problem.name if focus_dir is not None else None
-    if few is None or not few.is_file():
+    if few is None:
         return call_record(solve(domain, problem, planner, timeout_s))
     first = call_record(solve(domain, few, planner, timeout_s * FOCUS_SHARE))
     if first["status"] == "solved":
@@ -194,7 +193,8 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     for problem in problems:
         few = args.focus / problem.name if args.focus is not None else None
-        digest = sha256_file(problem) + (f"+{sha256_file(few)}" if few is not None and few.is_file() else "")
+        few = few if few is not None and few.is_file() else None  # its focus problem, where it has one
+        digest = sha256_file(problem) + (f"+{sha256_file(few)}" if few is not None else "")
         old = done.get(str(problem))
         if old is not None and old.get("sha256") == digest and set(old.get("planners", {})) == set(planners):
             rows.append(old)
@@ -203,7 +203,7 @@ def main(argv: list[str] | None = None) -> int:
         if shortest is not None:
             rec["shortest"] = shortest[problem.name]
         for name in planners:
-            rec["planners"][name] = solve_focused(args.domain, problem, args.focus, name, args.timeout)
+            rec["planners"][name] = solve_focused(args.domain, problem, few, name, args.timeout)
         rows.append(rec)
         print(f"{problem.name}: " + ", ".join(f"{n} {r['status']} {r['call_time_s']:.2f}s"
                                              for n, r in rec["planners"].items()), flush=True)

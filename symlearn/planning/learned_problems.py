@@ -22,7 +22,8 @@ planner may solve OUT/focus/NAME.pddl first and fall back to OUT/NAME.pddl where
 need another object moved out of the way). A problem whose focus is every object or none gets no focus file.
 At 9-10 objects the translator grounds a whole problem in 5-6 s; the focus problem is what makes a 10 s call work:
 
-    python bench/stock_fd.py --domain OUT/domain.pddl --problems OUT/focus --shortest OUT/problems.json --out x.json
+    python bench/stock_fd.py --domain OUT/domain.pddl --problems OUT --focus OUT/focus --shortest OUT/problems.json \\
+        --out x.json
 
 The folder is written whole at the end (atomic_write_folder) and never over an existing one.
 """
@@ -47,7 +48,8 @@ FOCUS_FOLDER = "focus"
 def export_learned_problems(run_dir: Path, problems_dir: Path, out: Path,
                             goal_relations: tuple[str, ...] = (), focus: bool = False) -> dict:
     """Write OUT/domain.pddl, OUT/NAME.pddl for every problem of problems_dir and OUT/problems.json (with `focus`,
-    OUT/focus/NAME.pddl too, over the objects the goal needs); returns the manifest. Refused in one line, before the simulator starts, when OUT exists or an input is missing."""
+    OUT/focus/NAME.pddl too, over the objects the goal needs); returns the manifest. Refused in one line, before the
+    simulator starts, when OUT exists or an input is missing."""
     from symlearn.sim.simulator import TabletopSimulator
 
     run_dir, problems_dir, out = Path(run_dir), Path(problems_dir), Path(out)
