@@ -136,6 +136,14 @@ def test_cli_collect_and_refusals(tmp_path):
     bad = subprocess.run(run[:-2] + ["0-6", "--quiet"], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and "out of range" in bad.stderr and len(bad.stderr.strip().splitlines()) == 1
     assert summarize(out)["shards"] == 12
+    far = tmp_path / "far"
+    r = subprocess.run(run[:4] + ["--out", str(far), "--n", "12", "--scenes", "far-stick", "--quiet"], capture_output=True,
+                       text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    exploration = load_manifest(far)["settings"]["exploration"]
+    assert exploration["scene_draw"] == "far-stick" and exploration["k_values"] == [2, 3, 4]
+    types = load_split(far, "all").obj_type
+    assert (types == 1).sum(1).tolist() == [1] * 12  # one stick a scene
 
 
 class _DroppingSim:
@@ -195,3 +203,31 @@ def test_independent_type_draw_allows_scenes_without_stick():
     assert max(counts) == 1 and 0.2 < np.mean(np.array(counts) == 0) < 0.35  # (1 - 0.35)^3 = 0.27
     with pytest.raises(ValueError, match="type_draw"):
         ExplorationConfig(type_draw="random")
+
+
+def test_far_stick_scenes_put_the_stick_in_the_far_row_and_carry_riders():
+    """far-stick scenes: the stick first and in the far row, cubes in the far row at about far_prob; collected in the
+    simulator, picking the stick carries what rests on it in a good share of the actions (about 1 in 5; near-row
+    scenes about 1 in 35)."""
+    from symlearn.sim.exploration import sample_scene_spec
+    from symlearn.world import FAR_ROW, ObjectType
+    rng = np.random.default_rng(0)
+    cfg = ExplorationConfig.far_stick(2, 4)
+    specs = [sample_scene_spec(rng, cfg) for _ in range(500)]
+    assert all(s[0][0] == ObjectType.STICK and s[0][1] in FAR_ROW for s in specs)
+    assert all(t == ObjectType.CUBE for s in specs for t, _ in s[1:]) and {len(s) for s in specs} == {2, 3, 4}
+    far = np.mean([loc in FAR_ROW for s in specs for _, loc in s[1:]])
+    assert abs(far - cfg.far_prob) < 0.05
+    with pytest.raises(ValueError, match="scene_draw"):
+        ExplorationConfig(scene_draw="anywhere")
+    with pytest.raises(ValueError, match="far_prob"):
+        ExplorationConfig(far_prob=1.5)
+    a = collect_shard(CollectConfig(n=40, seed=1, exploration=cfg), 0, 40)
+    carried = 0
+    for i in range(40):
+        g, k = int(a["grasped"][i]), int(a["n_objects"][i])
+        if g >= 0 and a["obj_type"][i, g] == int(ObjectType.STICK):
+            moved = np.linalg.norm(a["effect"][i, :k, :2], axis=1) >= 0.1
+            moved[g] = False
+            carried += bool(moved.any())
+    assert carried >= 3

@@ -19,11 +19,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from symlearn.config_file import Bound, check_bounds
-from symlearn.world import N_LOCATIONS, NEAR_ROW, Action, ObjectType
+from symlearn.world import FAR_ROW, N_LOCATIONS, NEAR_ROW, Action, ObjectType
 
 MAX_OBJECTS = 10  # the largest scene the simulator builds, a problem holds and the planners take; the data sets
 # are collected at 1-5 objects, so 6-10-object scenes are zero-shot for every learned model
 TYPE_DRAWS = ("authors", "independent")
+# "near-row": the paper's scenes, every object dropped in the near row; "far-stick": a stick dropped in the far
+# row and each other object (cubes) dropped in the far row with probability far_prob (on the stick, beside it or on
+# each other), else in the near row: scenes where picking the stick carries what rests on it, an event random
+# near-row episodes reach about once in 2,000 actions
+SCENE_DRAWS = ("near-row", "far-stick")
 
 
 @dataclass(frozen=True)
@@ -40,6 +45,8 @@ class ExplorationConfig:
     type_draw: str = "authors"
     stick_prob: float = 0.35  # used by type_draw="independent" only
     pick_occupied_prob: float = 0.8  # else the pick location is uniform over all six
+    scene_draw: str = "near-row"  # where objects are dropped (SCENE_DRAWS)
+    far_prob: float = 0.7  # scene_draw="far-stick": a cube dropped in the far row with this probability
 
     def __post_init__(self) -> None:
         if len(self.k_values) != len(self.k_probs) or not self.k_values:
@@ -52,8 +59,10 @@ class ExplorationConfig:
             raise ValueError(f"k_probs {self.k_probs} must be non-negative and sum to 1")
         if self.type_draw not in TYPE_DRAWS:
             raise ValueError(f"type_draw={self.type_draw!r}: expected one of {', '.join(TYPE_DRAWS)}")
-        if not 0.0 <= self.stick_prob <= 1.0 or not 0.0 <= self.pick_occupied_prob <= 1.0:
-            raise ValueError("stick_prob and pick_occupied_prob must lie in [0, 1]")
+        if self.scene_draw not in SCENE_DRAWS:
+            raise ValueError(f"scene_draw={self.scene_draw!r}: expected one of {', '.join(SCENE_DRAWS)}")
+        if not all(0.0 <= p <= 1.0 for p in (self.stick_prob, self.pick_occupied_prob, self.far_prob)):
+            raise ValueError("stick_prob, pick_occupied_prob and far_prob must lie in [0, 1]")
 
     def episode_length(self, k: int) -> int:
         return self.episode_lengths[min(k, len(self.episode_lengths)) - 1]
@@ -65,6 +74,16 @@ class ExplorationConfig:
         if not ks:
             raise ValueError(f"empty object range {lo}-{hi}")
         return ExplorationConfig(k_values=ks, k_probs=tuple([1.0 / len(ks)] * len(ks)), type_draw=type_draw)
+
+    @staticmethod
+    def far_stick(lo: int = 2, hi: int = 4) -> "ExplorationConfig":
+        """Carrying scenes: a stick in the far row with lo-1..hi-1 cubes, short episodes (4 actions) so most
+        actions meet the scene while the cubes still rest on or beside the stick."""
+        ks = tuple(range(lo, hi + 1))
+        if not ks:
+            raise ValueError(f"empty object range {lo}-{hi}")
+        return ExplorationConfig(k_values=ks, k_probs=tuple([1.0 / len(ks)] * len(ks)), episode_lengths=(4,),
+                                 scene_draw="far-stick")
 
 
 def sample_types(rng: np.random.Generator, cfg: ExplorationConfig, k: int) -> list[ObjectType]:
@@ -82,12 +101,19 @@ def sample_types(rng: np.random.Generator, cfg: ExplorationConfig, k: int) -> li
 
 def sample_scene_spec(rng: np.random.Generator, cfg: ExplorationConfig,
                       k: int | None = None) -> list[tuple[ObjectType, int]]:
-    """Objects to drop, in order: (type, near-row location). Distinct locations while they last,
-    then stacked on a random near-row location; at most one stick (types by `sample_types`)."""
+    """Objects to drop, in order: (type, location). "near-row" scenes: near-row locations, distinct while they
+    last, then stacked on a random one; at most one stick (types by `sample_types`). "far-stick" scenes: the stick
+    first, in the far row, then cubes (see SCENE_DRAWS)."""
     if k is None:
         k = int(rng.choice(cfg.k_values, p=cfg.k_probs))
     if not 1 <= k <= MAX_OBJECTS:
         raise ValueError(f"number of objects k={k} is out of range 1..{MAX_OBJECTS}")
+    if cfg.scene_draw == "far-stick":
+        spec = [(ObjectType.STICK, int(rng.choice(FAR_ROW)))]
+        for _ in range(k - 1):
+            row = FAR_ROW if rng.random() < cfg.far_prob else NEAR_ROW
+            spec.append((ObjectType.CUBE, int(rng.choice(row))))
+        return spec
     locs = list(rng.permutation(NEAR_ROW))
     types = sample_types(rng, cfg, k)
     return [(t, int(locs[i]) if i < len(locs) else int(rng.choice(NEAR_ROW))) for i, t in enumerate(types)]
