@@ -18,7 +18,7 @@ from symlearn.cli.args import non_negative_int, positive_int, set_threads, threa
 from symlearn.outputs import folder_output
 
 # the keys of symlearn.learning.relational_training.TRAIN_PRESETS, written here so that the CLI loads without torch
-TRAIN_PRESET_NAMES = ("attention", "support", "support-post", "support-exclusive", "cover")
+TRAIN_PRESET_NAMES = ("attention", "support", "support-post", "support-exclusive", "cover", "cover-carry")
 
 
 def cmd_train_relations(args: argparse.Namespace) -> int:
@@ -118,7 +118,8 @@ def add_relations_commands(sub) -> None:
     t.add_argument("--preset", default="attention", choices=sorted(TRAIN_PRESET_NAMES),
                    help="attention: three free object-object heads; support: one rests-on head; support-post: "
                         "and its reading after the action; support-exclusive: and one object on each "
-                        "cover: and at(o, l) for every cell whose pick lifts o (docs/RELATIONS.md; default attention)")
+                        "cover: and at(o, l) for every cell whose pick lifts o; cover-carry: and an object seen "
+                        "carrying two riders may hold both (docs/RELATIONS.md; default attention)")
     t.add_argument("--epochs", type=positive_int, help="default 30")
     t.add_argument("--init", help="start a new run from the weights of this run's relations.pt (same preset)")
     t.add_argument("--seed", type=non_negative_int, help="default 0")

@@ -155,15 +155,18 @@ def post_support_loss(pre_logits: torch.Tensor, post_logits: torch.Tensor, held:
     return loss
 
 
-def support_exclusion(logits: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+def support_exclusion(logits: torch.Tensor, mask: torch.Tensor, spared: torch.Tensor | None = None) -> torch.Tensor:
     """Mean squared excess over one of the objects resting on each object (rests-on probabilities summed per
     support): in a three-object stack the top rests on the middle one, not also on the bottom one, which the
     grasp alone cannot tell (both stayed where the top was picked). A stick with a cube on each end is the
-    exception the penalty pays for; it is rare in the data."""
+    exception: `spared` (B, K) bool marks supports the robot saw carry two or more riders, left out of the
+    penalty (without it the penalty pays for them; they are rare in the paper's data)."""
     k = mask.shape[1]
     eye = torch.eye(k, dtype=torch.bool, device=mask.device)[None]
     p = torch.softmax(logits[:, 1, :k, :k], -1).masked_fill(eye, 0.0) * mask[:, :, None]
     excess = F.relu(p.sum(1) - 1.0) * mask
+    if spared is not None:
+        excess = excess * ~spared
     return (excess ** 2).sum() / mask.sum().clamp_min(1)
 
 
