@@ -247,6 +247,14 @@ def predicates_of(ops: Sequence[Operator], extra: Iterable[Atom] = ()) -> dict[s
     return dict(sorted(out.items()))
 
 
+def carried(op: Operator) -> list[str]:
+    """The items one action of the operator moves (it adds an `at` of each and deletes one): two or more is
+    carrying, what rests on the held item riding along. An item that only gains a cell (a stick whose end a lifted
+    cube no longer hides) did not move."""
+    gains, loses = ({a[1] for a in atoms if a[0] == "at"} for atoms in (op.add, op.delete))
+    return sorted(gains & loses)
+
+
 def _atom(a: Atom) -> str:
     return "(" + " ".join(a) + ")"
 
@@ -277,7 +285,9 @@ def domain_pddl(ops: Sequence[Operator], name: str = "learned-relations", commen
     lines.append("  )")
     for o in ops:
         params = " ".join(f"{v} - {t}" for v, t in o.parameters)
-        lines += [f"  (:action {o.name}  ; seen {o.count} times", f"    :parameters ({params})",
+        moved = carried(o)
+        what = f"; carries {' and '.join(moved)} together" if len(moved) > 1 else ""
+        lines += [f"  (:action {o.name}  ; seen {o.count} times{what}", f"    :parameters ({params})",
                   f"    :precondition (and {' '.join([*map(_atom, o.precondition), *distinct(o)])})",
                   f"    :effect (and {' '.join(map(_atom, o.add))} "
                   f"{' '.join('(not ' + _atom(a) + ')' for a in o.delete)}))"]

@@ -313,3 +313,22 @@ def test_a_plan_over_the_focus_objects_is_a_plan_of_the_whole_state(tmp_path):
     full = _solve(domain_pddl(ops), predicates_of(ops), objects, state, goal,
                   dataclasses.replace(cfg, focus=False), 20.0)
     assert full.status.name == "SOLVED" and len(plan.steps) == len(full.steps)
+
+
+def test_an_operator_that_moves_two_items_is_written_as_carrying():
+    from pddl_export.learned_domain import Operator, carried
+    from symlearn.export.learned_export import load_operators
+
+    carry = Operator("move-9", (("?from", "location"), ("?o1", "item"), ("?o2", "item"), ("?to", "location")),
+                     (("at", "?o1", "?from"), ("at", "?o2", "l0"), ("on", "?o2", "?o1")),
+                     (("at", "?o1", "?to"), ("at", "?o2", "?to")), (("at", "?o1", "?from"), ("at", "?o2", "l0")), 26)
+    uncover = Operator("move-5", carry.parameters, (("at", "?o2", "?from"), ("on", "?o2", "?o1")),
+                       (("at", "?o1", "?from"), ("at", "?o2", "?to")), (("at", "?o2", "?from"),), 243)
+    assert carried(carry) == ["?o1", "?o2"] and carried(uncover) == ["?o2"]  # the stick under ?o2 only shows a cell
+    text = domain_pddl([carry, uncover])
+    assert "(:action move-9  ; seen 26 times; carries ?o1 and ?o2 together" in text
+    assert "(:action move-5  ; seen 243 times\n" in text
+    root = Path(__file__).resolve().parents[1] / "pretrained"
+    ops = load_operators(root / "relations_carry")
+    assert [o.name for o in ops if len(carried(o)) > 1] == ["move-19", "move-77", "move-82", "move-100"]
+    assert not [o.name for o in load_operators(root / "relations_cover") if len(carried(o)) > 1]
