@@ -1,6 +1,8 @@
+import dataclasses
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -72,6 +74,23 @@ def test_resume_redoes_only_missing_shards(tmp_path):
     assert changed == [shard_name(5)]
 
 
+def test_a_data_set_collected_before_the_scene_draw_keys_resumes(tmp_path):
+    # manifests written before scene_draw and far_prob existed lack them; they had the near-row draw, so the same
+    # arguments resume them, and a far-stick request is still refused
+    out = tmp_path / "old"
+    cfg = CollectConfig(n=12, seed=1, shard_size=1)
+    collect(out, cfg, show_progress=False)
+    m = json.loads((out / "manifest.json").read_text())
+    for key in ("scene_draw", "far_prob"):
+        del m["settings"]["exploration"][key]
+    (out / "manifest.json").write_text(json.dumps(m))
+    (out / shard_name(3)).unlink()
+    assert collect(out, cfg, show_progress=False)["complete"]
+    far = dataclasses.replace(cfg, exploration=dataclasses.replace(cfg.exploration, scene_draw="far-stick"))
+    with pytest.raises(CollectError, match="different settings.*scene_draw"):
+        collect(out, far, show_progress=False)
+
+
 def test_different_settings_refused(tiny):
     with pytest.raises(CollectError, match="different settings.*seed"):
         collect(tiny, CollectConfig(n=24, seed=4, shard_size=2), show_progress=False)
@@ -136,12 +155,13 @@ def test_cli_collect_and_refusals(tmp_path):
     bad = subprocess.run(run[:-2] + ["0-6", "--quiet"], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and "out of range" in bad.stderr and len(bad.stderr.strip().splitlines()) == 1
     assert summarize(out)["shards"] == 12
-    far = tmp_path / "far"
-    r = subprocess.run(run[:4] + ["--out", str(far), "--n", "12", "--scenes", "far-stick", "--quiet"], capture_output=True,
-                       text=True, timeout=300)
+    far = tmp_path / "far"  # the shipped recipe of data/carry: --objects over the settings file's scene draw
+    recipe = Path(__file__).resolve().parents[1] / "pretrained" / "relations_carry" / "collect_far_stick.toml"
+    r = subprocess.run(run[:4] + ["--out", str(far), "--n", "12", "--objects", "2-4", "--config", str(recipe), "--quiet"],
+                       capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     exploration = load_manifest(far)["settings"]["exploration"]
-    assert exploration["scene_draw"] == "far-stick" and exploration["k_values"] == [2, 3, 4]
+    assert exploration == json.loads(json.dumps(dataclasses.asdict(ExplorationConfig.far_stick(2, 4))))
     types = load_split(far, "all").obj_type
     assert (types == 1).sum(1).tolist() == [1] * 12  # one stick a scene
 

@@ -36,13 +36,10 @@ def collect_config(args: argparse.Namespace) -> CollectConfig:
     """CollectConfig's defaults with --config's [collect] table and the flags over them."""
     from symlearn.config_file import replace_nested
     from symlearn.sim.collect import CollectConfig
-    from symlearn.sim.exploration import ExplorationConfig
 
     cfg = config_from_file(args, "collect", lambda v: replace_nested(CollectConfig(), v))
-    if args.scenes == "far-stick":
-        cfg = dataclasses.replace(cfg, exploration=ExplorationConfig.far_stick(*(args.objects or (2, 4))))
-    elif args.objects is not None:
-        cfg = dataclasses.replace(cfg, exploration=ExplorationConfig.with_k_range(*args.objects))
+    if args.objects is not None:  # over the file's other exploration settings (a far-stick scene draw), not instead
+        cfg = dataclasses.replace(cfg, exploration=cfg.exploration.over_objects(*args.objects))
     return dataclasses.replace(cfg, **{k: v for k, v in dict(n=args.n, seed=args.seed).items() if v is not None})
 
 
@@ -237,14 +234,12 @@ def add_collect_command(sub) -> None:
     c.add_argument("--n", type=positive_int, help="number of samples (actions; default 12000)")
     c.add_argument("--seed", type=non_negative_int, help="default 0")
     c.add_argument("--objects", type=int_range, default=None,
-                   help="objects per scene, e.g. 4-5 (default: the paper's mix of 1-3; far-stick scenes 2-4)")
-    c.add_argument("--scenes", choices=("near-row", "far-stick"), default=None,
-                   help="far-stick: a stick in the far row with cubes on and beside it, 4 actions a scene, for "
-                        "carrying (default: the paper's near-row scenes)")
+                   help="objects per scene, e.g. 4-5 (default: the paper's mix of 1-3)")
     c.add_argument("--workers", type=positive_int, default=1,
                    help="worker processes (with --ray: shards in flight at once, and a local Ray's CPUs)")
     add_ray_flag(c, "shard")
-    add_config_flag(c, "[collect] (CollectConfig: shard_size, [collect.exploration], [collect.sim])")
+    add_config_flag(c, "[collect] (CollectConfig: shard_size, [collect.exploration], [collect.sim]; carrying scenes: "
+                       "[collect.exploration] scene_draw = \"far-stick\", episode_lengths = [4])")
     c.add_argument("--quiet", action="store_true", help="no progress bar")
     c.set_defaults(func=cmd_collect)
 

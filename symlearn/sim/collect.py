@@ -251,6 +251,20 @@ def _manifest(cfg: CollectConfig, done: dict[int, dict]) -> dict:
             "updated": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
 
 
+# exploration settings added after data sets were collected, with the value every earlier collection had
+ADDED_EXPLORATION_KEYS = {"scene_draw": "near-row", "far_prob": 0.7}
+
+
+def _upgraded(settings):
+    """Recorded settings with the exploration keys added since given the value they had then, so that a data set
+    collected before them resumes under the same arguments."""
+    if not (isinstance(settings, dict) and isinstance(settings.get("exploration"), dict)):
+        return settings
+    return {**settings, "exploration": {**settings["exploration"],
+                                        **{k: v for k, v in ADDED_EXPLORATION_KEYS.items()
+                                           if k not in settings["exploration"]}}}
+
+
 def _resume_state(out: Path, cfg: CollectConfig) -> dict[int, dict]:
     """Finished shards of an earlier run with the same settings; refuses a foreign or different DIR."""
     mpath = out / "manifest.json"
@@ -268,8 +282,8 @@ def _resume_state(out: Path, cfg: CollectConfig) -> dict[int, dict]:
     if old.get("kind") != DATA_KIND or old.get("format_version") != FORMAT_VERSION:
         raise CollectError(f"{out} holds a foreign data set or format version "
                            f"{old.get('format_version')!r} (expected {FORMAT_VERSION})")
-    if old.get("settings") != cfg.to_json():
-        diff = _first_difference(old.get("settings"), cfg.to_json())
+    if _upgraded(old.get("settings")) != cfg.to_json():
+        diff = _first_difference(_upgraded(old.get("settings")), cfg.to_json())
         raise CollectError(f"{out} was collected with different settings ({diff}); "
                            "use the same arguments to resume or choose another --out")
     try:

@@ -14,6 +14,7 @@ location is uniform over all six.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -75,15 +76,20 @@ class ExplorationConfig:
             raise ValueError(f"empty object range {lo}-{hi}")
         return ExplorationConfig(k_values=ks, k_probs=tuple([1.0 / len(ks)] * len(ks)), type_draw=type_draw)
 
-    @staticmethod
-    def far_stick(lo: int = 2, hi: int = 4) -> "ExplorationConfig":
-        """Carrying scenes: a stick in the far row with lo-1..hi-1 cubes, short episodes (4 actions) so most
-        actions meet the scene while the cubes still rest on or beside the stick."""
+    def over_objects(self, lo: int, hi: int) -> "ExplorationConfig":
+        """These settings with scenes of lo..hi objects, uniformly (what `collect --objects` sets)."""
         ks = tuple(range(lo, hi + 1))
         if not ks:
             raise ValueError(f"empty object range {lo}-{hi}")
-        return ExplorationConfig(k_values=ks, k_probs=tuple([1.0 / len(ks)] * len(ks)), episode_lengths=(4,),
-                                 scene_draw="far-stick")
+        return dataclasses.replace(self, k_values=ks, k_probs=tuple([1.0 / len(ks)] * len(ks)))
+
+    @staticmethod
+    def far_stick(lo: int = 2, hi: int = 4) -> "ExplorationConfig":
+        """Carrying scenes: a stick in the far row with lo-1..hi-1 cubes, short episodes (4 actions) so most
+        actions meet the scene while the cubes still rest on or beside the stick. The same from the command line:
+        `collect --objects 2-4 --config F` with F's `[collect.exploration]` holding `scene_draw = "far-stick"` and
+        `episode_lengths = [4]`."""
+        return ExplorationConfig(episode_lengths=(4,), scene_draw="far-stick").over_objects(lo, hi)
 
 
 def sample_types(rng: np.random.Generator, cfg: ExplorationConfig, k: int) -> list[ObjectType]:
