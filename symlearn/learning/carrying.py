@@ -128,6 +128,8 @@ def carrying(run_dir: Path) -> dict:
 CARRY_GOALS: tuple[tuple[str, tuple[tuple[ObjectType, int], ...], tuple[Action, ...]], ...] = (
     ("carry_one_rider", ((S, 1), (C, 0)), (Action(1, 2),)),
     ("carry_two_riders", ((S, 1), (C, 0), (C, 2)), (Action(1, 2),)),
+    ("carry_rider_to_near_row", ((S, 1), (C, 0)), (Action(1, 4),)),
+    ("carry_riders_to_near_row", ((S, 1), (C, 0), (C, 2)), (Action(1, 4),)),
 )
 
 
