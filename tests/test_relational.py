@@ -697,3 +697,26 @@ def test_a_stock_planner_carries_a_stick_with_its_rider_and_the_simulator_builds
     sim.reset(problem.initial)
     sim.step(Action(action // 6, action % 6))
     assert max_goal_distance(sim.get_scene(), problem.goal) <= GOAL_TOLERANCE_M  # the cube on the stick, near row
+
+
+def test_the_carrying_problem_of_the_carry_readme_is_one_carry_for_every_planner(tmp_path):
+    # pretrained/relations_carry/README.md writes a problem by hand: a far-row stick with a cube on its end, both to the
+    # near row. Stock lama-first and LM-cut, and pyperplan and Fast Downward through unified-planning (its validator
+    # checks their plans), all answer the one learned carrying action
+    import re
+
+    from search.classical import solve_pddl
+    from search.stock_planners import solve_files
+
+    readme = (SHIPPED_CARRY / "README.md").read_text()
+    problem = re.search(r"```\n(\(define \(problem carry\).*?)```", readme, re.S).group(1)
+    domain = SHIPPED_CARRY / "learned" / "domain.pddl"
+    want = ("(move-82 l1 s c l4)",)
+    (tmp_path / "carry.pddl").write_text(problem)
+    for planner in ("fd-lama-first", "fd-lmcut"):
+        res = solve_files(domain, tmp_path / "carry.pddl", planner, 60.0)
+        assert res.status.name == "SOLVED" and tuple(res.steps) == want, (planner, res.message, res.steps)
+    for engine in ("pyperplan", "fast-downward"):
+        res = solve_pddl(domain.read_text(), problem, engine, 60.0)
+        assert res.status.name == "SOLVED" and tuple(res.steps) == want, (engine, res.message, res.steps)
+
