@@ -487,7 +487,7 @@ def test_a_tower_written_by_hand_for_the_rests_on_domain_is_solved_by_stock_plan
     assert up.status.name == "SOLVED" and len(up.steps) >= 5, up.message  # UP's validator accepted it
 
 
-@pytest.mark.parametrize("run", ["relations_on", "relations_cover"])
+@pytest.mark.parametrize("run", ["relations_on", "relations_cover", "relations_carry"])
 def test_exported_learned_problems_are_solvable_wherever_the_simulator_reaches_the_goal(run, tmp_path, capsys):
     # a sample of fresh located walks, read by a shipped model (rests-on, cover) and written as PDDL problems: every
     # goal the simulator reaches (its shortest plan is known) is solved by stock lama-first and LM-cut on the folder's
