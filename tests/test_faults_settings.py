@@ -161,7 +161,8 @@ def _leaves(cls: type, keys: tuple[str, ...] = ()) -> list[tuple[tuple[str, ...]
 
 LEAVES = [(table, keys, hint) for table in TABLES for keys, hint in _leaves(table_class(table))]
 # a zero or a negative number these settings legitimately hold (a probability, a margin, a coordinate, -1: all)
-ZERO_OK = {"collect.exploration.stick_prob", "collect.exploration.pick_occupied_prob", "collect.sim.min_segment_s",
+ZERO_OK = {"collect.exploration.stick_prob", "collect.exploration.pick_occupied_prob", "collect.exploration.far_prob",
+           "collect.sim.min_segment_s",
            "collect.sim.pause_s", "collect.sim.settle_max_s", "collect.sim.min_travel_z", "collect.sim.clearance",
            "collect.sim.release_gap", "collect.sim.home", "collect.sim.robot_base", "collect.sim.friction",
            "collect.sim.camera.eye", "collect.sim.camera.target", "train.lr_min_ratio", "train.model.dropout",
@@ -357,7 +358,7 @@ def _candidates(value) -> list:
     if isinstance(value, float):
         return [value * 0.5, value * 2, value + 0.01, 0.5, 0.1, 1.0]
     if isinstance(value, str):
-        return ["independent", "all", "network"]
+        return ["independent", "all", "network", "far-stick"]
     if isinstance(value, tuple):
         return [tuple(reversed(value)), tuple(v * 2 for v in value), tuple(v + 1 for v in value),
                 tuple(v * 0.5 for v in value)]
