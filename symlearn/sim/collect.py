@@ -282,8 +282,9 @@ def _resume_state(out: Path, cfg: CollectConfig) -> dict[int, dict]:
     if old.get("kind") != DATA_KIND or old.get("format_version") != FORMAT_VERSION:
         raise CollectError(f"{out} holds a foreign data set or format version "
                            f"{old.get('format_version')!r} (expected {FORMAT_VERSION})")
-    if _upgraded(old.get("settings")) != cfg.to_json():
-        diff = _first_difference(_upgraded(old.get("settings")), cfg.to_json())
+    settings, want = _upgraded(old.get("settings")), cfg.to_json()
+    if settings != want:
+        diff = _first_difference(settings, want)
         raise CollectError(f"{out} was collected with different settings ({diff}); "
                            "use the same arguments to resume or choose another --out")
     try:
