@@ -235,6 +235,29 @@ def test_a_placed_effect_gets_an_operator_bound_to_where_the_action_let_go():
     assert plan.status.name == "SOLVED" and len(plan.steps) == 1 and plan.steps[0].endswith("l3 o1 l1)")
 
 
+def test_by_place_judges_an_operator_for_one_place_on_the_data_at_that_place():
+    from symlearn.export.learned_export import EXPORT_PRESETS, LearnedExportConfig, find_operators, judged_on
+
+    # 6 stick releases at l1 (covering l0 and l2) among 300 cube moves from l4 to l3: a shared sample of 20 holds
+    # about none of them, so the placed operator has no grounding to show its precision and the bound drops it
+    stick = [_t({("at", "o1", f), ("u7", "o1"), ("empty", "l0"), ("empty", "l1"), ("empty", "l2")},
+                {("at", "o1", "l0"), ("at", "o1", "l1"), ("at", "o1", "l2"), ("u7", "o1"), ("empty", f)}, f, "l1")
+             for f in ("l3", "l4", "l5")] * 2
+    cube = [_t({("at", "o2", "l4"), ("empty", "l3")}, {("at", "o2", "l3"), ("empty", "l4")}, "l4", "l3")] * 300
+    data = cube[:150] + stick + cube[150:]
+    base = LearnedExportConfig(min_count=5, placed=True, min_precision=0.5, confidence_z=1.96, sample=20)
+    kept = {}
+    for by_place in (False, True):
+        cfg = LearnedExportConfig(**{**base.__dict__, "by_place": by_place})
+        ops, notes = find_operators(data, cfg)
+        kept[by_place] = {n["name"]: (n["applies"], n["predicts"]) for n in notes if n["kept"]}
+    placed = next(o for o in learn_operators(data, 5, placed=True) if ("at", "?o1", "l0") in o.add)
+    assert placed.name not in kept[False] and kept[True][placed.name] == (6, 6)
+    assert "move-0" in kept[False] and kept[False]["move-0"] == kept[True]["move-0"]  # the cube move: shared sample
+    assert judged_on(placed, data, [], cfg) == stick  # every transition that lets go at l1, and no other
+    assert EXPORT_PRESETS["carry"].by_place and not EXPORT_PRESETS["placed"].by_place
+
+
 def test_the_relaxed_goal_keeps_an_object_at_the_goal_cells_it_covers_now():
     from symlearn.planning.learned_loop import relaxed_goal
 
@@ -330,5 +353,6 @@ def test_an_operator_that_moves_two_items_is_written_as_carrying():
     assert "(:action move-5  ; seen 243 times\n" in text
     root = Path(__file__).resolve().parents[1] / "pretrained"
     ops = load_operators(root / "relations_carry")
-    assert [o.name for o in ops if len(carried(o)) > 1] == ["move-19", "move-77", "move-82", "move-100"]
+    assert [o.name for o in ops if len(carried(o)) > 1] == ["move-19", "move-36", "move-77", "move-82", "move-93",
+                                                            "move-100", "move-102", "move-109"]
     assert not [o.name for o in load_operators(root / "relations_cover") if len(carried(o)) > 1]

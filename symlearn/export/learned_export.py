@@ -19,8 +19,9 @@ from typing import Sequence
 
 from pddl_export.files import atomic_write_files, sha256_file
 from pddl_export.bounded_json import read_json_file
-from pddl_export.learned_domain import (Operator, Transition, coverage, domain_pddl, generalize, learn_operators,
-                                        operators_from_json, operators_to_json, precision)
+from pddl_export.learned_domain import (Operator, Transition, carried, coverage, domain_pddl, generalize,
+                                        learn_operators, location_binding, operators_from_json, operators_to_json,
+                                        precision)
 from symlearn.config_file import Bound, check_bounds, preset
 from symlearn.data.dataset import data_fingerprint
 from symlearn.learning.relational_training import CHECKPOINT, load_relational
@@ -43,7 +44,11 @@ class LearnedExportConfig:
 
     `confidence_z` judges precision by its Wilson lower bound at that many standard errors (0: the plain ratio):
     a rare operator whose precision rests on a handful of groundings (4 of 16) is dropped unless the data show it
-    is above `min_precision`, while a common one loses almost nothing to the bound."""
+    is above `min_precision`, while a common one loses almost nothing to the bound.
+
+    `by_place` judges an operator for one place (`placed`) on up to `sample` transitions at that place instead
+    of the shared sample: an operator that carries a far-row stick from l1 applies in about 1 transition of 6
+    there and in few of a sample drawn from every place, where the bound drops it for want of evidence."""
 
     min_count: int = MIN_COUNT
     share: float = 1.0
@@ -54,6 +59,7 @@ class LearnedExportConfig:
     sample: int = 4000
     seed: int = 0
     placed: bool = False  # an effect naming a location besides the action's two gets an operator per place (lift)
+    by_place: bool = False
 
     def __post_init__(self) -> None:
         check_bounds(self, {"min_count": Bound(1, 2**62, integer=True), "share": Bound(0.0, 1.0, lo_open=True),
@@ -76,6 +82,8 @@ EXPORT_PRESETS = {
 }
 # as precise, and an operator per place for an effect that names other locations: a stick let go at l1 covers l0 and l2
 EXPORT_PRESETS["placed"] = dataclasses.replace(EXPORT_PRESETS["precise"], placed=True)
+# as placed, each operator for one place judged on the transitions at that place (LearnedExportConfig.by_place)
+EXPORT_PRESETS["carry"] = dataclasses.replace(EXPORT_PRESETS["placed"], by_place=True)
 
 
 def wilson_lower(hits: int, n: int, z: float) -> float:
@@ -102,15 +110,28 @@ def prune_dead_relations(transitions: list[Transition]) -> list[Transition]:
     return [Transition(keep(t.pre), keep(t.post), t.pick, t.release) for t in transitions]
 
 
+def judged_on(op: Operator, transitions: Sequence[Transition], shared: list[Transition],
+              cfg: LearnedExportConfig) -> list[Transition]:
+    """The transitions an operator's precision is judged on: with cfg.by_place and an operator for one place, up
+    to cfg.sample of those at that place; else the shared sample."""
+    pins = {var: loc for _, var, loc in (a for a in op.precondition if a[0] == "=")}
+    if not (cfg.by_place and pins):
+        return shared
+    here = [t for t in transitions if all(location_binding(t).get(v) == loc for v, loc in pins.items())]
+    return here if len(here) <= cfg.sample else random.Random(cfg.seed).sample(here, cfg.sample)
+
+
 def find_operators(transitions: Sequence[Transition], cfg: LearnedExportConfig) -> tuple[list[Operator], list[dict]]:
     """The operators of `transitions` (see LearnedExportConfig) and, per operator found, what became of it."""
     ops = learn_operators(transitions, cfg.min_count, cfg.share, cfg.max_objects, cfg.placed)
-    sample = list(transitions)
-    if len(sample) > cfg.sample:
-        sample = random.Random(cfg.seed).sample(sample, cfg.sample)
+    shared = list(transitions)
+    if len(shared) > cfg.sample:
+        shared = random.Random(cfg.seed).sample(shared, cfg.sample)
+    judge = cfg.min_precision or cfg.slack >= 0
     kept, notes = [], []
-    for op, (applies, hits) in zip(ops, precision(ops, sample) if (cfg.min_precision or cfg.slack >= 0) else
-                                   [(0, 0)] * len(ops)):
+    for op in ops:
+        sample = judged_on(op, transitions, shared, cfg)
+        applies, hits = precision([op], sample)[0] if judge else (0, 0)
         p = hits / applies if applies else 0.0
         low = wilson_lower(hits, applies, cfg.confidence_z)
         note = {"name": op.name, "count": op.count, "applies": applies, "predicts": hits, "precision": round(p, 3),
@@ -123,7 +144,7 @@ def find_operators(transitions: Sequence[Transition], cfg: LearnedExportConfig) 
             note["dropped_preconditions"] = [list(a) for a in op.precondition if a not in general.precondition]
             op = general
         kept.append(op)
-        notes.append(note | {"kept": True})
+        notes.append(note | {"kept": True, "carries": carried(op)} if len(carried(op)) > 1 else note | {"kept": True})
     return kept, notes
 
 
