@@ -144,7 +144,8 @@ def find_operators(transitions: Sequence[Transition], cfg: LearnedExportConfig) 
             note["dropped_preconditions"] = [list(a) for a in op.precondition if a not in general.precondition]
             op = general
         kept.append(op)
-        notes.append(note | {"kept": True, "carries": carried(op)} if len(carried(op)) > 1 else note | {"kept": True})
+        moved = carried(op)
+        notes.append(note | {"kept": True} | ({"carries": moved} if len(moved) > 1 else {}))
     return kept, notes
 
 
