@@ -1,6 +1,7 @@
 """Operators found from transitions over learned predicates, and their PDDL: lifting, grouping, planning."""
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 import pddl
 
@@ -236,6 +237,7 @@ def test_a_placed_effect_gets_an_operator_bound_to_where_the_action_let_go():
 
 
 def test_by_place_judges_an_operator_for_one_place_on_the_data_at_that_place():
+    from pddl_export.learned_domain import location_binding
     from symlearn.export.learned_export import EXPORT_PRESETS, LearnedExportConfig, find_operators, judged_on
 
     # 6 stick releases at l1 (covering l0 and l2) among 300 cube moves from l4 to l3: a shared sample of 20 holds
@@ -248,13 +250,14 @@ def test_by_place_judges_an_operator_for_one_place_on_the_data_at_that_place():
     base = LearnedExportConfig(min_count=5, placed=True, min_precision=0.5, confidence_z=1.96, sample=20)
     kept = {}
     for by_place in (False, True):
-        cfg = LearnedExportConfig(**{**base.__dict__, "by_place": by_place})
+        cfg = dataclasses.replace(base, by_place=by_place)
         ops, notes = find_operators(data, cfg)
         kept[by_place] = {n["name"]: (n["applies"], n["predicts"]) for n in notes if n["kept"]}
     placed = next(o for o in learn_operators(data, 5, placed=True) if ("at", "?o1", "l0") in o.add)
     assert placed.name not in kept[False] and kept[True][placed.name] == (6, 6)
     assert "move-0" in kept[False] and kept[False]["move-0"] == kept[True]["move-0"]  # the cube move: shared sample
-    assert judged_on(placed, data, [], cfg) == stick  # every transition that lets go at l1, and no other
+    at_places = [(location_binding(t), t) for t in data]
+    assert judged_on(placed, at_places, [], cfg) == stick  # every transition that lets go at l1, and no other
     assert EXPORT_PRESETS["carry"].by_place and not EXPORT_PRESETS["placed"].by_place
 
 
@@ -302,8 +305,6 @@ def test_the_focus_problem_keeps_the_atoms_of_the_focus_objects_and_the_cells_th
 
 
 def test_a_plan_over_the_focus_objects_is_a_plan_of_the_whole_state(tmp_path):
-    import dataclasses
-
     from unified_planning.engines import ValidationResultStatus
     from unified_planning.io import PDDLReader
     from unified_planning.shortcuts import PlanValidator

@@ -110,14 +110,15 @@ def prune_dead_relations(transitions: list[Transition]) -> list[Transition]:
     return [Transition(keep(t.pre), keep(t.post), t.pick, t.release) for t in transitions]
 
 
-def judged_on(op: Operator, transitions: Sequence[Transition], shared: list[Transition],
+def judged_on(op: Operator, placed: Sequence[tuple[dict[str, str], Transition]], shared: list[Transition],
               cfg: LearnedExportConfig) -> list[Transition]:
     """The transitions an operator's precision is judged on: with cfg.by_place and an operator for one place, up
-    to cfg.sample of those at that place; else the shared sample."""
+    to cfg.sample of those at that place (`placed`: each transition with its location_binding); else the shared
+    sample."""
     pins = {var: loc for _, var, loc in (a for a in op.precondition if a[0] == "=")}
     if not (cfg.by_place and pins):
         return shared
-    here = [t for t in transitions if all(location_binding(t).get(v) == loc for v, loc in pins.items())]
+    here = [t for where, t in placed if all(where.get(v) == loc for v, loc in pins.items())]
     return here if len(here) <= cfg.sample else random.Random(cfg.seed).sample(here, cfg.sample)
 
 
@@ -127,10 +128,11 @@ def find_operators(transitions: Sequence[Transition], cfg: LearnedExportConfig) 
     shared = list(transitions)
     if len(shared) > cfg.sample:
         shared = random.Random(cfg.seed).sample(shared, cfg.sample)
+    placed = [(location_binding(t), t) for t in transitions] if cfg.by_place else []
     judge = cfg.min_precision or cfg.slack >= 0
     kept, notes = [], []
     for op in ops:
-        sample = judged_on(op, transitions, shared, cfg)
+        sample = judged_on(op, placed, shared, cfg)
         applies, hits = precision([op], sample)[0] if judge else (0, 0)
         p = hits / applies if applies else 0.0
         low = wilson_lower(hits, applies, cfg.confidence_z)
