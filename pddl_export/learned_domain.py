@@ -177,6 +177,20 @@ def bindings(op: Operator, state: frozenset[Atom], fixed: dict[str, str]) -> Ite
     yield from extend(0, dict(fixed))
 
 
+def successor(op: Operator, args: Sequence[str], state: frozenset[Atom]) -> frozenset[Atom] | None:
+    """The state a plan step `(op args...)` leads to from `state` in the learned domain (STRIPS: the delete list
+    removed, the add list added), or None where its precondition does not hold there: what the domain predicts the
+    step does, for a closed loop that checks the scene it observes next against it."""
+    if len(args) != len(op.parameters):
+        raise ValueError(f"{op.name} takes {len(op.parameters)} arguments, got {len(args)}: {list(args)}")
+    b = {v: a for (v, _), a in zip(op.parameters, args)}
+    ground = lambda atoms: {tuple([a[0], *(b.get(x, x) for x in a[1:])]) for a in atoms}  # noqa: E731
+    pre = ground(op.precondition)
+    if any(a[0] == "=" and a[1] != a[2] for a in pre) or not {a for a in pre if a[0] != "="} <= state:
+        return None
+    return frozenset((state - ground(op.delete)) | ground(op.add))
+
+
 def precision(ops: Sequence[Operator], transitions: Sequence[Transition]) -> list[tuple[int, int]]:
     """For each operator, (groundings that apply in a transition's pre-state at the action's two locations, those
     that predict the observed change exactly). A planner may pick any applicable grounding, so each counts: an

@@ -4,6 +4,7 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 import pddl
+import pytest
 
 from pddl_export.learned_domain import (Transition, coverage, domain_pddl, learn_operators, lift, predicates_of,
                                         problem_pddl)
@@ -357,3 +358,53 @@ def test_an_operator_that_moves_two_items_is_written_as_carrying():
     assert [o.name for o in ops if len(carried(o)) > 1] == ["move-19", "move-36", "move-77", "move-82", "move-93",
                                                             "move-100", "move-102", "move-109"]
     assert not [o.name for o in load_operators(root / "relations_cover") if len(carried(o)) > 1]
+
+
+def test_a_plan_step_leads_where_the_domain_says_and_only_where_its_precondition_holds():
+    from pddl_export.learned_domain import successor
+    from symlearn.export.learned_export import load_operators
+    from symlearn.planning.learned_loop import LearnedLoopConfig, _solve
+
+    ops = load_operators(Path("pretrained/relations_carry"))
+    by_name = {o.name: o for o in ops}
+    # a cube o1 at l3 under o2, a cube o3 alone at l4; the goal: o2 on o3, o1 moved to l0
+    state = frozenset({("at", "o1", "l3"), ("at", "o2", "l3"), ("on", "o2", "o1"), ("clear", "o2"),
+                       ("on-table", "o1"), ("at", "o3", "l4"), ("clear", "o3"), ("on-table", "o3"), ("u3", "o2"),
+                       ("empty", "l0"), ("empty", "l1"), ("empty", "l2"), ("empty", "l5")})
+    goal = frozenset({("on", "o2", "o3"), ("at", "o1", "l0")})
+    plan = _solve(domain_pddl(ops), predicates_of(ops), ["o1", "o2", "o3"], state, goal,
+                  LearnedLoopConfig(planner="fd-lmcut"), 20.0)
+    assert plan.status.name == "SOLVED" and len(plan.steps) == 2
+    now = state
+    for step in plan.steps:  # each step applies where the one before led, and the goal holds after the last
+        name, *args = step.strip("()").split()
+        now = successor(by_name[name], args, now)
+        assert now is not None, step
+    assert goal <= now and ("at", "o2", "l3") not in now and ("clear", "o1") in now
+    # move-0 (an item on the table to an empty cell): not where the cell is filled, nor for an item under another
+    move = by_name["move-0"]
+    assert successor(move, ["l4", "o3", "l0"], state) == (state - {("at", "o3", "l4"), ("empty", "l0")}) | {
+        ("at", "o3", "l0"), ("empty", "l4")}
+    assert successor(move, ["l4", "o3", "l3"], state) is None
+    assert successor(move, ["l3", "o1", "l0"], state) is None  # o1 is not clear
+    placed = next(o for o in ops if ("=", "?to", "l0") in o.precondition)  # bound to one place: not elsewhere
+    args = ["l1" if v == "?to" else "l4" if t == "location" else "o3" for v, t in placed.parameters]
+    assert successor(placed, args, state | set(_everything(placed, args))) is None
+    with pytest.raises(ValueError, match="takes 3 arguments"):
+        successor(move, ["l4", "o3"], state)
+
+
+def _everything(op, args):
+    """Every atom of op's precondition under args, as a state where it would otherwise apply."""
+    b = {v: a for (v, _), a in zip(op.parameters, args)}
+    return [tuple([a[0], *(b.get(x, x) for x in a[1:])]) for a in op.precondition if a[0] != "="]
+
+
+def test_the_loop_holds_the_unary_bits_each_scene_shows_the_first_or_every_one_seen():
+    from symlearn.planning.learned_loop import held_bits
+
+    first, then = {("u0", "o1"), ("u6", "o2")}, {("u0", "o1"), ("u2", "o2")}  # o2 set on a stick's end: u6 -> u2
+    assert held_bits("each", None, first) == first and held_bits("each", first, then) == then
+    assert held_bits("first", None, first) == first and held_bits("first", first, then) == first
+    assert held_bits("seen", None, first) == first
+    assert held_bits("seen", first, then) == {("u0", "o1"), ("u6", "o2"), ("u2", "o2")}

@@ -336,6 +336,8 @@ def test_the_learned_commands_refuse_bad_input_in_one_line(tmp_path, capsys):
 
     with pytest.raises(ValueError, match="unknown planner 'lama'"):
         LearnedLoopConfig(planner="lama")
+    with pytest.raises(ValueError, match="unary must be each, first or seen; got 'all'"):
+        LearnedLoopConfig(unary="all")
     rc, _ = cli("benchmark-learned", "--run", SHIPPED, "--problems", tmp_path, "--out", tmp_path / "b.json",
                 "--planner", "lama")
     err = capsys.readouterr().err
@@ -463,6 +465,30 @@ def test_a_four_cube_tower_is_stated_and_built_by_stock_fast_downward_in_simulat
     res = run_learned(sim, model, blob, load_operators(SHIPPED_ON), problem, LearnedLoopConfig(), goal)
     assert res.success, (res.stop, res.actions)  # the simulator's verdict: every cube where the goal scene has it
     assert len(res.actions) == 4  # one pick-and-place a cube
+
+
+def test_the_loop_keeps_a_plan_while_each_scene_is_the_one_it_predicted(sim):
+    # execution monitoring (LearnedLoopConfig.monitor): the carry model builds the tower of four from one planner
+    # call, each scene after a step read as the domain predicted; planning at every step calls the planner 4 times
+    from symlearn.export.learned_export import load_operators
+    from symlearn.learning.relational_training import load_relational
+    from symlearn.planning.learned_loop import LearnedLoopConfig, run_learned
+    from symlearn.problems.problem import Problem
+
+    model, blob = load_relational(SHIPPED_CARRY)
+    ops = load_operators(SHIPPED_CARRY)
+    spec = ((C, 0), (C, 1), (C, 2), (C, 4))
+    sim.build(spec)
+    initial = sim.get_scene()
+    sim.build(((C, 5), (C, 5), (C, 5), (C, 5)))
+    problem = Problem("tower4", 0, spec, initial, (0 * 6 + 5, 1 * 6 + 5, 2 * 6 + 5, 4 * 6 + 5), sim.get_scene(),
+                      task="tower-4")
+    goal = frozenset({("at", "o1", "l5"), ("on", "o2", "o1"), ("on", "o3", "o2"), ("on", "o4", "o3")})
+    kept = run_learned(sim, model, blob, ops, problem, LearnedLoopConfig(monitor=True), goal)
+    assert kept.success and kept.actions == [5, 11, 17, 29], (kept.stop, kept.actions)
+    assert len(kept.plan_times_s) == 1 and kept.kept_steps == 3
+    every = run_learned(sim, model, blob, ops, problem, LearnedLoopConfig(monitor=False), goal)
+    assert every.success and every.actions == kept.actions and len(every.plan_times_s) == 4 and every.kept_steps == 0
 
 
 def test_a_tower_written_by_hand_for_the_rests_on_domain_is_solved_by_stock_planners():
