@@ -177,6 +177,12 @@ def bindings(op: Operator, state: frozenset[Atom], fixed: dict[str, str]) -> Ite
     yield from extend(0, dict(fixed))
 
 
+def ground(atoms: Iterable[Atom], binding: dict[str, str]) -> set[Atom]:
+    """Lifted atoms with each variable replaced by what `binding` gives it (constants, and variables it does not
+    name, stay as they are)."""
+    return {tuple([a[0], *(binding.get(x, x) for x in a[1:])]) for a in atoms}
+
+
 def successor(op: Operator, args: Sequence[str], state: frozenset[Atom]) -> frozenset[Atom] | None:
     """The state a plan step `(op args...)` leads to from `state` in the learned domain (STRIPS: the delete list
     removed, the add list added), or None where its precondition does not hold there: what the domain predicts the
@@ -184,11 +190,10 @@ def successor(op: Operator, args: Sequence[str], state: frozenset[Atom]) -> froz
     if len(args) != len(op.parameters):
         raise ValueError(f"{op.name} takes {len(op.parameters)} arguments, got {len(args)}: {list(args)}")
     b = {v: a for (v, _), a in zip(op.parameters, args)}
-    ground = lambda atoms: {tuple([a[0], *(b.get(x, x) for x in a[1:])]) for a in atoms}  # noqa: E731
-    pre = ground(op.precondition)
+    pre = ground(op.precondition, b)
     if any(a[0] == "=" and a[1] != a[2] for a in pre) or not {a for a in pre if a[0] != "="} <= state:
         return None
-    return frozenset((state - ground(op.delete)) | ground(op.add))
+    return frozenset((state - ground(op.delete, b)) | ground(op.add, b))
 
 
 def precision(ops: Sequence[Operator], transitions: Sequence[Transition]) -> list[tuple[int, int]]:
@@ -207,8 +212,7 @@ def precision(ops: Sequence[Operator], transitions: Sequence[Transition]) -> lis
             add, delete = changes(t)
             for b in bindings(op, t.pre, fixed):
                 applies += 1
-                ground = lambda atoms: {tuple([a[0], *(b.get(x, x) for x in a[1:])]) for a in atoms}  # noqa: E731
-                hits += ground(op.add) == add and ground(op.delete) == delete
+                hits += ground(op.add, b) == add and ground(op.delete, b) == delete
         out.append((applies, hits))
     return out
 

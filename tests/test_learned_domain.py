@@ -396,8 +396,9 @@ def test_a_plan_step_leads_where_the_domain_says_and_only_where_its_precondition
 
 def _everything(op, args):
     """Every atom of op's precondition under args, as a state where it would otherwise apply."""
-    b = {v: a for (v, _), a in zip(op.parameters, args)}
-    return [tuple([a[0], *(b.get(x, x) for x in a[1:])]) for a in op.precondition if a[0] != "="]
+    from pddl_export.learned_domain import ground
+
+    return ground((a for a in op.precondition if a[0] != "="), {v: a for (v, _), a in zip(op.parameters, args)})
 
 
 def test_the_loop_holds_the_unary_bits_each_scene_shows_the_first_or_every_one_seen():

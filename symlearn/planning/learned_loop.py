@@ -235,15 +235,16 @@ def run_learned(sim, model, blob: dict, ops: Sequence[Operator], problem: Proble
         if goal <= state:
             res.stop = "goal believed reached"
             return res
-        if cfg.monitor and rest and expected is not None and _as_predicted(state, expected) \
-                and _next_state(rest[0], by_name, state) is not None:
+        keep = cfg.monitor and rest and expected is not None and _as_predicted(state, expected)
+        after = _next_state(rest[0], by_name, state) if keep else None
+        if after is not None:
             res.kept_steps += 1
         else:
             rest = _plan(domain, predicates, objects, state, goal, located, cfg, res)
             if not rest:
                 return res
-        step = rest.pop(0)
-        expected = _next_state(step, by_name, state)
+            after = _next_state(rest[0], by_name, state)
+        step, expected = rest.pop(0), after
         action = step_action(step, by_name)
         sim.step(Action(action // N_LOCATIONS, action % N_LOCATIONS))
         res.actions.append(action)
