@@ -83,8 +83,8 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
     return 0
 
 
-def _init_distributed() -> None:
-    """Join the process group when launched by torchrun (WORLD_SIZE > 1)."""
+def _init_distributed() -> bool:
+    """Join the process group when launched by torchrun (WORLD_SIZE > 1); whether it joined one."""
     import os
 
     if int(os.environ.get("WORLD_SIZE", "1")) > 1:
@@ -92,6 +92,22 @@ def _init_distributed() -> None:
         import torch.distributed as dist
 
         dist.init_process_group("nccl" if torch.cuda.is_available() else "gloo")
+        return True
+    return False
+
+
+def _leave_distributed(finished: bool) -> None:
+    """Leave the process group; after a finished run, first wait for every rank. A rank that exits with its gloo
+    connections open can abort (SIGABRT) while a peer still writes its files. A failed rank does not wait: its peers
+    may never reach the barrier, and torchrun stops them once it exits."""
+    import torch.distributed as dist
+
+    if dist.is_initialized():
+        try:
+            if finished:
+                dist.barrier()
+        finally:
+            dist.destroy_process_group()
 
 
 def train_config(args: argparse.Namespace) -> TrainConfig:
@@ -112,10 +128,16 @@ def cmd_train(args: argparse.Namespace) -> int:
     cfg = train_config(args)
     folder_output(Path(args.out), "--out")
     set_threads(args.threads)
-    _init_distributed()
+    joined = _init_distributed()
     print(f"train: preset {cfg.preset}, {cfg.epochs} epochs, seed {cfg.seed}, attention {cfg.model.attention} "
           f"-> {args.out}", file=sys.stderr)
-    out = train(Path(args.data), Path(args.out), cfg, resume=not args.no_resume, show_progress=not args.quiet)
+    finished = False
+    try:
+        out = train(Path(args.data), Path(args.out), cfg, resume=not args.no_resume, show_progress=not args.quiet)
+        finished = True
+    finally:
+        if joined:
+            _leave_distributed(finished)
     last = out["history"][-1] if out["history"] else {}
     print(json.dumps({"run": args.out, "best_val_loss": out["best_val_loss"], "last_epoch": last}, indent=2,
                      allow_nan=False))
