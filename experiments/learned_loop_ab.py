@@ -1,11 +1,12 @@
-"""The learned route's closed loop under other loop settings: how it reads unary bits, whether it keeps a plan.
+"""The learned route's closed loop under other loop settings: unary bits, keeping a plan, shortening it.
 
 `symlearn benchmark-learned` runs the loop as LearnedLoopConfig's defaults have it (execution monitoring on, an
-object's bits those it showed so far in the episode). This runs the same benchmark, resumable, with those two levers
-set otherwise, as the dev comparison behind the defaults did (bench/results/relations_dev_loop.json):
+object's bits those it showed so far in the episode, each plan shortened in up to 2 s). This runs the same benchmark,
+resumable, with those levers set otherwise, as the dev comparisons behind the defaults did
+(bench/results/relations_dev_loop.json):
 
     python experiments/learned_loop_ab.py --run pretrained/relations_carry --problems problems/rel_dev68 \
-        --out dev68_each_off.json --monitor off --unary each [--planner fd-lama-first]
+        --out dev68_each_off.json --monitor off --unary each [--shorten-s 0] [--planner fd-lama-first]
 """
 from __future__ import annotations
 
@@ -25,9 +26,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--planner", default=LearnedLoopConfig.planner)
     ap.add_argument("--monitor", choices=("on", "off"), default="on" if LearnedLoopConfig.monitor else "off")
     ap.add_argument("--unary", choices=("each", "first", "seen"), default=LearnedLoopConfig.unary)
+    ap.add_argument("--shorten-s", type=float, default=LearnedLoopConfig.shorten_s,
+                    help="seconds of a call for shortening the plan (0: executed as the planner gives it)")
     a = ap.parse_args(argv)
-    res = benchmark_learned(Path(a.run), Path(a.problems), Path(a.out), goal_relations=("on",),
-                            relax_unreachable=True, planner=a.planner, monitor=a.monitor == "on", unary=a.unary)
+    cfg = LearnedLoopConfig(planner=a.planner, goal_relations=("on",), relax_unreachable=True,
+                            monitor=a.monitor == "on", unary=a.unary, shorten_s=a.shorten_s)
+    res = benchmark_learned(Path(a.run), Path(a.problems), Path(a.out), cfg)
     print(json.dumps({band: v["success"] for band, v in res["summary"].items()}))
     return 0
 

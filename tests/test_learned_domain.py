@@ -325,8 +325,10 @@ def test_a_plan_over_the_focus_objects_is_a_plan_of_the_whole_state(tmp_path):
     assert focus_objects(state, goal) == {"o5", "o6", "o9"}  # the top at the goal cell, and what it rests on
     objects = [f"o{i}" for i in range(1, 10)]
     cfg = LearnedLoopConfig(planner="fd-lmcut")  # optimal: the focus objects cost no action here
-    plan = _solve(domain_pddl(ops), predicates_of(ops), objects, state, goal, cfg, 20.0)
+    plan, solved = _solve(domain_pddl(ops), predicates_of(ops), objects, state, goal, cfg, 20.0)
     assert plan.status.name == "SOLVED" and plan.steps
+    # the problem it was found for: the focus objects' atoms alone
+    assert {x for a in solved[0] | solved[1] for x in a[1:] if x.startswith("o")} == {"o5", "o6", "o9"}
     # unified-planning's validator: every step applies to the whole state, and the whole goal holds after the last
     (tmp_path / "d.pddl").write_text(domain_pddl(ops))
     (tmp_path / "p.pddl").write_text(problem_pddl("whole", objects, state, goal, predicates_of(ops)))
@@ -335,9 +337,9 @@ def test_a_plan_over_the_focus_objects_is_a_plan_of_the_whole_state(tmp_path):
     up_plan = reader.parse_plan_string(whole, "\n".join(plan.steps))
     with PlanValidator(problem_kind=whole.kind, plan_kind=up_plan.kind) as validator:
         assert validator.validate(whole, up_plan).status == ValidationResultStatus.VALID
-    full = _solve(domain_pddl(ops), predicates_of(ops), objects, state, goal,
-                  dataclasses.replace(cfg, focus=False), 20.0)
-    assert full.status.name == "SOLVED" and len(plan.steps) == len(full.steps)
+    full, solved = _solve(domain_pddl(ops), predicates_of(ops), objects, state, goal,
+                          dataclasses.replace(cfg, focus=False), 20.0)
+    assert full.status.name == "SOLVED" and len(plan.steps) == len(full.steps) and solved == (state, goal)
 
 
 def test_an_operator_that_moves_two_items_is_written_as_carrying():
@@ -372,7 +374,7 @@ def test_a_plan_step_leads_where_the_domain_says_and_only_where_its_precondition
                        ("on-table", "o1"), ("at", "o3", "l4"), ("clear", "o3"), ("on-table", "o3"), ("u3", "o2"),
                        ("empty", "l0"), ("empty", "l1"), ("empty", "l2"), ("empty", "l5")})
     goal = frozenset({("on", "o2", "o3"), ("at", "o1", "l0")})
-    plan = _solve(domain_pddl(ops), predicates_of(ops), ["o1", "o2", "o3"], state, goal,
+    plan, _ = _solve(domain_pddl(ops), predicates_of(ops), ["o1", "o2", "o3"], state, goal,
                   LearnedLoopConfig(planner="fd-lmcut"), 20.0)
     assert plan.status.name == "SOLVED" and len(plan.steps) == 2
     now = state

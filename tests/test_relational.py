@@ -338,6 +338,8 @@ def test_the_learned_commands_refuse_bad_input_in_one_line(tmp_path, capsys):
         LearnedLoopConfig(planner="lama")
     with pytest.raises(ValueError, match="unary must be each, first or seen; got 'all'"):
         LearnedLoopConfig(unary="all")
+    with pytest.raises(ValueError, match="shorten_s=-1"):
+        LearnedLoopConfig(shorten_s=-1)
     rc, _ = cli("benchmark-learned", "--run", SHIPPED, "--problems", tmp_path, "--out", tmp_path / "b.json",
                 "--planner", "lama")
     err = capsys.readouterr().err

@@ -86,11 +86,13 @@ def cmd_export_learned(args: argparse.Namespace) -> int:
 
 def cmd_benchmark_learned(args: argparse.Namespace) -> int:
     from symlearn.planning.learned_benchmark import benchmark_learned
+    from symlearn.planning.learned_loop import LearnedLoopConfig
 
-    set_threads(args.threads)
     relations = tuple(args.goal_relations or ())
-    res = benchmark_learned(Path(args.run), Path(args.problems), Path(args.out), args.timeout, relations,
-                            tuple(args.drop or ()), relax_unreachable=bool(relations), planner=args.planner)
+    cfg = LearnedLoopConfig(planner=args.planner, timeout_s=args.timeout, goal_relations=relations,
+                            drop=tuple(args.drop or ()), relax_unreachable=bool(relations))
+    set_threads(args.threads)
+    res = benchmark_learned(Path(args.run), Path(args.problems), Path(args.out), cfg)
     print(json.dumps(res["summary"], indent=1))
     return 0
 

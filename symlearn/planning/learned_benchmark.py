@@ -16,16 +16,12 @@ from symlearn.problems.problem import load_problems
 from symlearn.provenance import versions
 
 
-def benchmark_learned(run_dir: Path, problems_dir: Path, out: Path, timeout_s: float = 10.0,
-                      goal_relations: tuple[str, ...] = (), drop: tuple[str, ...] = (),
-                      relax_unreachable: bool = False, planner: str = LearnedLoopConfig.planner,
-                      monitor: bool = LearnedLoopConfig.monitor, unary: str = LearnedLoopConfig.unary) -> dict:
-    """Run every problem of problems_dir; the result file is rewritten after each problem and a rerun with the
-    same settings skips the problems it holds."""
+def benchmark_learned(run_dir: Path, problems_dir: Path, out: Path,
+                      cfg: LearnedLoopConfig = LearnedLoopConfig()) -> dict:
+    """Run every problem of problems_dir under cfg; the result file (cfg recorded in its settings) is rewritten after
+    each problem and a rerun with the same settings skips the problems it holds."""
     from symlearn.sim.simulator import TabletopSimulator
 
-    cfg = LearnedLoopConfig(planner=planner, timeout_s=timeout_s, goal_relations=goal_relations, drop=drop,
-                            relax_unreachable=relax_unreachable, monitor=monitor, unary=unary)
     ops = load_operators(run_dir)
     model, blob = load_relational(Path(run_dir))
     settings = {"run": str(run_dir), **run_hashes(run_dir), "problems": str(problems_dir),

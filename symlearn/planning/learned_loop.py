@@ -2,8 +2,8 @@
 
 At every step the scene is observed, the relational model computes its symbolic state (objects o1..ok,
 `(at o l)`, `(rK a b)`, `(uB o)`: symlearn.symbolic.learned_state), the state and the goal are written as a
-PDDL problem of the learned domain (pddl_export.learned_domain), stock Fast Downward plans, and the first
-action of the plan is executed; then the loop observes again, and keeps the rest of the plan while the scene reads
+PDDL problem of the learned domain (pddl_export.learned_domain), stock Fast Downward plans (a satisficing
+planner's plan then shortened, search.plan_shortening), and the first action of the plan is executed; then the loop observes again, and keeps the rest of the plan while the scene reads
 as the domain predicted (LearnedLoopConfig.monitor), else plans again. An object's unary bits are those it showed
 so far in the episode (LearnedLoopConfig.unary): the domain takes them for properties, the encoder reads them anew
 from each view. The goal is given as the problem's goal scene,
@@ -25,6 +25,7 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from pddl_export.learned_domain import Atom, Operator, domain_pddl, predicates_of, problem_pddl, successor
+from search.plan_shortening import shorten_plan
 from search.stock_planners import STOCK_PLANNERS, solve_texts
 from symlearn.config_file import TIMEOUT_S, Bound, check_bounds
 from symlearn.problems.problem import GOAL_TOLERANCE_M, Problem, max_goal_distance
@@ -74,6 +75,12 @@ class LearnedLoopConfig:
     # permits what it permits); dev, without monitor: "seen" 0.975 / 0.85 / 0.75 / 0.86, "first" 1.00 / 0.75 /
     # 0.70 / 0.86, "each" 0.975 / 0.85 / 0.70 / 0.82
     unary: str = "seen"
+    # seconds of a planner call's time limit (of what the planner left) for shortening a satisficing planner's plan
+    # by plan neighborhood graph search (search.plan_shortening); 0 executes the plan as it comes. An optimal
+    # planner's plan is never shortened: none shorter exists. Chosen on dev (carry, lama-first, walks 1-5 / 6-8 /
+    # 9-10 / structures): 0.975 / 0.85 / 0.70 / 0.77 against 0.95 / 0.90 / 0.70 / 0.68 without, executed over the
+    # shortest 1.02 / 1.12 / 1.21 / 1.00 against 1.18 / 1.25 / 1.08 / 1.06 (LM-cut with it, 2 s: the same outcomes)
+    shorten_s: float = 2.0
 
     def __post_init__(self) -> None:
         """Refuse a planner, time limit, step factor or unary reading no run can use, before the simulator starts."""
@@ -81,7 +88,8 @@ class LearnedLoopConfig:
             raise ValueError(f"unary must be each, first or seen; got {self.unary!r}")
         if self.planner not in STOCK_PLANNERS:
             raise ValueError(f"unknown planner {self.planner!r}; known: {', '.join(STOCK_PLANNERS)}")
-        check_bounds(self, {"timeout_s": TIMEOUT_S, "max_steps_factor": Bound(0.0, 100.0, lo_open=True)})
+        check_bounds(self, {"timeout_s": TIMEOUT_S, "max_steps_factor": Bound(0.0, 100.0, lo_open=True),
+                            "shorten_s": Bound(0.0, 3600.0)})
 
 
 @dataclass
@@ -240,7 +248,7 @@ def run_learned(sim, model, blob: dict, ops: Sequence[Operator], problem: Proble
         if after is not None:
             res.kept_steps += 1
         else:
-            rest = _plan(domain, predicates, objects, state, goal, located, cfg, res)
+            rest = _plan(ops, domain, predicates, objects, state, goal, located, cfg, res)
             if not rest:
                 return res
             after = _next_state(rest[0], by_name, state)
@@ -272,25 +280,30 @@ def _next_state(step: str, ops: dict[str, Operator], state: frozenset[Atom]) -> 
     return successor(ops[parts[0]], parts[1:], state)
 
 
-def _plan(domain: str, predicates: dict, objects: list[str], state: frozenset[Atom], goal: frozenset[Atom],
-          located: frozenset[Atom], cfg: LearnedLoopConfig, res: LoopResult) -> list[str]:
-    """A plan's steps from state, its call recorded in res; none, with res.stop saying why, where no plan came."""
+def _plan(ops: Sequence[Operator], domain: str, predicates: dict, objects: list[str], state: frozenset[Atom],
+          goal: frozenset[Atom], located: frozenset[Atom], cfg: LearnedLoopConfig, res: LoopResult) -> list[str]:
+    """A plan's steps from state (shortened, LearnedLoopConfig.shorten_s), its call recorded in res; none, with
+    res.stop saying why, where no plan came."""
     t0 = time.perf_counter()
     first = cfg.timeout_s * (RELAX_SHARE if cfg.relax_unreachable else 1.0)
-    plan = _solve(domain, predicates, objects, state, goal, cfg, first)
+    plan, solved = _solve(domain, predicates, objects, state, goal, cfg, first)
     if cfg.relax_unreachable and plan.status.name in ("UNSOLVABLE", "TIMEOUT"):
         relaxed = relaxed_goal(located, state)
         if relaxed != goal:
             res.relaxed_calls += 1
             left = max(cfg.timeout_s - (time.perf_counter() - t0), 1.0)
-            plan = _solve(domain, predicates, objects, state, relaxed, cfg, left)
+            plan, solved = _solve(domain, predicates, objects, state, relaxed, cfg, left)
+    steps = list(plan.steps) if plan.status.name == "SOLVED" else []
+    if res.first_plan_length is None and steps:
+        res.first_plan_length = len(steps)
+    budget = min(cfg.shorten_s, cfg.timeout_s - (time.perf_counter() - t0))
+    if len(steps) > 1 and budget > 0 and not STOCK_PLANNERS[cfg.planner].optimal:  # an optimal plan is shortest
+        steps = shorten_plan(ops, *solved, steps, timeout_s=budget)
     res.plan_times_s.append(round(time.perf_counter() - t0, 3))
-    if plan.status.name != "SOLVED" or not plan.steps:
+    if not steps:
         res.stop = f"planner: {plan.status.name.lower()} {plan.message}"[:200]
         return []
-    if res.first_plan_length is None:
-        res.first_plan_length = len(plan.steps)
-    return list(plan.steps)
+    return steps
 
 
 def focus_objects(state: frozenset[Atom], goal: frozenset[Atom]) -> set[str]:
@@ -336,8 +349,9 @@ def focus_problem(objects: Sequence[str], state: frozenset[Atom], goal: frozense
 
 def _solve(domain: str, predicates: dict, objects: list[str], state: frozenset[Atom], goal: frozenset[Atom],
            cfg: LearnedLoopConfig, timeout_s: float):
-    """A plan for `goal` from `state`: with cfg.focus, first over focus_objects alone in FOCUS_SHARE of the time,
-    then, where none is found there, over every object in the time left."""
+    """A plan for `goal` from `state`, and the (state, goal) it was found for: with cfg.focus, first over
+    focus_objects alone in FOCUS_SHARE of the time, then, where none is found there, over every object in the time
+    left."""
     t0 = time.perf_counter()
     few = focus_problem(objects, state, goal) if cfg.focus else None
     if few is not None:
@@ -345,9 +359,9 @@ def _solve(domain: str, predicates: dict, objects: list[str], state: frozenset[A
         plan = solve_texts(domain, problem_pddl("p", names, few_state, few_goal, predicates), cfg.planner,
                            timeout_s * FOCUS_SHARE)
         if plan.status.name == "SOLVED":
-            return plan
+            return plan, (few_state, few_goal)
         timeout_s = max(timeout_s - (time.perf_counter() - t0), 1.0)
-    return solve_texts(domain, problem_pddl("p", objects, state, goal, predicates), cfg.planner, timeout_s)
+    return solve_texts(domain, problem_pddl("p", objects, state, goal, predicates), cfg.planner, timeout_s), (state, goal)
 
 
 def summarize(results: Sequence[LoopResult]) -> dict:
