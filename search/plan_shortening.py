@@ -12,6 +12,7 @@ taken), so it is a plan of the same problem.
 """
 from __future__ import annotations
 
+import itertools
 import time
 from typing import Callable, Iterable, Sequence
 
@@ -22,14 +23,21 @@ from search.result import PlanStatus
 State = frozenset[Atom]
 
 
-def applicable(ops: Sequence[Operator], state: State) -> Iterable[tuple[str, State]]:
-    """Every ground step "(op args...)" whose precondition holds in state, with the state it leads to."""
+def applicable(ops: Sequence[Operator], state: State, entities: dict[str, Sequence[str]]) -> Iterable[tuple[str, State]]:
+    """Every ground step "(op args...)" whose precondition holds in state, with the state it leads to. A parameter
+    its precondition does not name (an ablation can drop the atoms that did) ranges over `entities` of its type
+    ({"item": the problem's objects, "location": the domain's constants}), distinct from the others, as a PDDL
+    planner grounds it."""
     for op in ops:
         for b in bindings(op, state, {}):
-            args = [b[v] for v, _ in op.parameters]
-            after = successor(op, args, state)
-            if after is not None:
-                yield f"({op.name} {' '.join(args)})", after
+            free = [(v, t) for v, t in op.parameters if v not in b]
+            for rest in itertools.product(*(entities.get(t, ()) for _, t in free)):
+                if len(set(rest)) < len(rest) or set(rest) & set(b.values()):
+                    continue
+                args = [{**b, **dict(zip((v for v, _ in free), rest))}[v] for v, _ in op.parameters]
+                after = successor(op, args, state)
+                if after is not None:
+                    yield f"({op.name} {' '.join(args)})", after
 
 
 def plan_states(ops: dict[str, Operator], state: State, steps: Sequence[str]) -> list[State] | None:
@@ -43,11 +51,12 @@ def plan_states(ops: dict[str, Operator], state: State, steps: Sequence[str]) ->
     return out
 
 
-def shorten_plan(ops: Sequence[Operator], state: State, goal: State, steps: Sequence[str], *,
-                 timeout_s: float, max_states: int = 4000) -> list[str]:
-    """A plan for `goal` from `state` no longer than `steps` (itself a plan of it), by plan neighborhood graph search
-    within timeout_s and a neighborhood of at most max_states states. `steps` comes back unchanged where it does not
-    reach the goal in the domain (nothing to improve on) or nothing shorter is found."""
+def shorten_plan(ops: Sequence[Operator], objects: Sequence[str], state: State, goal: State, steps: Sequence[str], *,
+                 timeout_s: float, max_states: int = 4000, n_locations: int = 6) -> list[str]:
+    """A plan for `goal` from `state` over `objects` (the problem's items; the locations are the domain's constants
+    l0.. as pddl_export.learned_domain writes them) no longer than `steps` (itself a plan of it), by plan neighborhood
+    graph search within timeout_s and a neighborhood of at most max_states states. `steps` comes back unchanged where
+    it does not reach the goal in the domain (nothing to improve on) or nothing shorter is found."""
     t0 = time.perf_counter()
     by_name = {o.name: o for o in ops}
     best = list(steps)
@@ -55,10 +64,11 @@ def shorten_plan(ops: Sequence[Operator], state: State, goal: State, steps: Sequ
     if states is None or not goal <= states[-1] or len(best) <= 1:
         return best
     memo: dict[State, list[tuple[str, State]]] = {}
+    entities = {"item": list(objects), "location": [f"l{i}" for i in range(n_locations)]}
 
     def moves(s: State) -> list[tuple[str, State]]:
         if s not in memo:
-            memo[s] = list(applicable(ops, s))
+            memo[s] = list(applicable(ops, s, entities))
         return memo[s]
 
     depth, last = 1, 0

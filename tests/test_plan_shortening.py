@@ -15,6 +15,14 @@ MOVE = Operator("move-0", (("?from", "location"), ("?o1", "item"), ("?to", "loca
                 (("at", "?o1", "?to"), ("empty", "?from")), (("at", "?o1", "?from"), ("empty", "?to")), 10)
 
 
+ITEMS = ("o1", "o2")
+# an item off the one it rests on, to an empty cell
+OFF = Operator("move-2", (("?from", "location"), ("?o1", "item"), ("?o2", "item"), ("?to", "location")),
+               (("at", "?o1", "?from"), ("on", "?o1", "?o2"), ("clear", "?o1"), ("empty", "?to")),
+               (("at", "?o1", "?to"), ("clear", "?o2"), ("on-table", "?o1")),
+               (("at", "?o1", "?from"), ("on", "?o1", "?o2"), ("empty", "?to")), 10)
+
+
 def _cells(where: dict[str, str], cells: tuple[str, ...] = ("l0", "l1", "l2", "l3")) -> frozenset:
     s = {("at", o, c) for o, c in where.items()} | {(p, o) for o in where for p in ("clear", "on-table")}
     return frozenset(s | {("empty", c) for c in cells if c not in where.values()})
@@ -23,24 +31,43 @@ def _cells(where: dict[str, str], cells: tuple[str, ...] = ("l0", "l1", "l2", "l
 def test_a_detour_is_cut_to_the_one_step_that_reaches_the_goal():
     state, goal = _cells({"o1": "l0"}), frozenset({("at", "o1", "l2")})
     back_and_forth = ["(move-0 l0 o1 l1)", "(move-0 l1 o1 l0)", "(move-0 l0 o1 l3)", "(move-0 l3 o1 l2)"]
-    assert shorten_plan([MOVE], state, goal, back_and_forth, timeout_s=30) == ["(move-0 l0 o1 l2)"]
+    assert shorten_plan([MOVE], ITEMS, state, goal, back_and_forth, timeout_s=30) == ["(move-0 l0 o1 l2)"]
     # no state repeats here: o2 is moved out of a way it was never in, then o1 goes where the goal wants it
     state = _cells({"o1": "l0", "o2": "l1"})
     aside = ["(move-0 l1 o2 l3)", "(move-0 l0 o1 l2)"]
     assert len(set(plan_states({"move-0": MOVE}, state, aside))) == 3
-    assert shorten_plan([MOVE], state, goal, aside, timeout_s=30) == ["(move-0 l0 o1 l2)"]
+    assert shorten_plan([MOVE], ITEMS, state, goal, aside, timeout_s=30) == ["(move-0 l0 o1 l2)"]
 
 
 def test_what_cannot_be_improved_comes_back_unchanged():
     state, goal = _cells({"o1": "l0", "o2": "l1"}), frozenset({("at", "o1", "l1"), ("at", "o2", "l0")})
     swap = ["(move-0 l1 o2 l2)", "(move-0 l0 o1 l1)", "(move-0 l2 o2 l0)"]  # three steps are the fewest
-    assert shorten_plan([MOVE], state, goal, swap, timeout_s=30) == swap
+    assert shorten_plan([MOVE], ITEMS, state, goal, swap, timeout_s=30) == swap
     wrong = ["(move-0 l0 o1 l1)"]  # o1 cannot go where o2 stands: not a plan, nothing to improve on
-    assert shorten_plan([MOVE], state, goal, wrong, timeout_s=30) == wrong
+    assert shorten_plan([MOVE], ITEMS, state, goal, wrong, timeout_s=30) == wrong
     short = ["(move-0 l0 o1 l3)", "(move-0 l3 o1 l2)"]
     goal = frozenset({("at", "o1", "l2")})
-    assert shorten_plan([MOVE], state, goal, short, timeout_s=30, max_states=2) == short  # over the state budget
+    assert shorten_plan([MOVE], ITEMS, state, goal, short, timeout_s=30, max_states=2) == short  # over the state budget
     assert plan_states({"move-0": MOVE}, state, ["(move-7 l0 o1 l3)"]) is None  # an operator the domain lacks
+
+
+def test_a_parameter_no_precondition_names_ranges_over_every_object_of_its_type():
+    from search.plan_shortening import applicable
+    from symlearn.planning.learned_loop import without
+
+    # the ablation drops `on`, `clear` and `on-table`: ?o2 of move-2 is named by no precondition any more, and a
+    # planner grounds it over every other item, as the search must
+    off = without([OFF], ("on", "clear", "on-table"))[0]
+    assert not any("?o2" in a for a in off.precondition)
+    state = frozenset({("at", "o1", "l0"), ("at", "o2", "l0"), ("at", "o3", "l1"), ("empty", "l2")})
+    steps = sorted(step for step, _ in applicable([off], state, {"item": ["o1", "o2", "o3"], "location": ["l0", "l1",
+                                                                                                          "l2"]}))
+    assert steps == ["(move-2 l0 o1 o2 l2)", "(move-2 l0 o1 o3 l2)", "(move-2 l0 o2 o1 l2)", "(move-2 l0 o2 o3 l2)",
+                     "(move-2 l1 o3 o1 l2)", "(move-2 l1 o3 o2 l2)"]
+    state |= {("empty", "l3")}
+    detour = ["(move-2 l0 o1 o2 l3)", "(move-2 l3 o1 o3 l2)"]  # by l3 to l2
+    short = shorten_plan([off], ["o1", "o2", "o3"], state, frozenset({("at", "o1", "l2")}), detour, timeout_s=30)
+    assert len(short) == 1 and short[0].startswith("(move-2 l0 o1 ") and short[0].endswith(" l2)")
 
 
 def _atoms(text: str) -> frozenset:
@@ -70,7 +97,7 @@ def test_lama_firsts_plan_of_a_structure_is_cut_to_the_shortest_and_stays_valid(
     optimal = solve_texts(domain_pddl(ops), problem, "fd-lmcut", 20.0)
     assert first.status.name == optimal.status.name == "SOLVED"
     assert len(first.steps) >= 2 * len(optimal.steps)  # lama-first's detours (17 steps against 5)
-    short = shorten_plan(ops, state, goal, list(first.steps), timeout_s=60)
+    short = shorten_plan(ops, objects, state, goal, list(first.steps), timeout_s=60)
     assert len(short) == len(optimal.steps)
     # unified-planning's validator on the stock domain and problem files: every step applies, the goal holds
     (tmp_path / "d.pddl").write_text(domain_pddl(ops))

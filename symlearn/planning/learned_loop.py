@@ -298,7 +298,7 @@ def _plan(ops: Sequence[Operator], domain: str, predicates: dict, objects: list[
         res.first_plan_length = len(steps)
     budget = min(cfg.shorten_s, cfg.timeout_s - (time.perf_counter() - t0))
     if len(steps) > 1 and budget > 0 and not STOCK_PLANNERS[cfg.planner].optimal:  # an optimal plan is shortest
-        steps = shorten_plan(ops, *solved, steps, timeout_s=budget)
+        steps = shorten_plan(ops, *solved, steps, timeout_s=budget, n_locations=N_LOCATIONS)
     res.plan_times_s.append(round(time.perf_counter() - t0, 3))
     if not steps:
         res.stop = f"planner: {plan.status.name.lower()} {plan.message}"[:200]
@@ -349,7 +349,7 @@ def focus_problem(objects: Sequence[str], state: frozenset[Atom], goal: frozense
 
 def _solve(domain: str, predicates: dict, objects: list[str], state: frozenset[Atom], goal: frozenset[Atom],
            cfg: LearnedLoopConfig, timeout_s: float):
-    """A plan for `goal` from `state`, and the (state, goal) it was found for: with cfg.focus, first over
+    """A plan for `goal` from `state`, and the (objects, state, goal) it was found for: with cfg.focus, first over
     focus_objects alone in FOCUS_SHARE of the time, then, where none is found there, over every object in the time
     left."""
     t0 = time.perf_counter()
@@ -359,9 +359,10 @@ def _solve(domain: str, predicates: dict, objects: list[str], state: frozenset[A
         plan = solve_texts(domain, problem_pddl("p", names, few_state, few_goal, predicates), cfg.planner,
                            timeout_s * FOCUS_SHARE)
         if plan.status.name == "SOLVED":
-            return plan, (few_state, few_goal)
+            return plan, (names, few_state, few_goal)
         timeout_s = max(timeout_s - (time.perf_counter() - t0), 1.0)
-    return solve_texts(domain, problem_pddl("p", objects, state, goal, predicates), cfg.planner, timeout_s), (state, goal)
+    return (solve_texts(domain, problem_pddl("p", objects, state, goal, predicates), cfg.planner, timeout_s),
+            (objects, state, goal))
 
 
 def summarize(results: Sequence[LoopResult]) -> dict:
