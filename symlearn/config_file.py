@@ -49,6 +49,7 @@ TABLES: Mapping[str, str] = types.MappingProxyType({
     "problems": "symlearn.problems.problem_generation:ProblemConfig",
     "execution": "symlearn.planning.execution:ExecutionConfig",
     "planner": "symlearn.planning.planner_catalogue:PlannerConfig",
+    "learned_loop": "symlearn.planning.learned_loop:LearnedLoopConfig",
 })
 # fields a file may not set: what the command line or the stage itself decides (the preset names the base config)
 NOT_SETTABLE = frozenset({"preset"})

@@ -168,7 +168,7 @@ ZERO_OK = {"collect.exploration.stick_prob", "collect.exploration.pick_occupied_
            "collect.sim.camera.eye", "collect.sim.camera.target", "train.lr_min_ratio", "train.model.dropout",
            "train.model.depth_ref", "transition.copy_prior", "export.pddl_fidelity_cases", "lifted.min_gain",
            "execution.max_replans",
-           "execution.max_fallbacks",
+           "execution.max_fallbacks", "learned_loop.shorten_s",
            "problems.min_goal_distance_m"}  # ProblemConfig's checks belong to the problems' own fixes
 NEGATIVE_OK = {"collect.sim.home", "collect.sim.robot_base", "collect.sim.camera.eye", "collect.sim.camera.target",
                "collect.sim.camera.up", "train.model.depth_ref", "export.pddl_fidelity_cases",
@@ -358,7 +358,9 @@ def _candidates(value) -> list:
     if isinstance(value, float):
         return [value * 0.5, value * 2, value + 0.01, 0.5, 0.1, 1.0]
     if isinstance(value, str):
-        return ["independent", "all", "network", "far-stick"]
+        return ["independent", "all", "network", "far-stick", "first", "fd-lama-first"]
+    if value == ():  # a list of names, empty by default ([learned_loop] goal_relations, drop)
+        return [("on",)]
     if isinstance(value, tuple):
         return [tuple(reversed(value)), tuple(v * 2 for v in value), tuple(v + 1 for v in value),
                 tuple(v * 0.5 for v in value)]
@@ -455,6 +457,8 @@ class _Stop(Exception):
      ("--rules", "--run", "{tmp}/run", "--data", "{tmp}/nodata")),
     ("export-pddl", "lifted", "symlearn.export.lifted_export.export_lifted",
      ("--run", "{tmp}/run", "--data", "{tmp}/nodata")),
+    ("benchmark-learned", "learned_loop", "symlearn.planning.learned_benchmark.benchmark_learned",
+     ("--run", "{tmp}/run", "--problems", "{tmp}/problems", "--out", "{tmp}/b.json")),
 ])
 def test_every_key_of_a_table_reaches_the_config_its_command_runs(tmp_path, monkeypatch, command, table, target,
                                                                   extra):

@@ -355,6 +355,37 @@ def test_the_learned_commands_refuse_bad_input_in_one_line(tmp_path, capsys):
     assert rc == 2 and "relations.pt is not a readable checkpoint" in err and len(err.strip().splitlines()) == 1
 
 
+def test_benchmark_learned_reads_its_loop_settings_from_the_file_and_the_flags_win(tmp_path, capsys):
+    from symlearn.cli.main import build_parser
+    from symlearn.cli.relations import loop_config
+    from symlearn.planning.learned_loop import LearnedLoopConfig
+
+    def parse(*flags):
+        return build_parser().parse_args(["benchmark-learned", "--run", "R", "--problems", "P", "--out", "O",
+                                          *map(str, flags)])
+
+    assert loop_config(parse()) == LearnedLoopConfig()
+    # the ablation's file (docs/RELATIONS.md), with the goal relations and the planner given as flags
+    cfg = loop_config(parse("--config", "pretrained/relations_carry/drop_relations.toml", "--goal-relations", "on",
+                            "--planner", "fd-lama-first"))
+    assert (cfg.drop, cfg.goal_relations, cfg.relax_unreachable, cfg.planner, cfg.timeout_s, cfg.shorten_s) == (
+        ("on", "clear", "on-table"), ("on",), True, "fd-lama-first", 10.0, 2.0)
+    loop = tmp_path / "loop.toml"
+    loop.write_text('[learned_loop]\nunary = "first"\nshorten_s = 0\ntimeout_s = 5\nplanner = "fd-lama-first"\n')
+    cfg = loop_config(parse("--config", loop, "--timeout", "3"))  # the flag wins over the file's timeout_s
+    assert (cfg.unary, cfg.shorten_s, cfg.timeout_s, cfg.planner, cfg.goal_relations) == ("first", 0.0, 3.0,
+                                                                                          "fd-lama-first", ())
+    for text, said in (("shorten = 1", "[learned_loop] has no setting 'shorten'"),
+                       ('unary = "all"', "[learned_loop] unary: unary must be each, first or seen; got 'all'"),
+                       ("shorten_s = -1", "[learned_loop] shorten_s: shorten_s=-1")):
+        loop.write_text(f"[learned_loop]\n{text}\n")
+        rc, _ = cli("benchmark-learned", "--run", SHIPPED, "--problems", tmp_path, "--out", tmp_path / "b.json",
+                    "--config", loop)
+        err = capsys.readouterr().err
+        assert rc == 2 and said in err and str(loop) in err and len(err.strip().splitlines()) == 1, err
+        assert not (tmp_path / "b.json").exists()
+
+
 def _support_model() -> RelationalDeepSym:
     torch.manual_seed(0)
     return RelationalDeepSym(RelationalConfig(conv_channels=(8, 8, 8, 8), feature_dim=16, hidden=16,

@@ -14,7 +14,8 @@ import json
 import sys
 from pathlib import Path
 
-from symlearn.cli.args import non_negative_int, positive_int, set_threads, thread_count
+from symlearn.cli.args import (add_config_flag, config_from_file, non_negative_int, positive_int, set_threads,
+                               thread_count)
 from symlearn.outputs import folder_output
 
 # the keys of symlearn.learning.relational_training.TRAIN_PRESETS, written here so that the CLI loads without torch
@@ -84,13 +85,22 @@ def cmd_export_learned(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_benchmark_learned(args: argparse.Namespace) -> int:
-    from symlearn.planning.learned_benchmark import benchmark_learned
+def loop_config(args: argparse.Namespace):
+    """The learned route's loop settings (LearnedLoopConfig): --config's [learned_loop] table over the defaults, and
+    the flags given over it (--goal-relations also plans a goal proved unreachable for its `at` atoms)."""
+    from symlearn.config_file import replace_nested
     from symlearn.planning.learned_loop import LearnedLoopConfig
 
-    relations = tuple(args.goal_relations or ())
-    cfg = LearnedLoopConfig(planner=args.planner, timeout_s=args.timeout, goal_relations=relations,
-                            drop=tuple(args.drop or ()), relax_unreachable=bool(relations))
+    flags = {k: v for k, v in dict(planner=args.planner, timeout_s=args.timeout).items() if v is not None}
+    if args.goal_relations is not None:
+        flags |= dict(goal_relations=tuple(args.goal_relations), relax_unreachable=bool(args.goal_relations))
+    return config_from_file(args, "learned_loop", lambda v: replace_nested(LearnedLoopConfig(), {**v, **flags}))
+
+
+def cmd_benchmark_learned(args: argparse.Namespace) -> int:
+    from symlearn.planning.learned_benchmark import benchmark_learned
+
+    cfg = loop_config(args)
     set_threads(args.threads)
     res = benchmark_learned(Path(args.run), Path(args.problems), Path(args.out), cfg)
     print(json.dumps(res["summary"], indent=1))
@@ -162,15 +172,14 @@ def add_relations_commands(sub) -> None:
     b.add_argument("--run", required=True)
     b.add_argument("--problems", required=True)
     b.add_argument("--out", required=True, help="result JSON file (resumed: finished problems are kept)")
-    b.add_argument("--timeout", type=float, default=10.0, help="seconds per planner call (10)")
-    b.add_argument("--planner", default="fd-lmcut",
-                   help="the stock planner configuration of each call: fd-lmcut (default), fd-lama-first, ... "
-                        "(search.stock_planners.STOCK_PLANNERS)")
+    b.add_argument("--timeout", type=float, help="seconds per planner call (default: LearnedLoopConfig's, 10)")
+    b.add_argument("--planner", help="the stock planner configuration of each call: fd-lmcut (LearnedLoopConfig's "
+                                     "default), fd-lama-first, ... (search.stock_planners.STOCK_PLANNERS)")
     b.add_argument("--goal-relations", nargs="*", help="object-object heads the goal keeps, e.g. on; with any, a "
                    "goal proved unreachable or unsolved in 0.6 of the time limit is planned for its at atoms "
                    "(learned_loop.relaxed_goal) in the time left")
-    b.add_argument("--drop", nargs="*", help="the ablation: predicates removed from the domain, the states and the "
-                                             "goal, e.g. r1 nothing-r1")
+    add_config_flag(b, "[learned_loop] (LearnedLoopConfig: drop, the ablation's predicates, e.g. [\"on\", "
+                       "\"clear\", \"on-table\"]; monitor; unary; shorten_s; focus; max_steps_factor)")
     b.add_argument("--threads", type=thread_count)
     b.set_defaults(func=cmd_benchmark_learned)
 
