@@ -23,7 +23,8 @@ from search.result import PlanStatus
 State = frozenset[Atom]
 
 
-def applicable(ops: Sequence[Operator], state: State, entities: dict[str, Sequence[str]]) -> Iterable[tuple[str, State]]:
+def applicable(ops: Sequence[Operator], state: State,
+               entities: dict[str, Sequence[str]]) -> Iterable[tuple[str, State]]:
     """Every ground step "(op args...)" whose precondition holds in state, with the state it leads to. A parameter
     its precondition does not name (an ablation can drop the atoms that did) ranges over `entities` of its type
     ({"item": the problem's objects, "location": the domain's constants}), distinct from the others, as a PDDL

@@ -3,8 +3,9 @@
 At every step the scene is observed, the relational model computes its symbolic state (objects o1..ok,
 `(at o l)`, `(rK a b)`, `(uB o)`: symlearn.symbolic.learned_state), the state and the goal are written as a
 PDDL problem of the learned domain (pddl_export.learned_domain), stock Fast Downward plans (a satisficing
-planner's plan then shortened, search.plan_shortening), and the first action of the plan is executed; then the loop observes again, and keeps the rest of the plan while the scene reads
-as the domain predicted (LearnedLoopConfig.monitor), else plans again. An object's unary bits are those it showed
+planner's plan then shortened, search.plan_shortening), and the first action of the plan is executed; then the
+loop observes again, and keeps the rest of the plan while the scene reads as the domain predicted
+(LearnedLoopConfig.monitor), else plans again. An object's unary bits are those it showed
 so far in the episode (LearnedLoopConfig.unary): the domain takes them for properties, the encoder reads them anew
 from each view. The goal is given as the problem's goal scene,
 as the seed paper gives it: the scene is placed, observed and turned into learned atoms the same way, and the
