@@ -196,6 +196,13 @@ def successor(op: Operator, args: Sequence[str], state: frozenset[Atom]) -> froz
     return frozenset((state - ground(op.delete, b)) | ground(op.add, b))
 
 
+def step_successor(ops: dict[str, Operator], step: str, state: frozenset[Atom]) -> frozenset[Atom] | None:
+    """successor() of a plan step as a planner writes it, "(move-3 l0 o1 l2)", its operator looked up by name in ops;
+    None where ops has no such operator or its precondition does not hold in state."""
+    name, *args = step.strip("() ").split()
+    return successor(ops[name], args, state) if name in ops else None
+
+
 def precision(ops: Sequence[Operator], transitions: Sequence[Transition]) -> list[tuple[int, int]]:
     """For each operator, (groundings that apply in a transition's pre-state at the action's two locations, those
     that predict the observed change exactly). A planner may pick any applicable grounding, so each counts: an

@@ -16,7 +16,7 @@ import itertools
 import time
 from typing import Callable, Iterable, Sequence
 
-from pddl_export.learned_domain import Atom, Operator, bindings, successor
+from pddl_export.learned_domain import Atom, Operator, bindings, step_successor, successor
 from search.astar import astar
 from search.result import PlanStatus
 
@@ -45,8 +45,7 @@ def plan_states(ops: dict[str, Operator], state: State, steps: Sequence[str]) ->
     """The states a plan passes through, the start first; None where a step does not apply."""
     out = [state]
     for step in steps:
-        name, *args = step.strip("() ").split()
-        if name not in ops or (state := successor(ops[name], args, state)) is None:
+        if (state := step_successor(ops, step, state)) is None:
             return None
         out.append(state)
     return out

@@ -25,7 +25,7 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
-from pddl_export.learned_domain import Atom, Operator, domain_pddl, predicates_of, problem_pddl, successor
+from pddl_export.learned_domain import Atom, Operator, domain_pddl, predicates_of, problem_pddl, step_successor
 from search.plan_shortening import shorten_plan
 from search.stock_planners import STOCK_PLANNERS, solve_texts
 from symlearn.config_file import TIMEOUT_S, Bound, check_bounds
@@ -245,14 +245,14 @@ def run_learned(sim, model, blob: dict, ops: Sequence[Operator], problem: Proble
             res.stop = "goal believed reached"
             return res
         keep = cfg.monitor and rest and expected is not None and _as_predicted(state, expected)
-        after = _next_state(rest[0], by_name, state) if keep else None
+        after = step_successor(by_name, rest[0], state) if keep else None
         if after is not None:
             res.kept_steps += 1
         else:
             rest = _plan(ops, domain, predicates, objects, state, goal, located, cfg, res)
             if not rest:
                 return res
-            after = _next_state(rest[0], by_name, state)
+            after = step_successor(by_name, rest[0], state)
         step, expected = rest.pop(0), after
         action = step_action(step, by_name)
         sim.step(Action(action // N_LOCATIONS, action % N_LOCATIONS))
@@ -272,13 +272,6 @@ def _as_predicted(state: frozenset[Atom], expected: frozenset[Atom]) -> bool:
     """Whether the observed state is the predicted one on every atom but the unary bits (LearnedLoopConfig.monitor)."""
     relational = lambda atoms: {a for a in atoms if not UNARY.fullmatch(a[0])}  # noqa: E731
     return relational(state) == relational(expected)
-
-
-def _next_state(step: str, ops: dict[str, Operator], state: frozenset[Atom]) -> frozenset[Atom] | None:
-    """What the learned domain predicts the plan step "(move-3 l0 o1 l2)" leads to from state (None: it does not
-    apply there)."""
-    parts = step.strip("() ").split()
-    return successor(ops[parts[0]], parts[1:], state)
 
 
 def _plan(ops: Sequence[Operator], domain: str, predicates: dict, objects: list[str], state: frozenset[Atom],
