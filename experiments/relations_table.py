@@ -4,7 +4,7 @@ whole-code route on the same problems, closed loop, by objects x shortest-plan l
     python experiments/relations_table.py [--learned RUN/learned/test.json RUN/learned/test68.json] \\
         [--learned-on RUN_ON/learned/test.json ...] [--learned-cover RUN_COVER/learned/test.json ...] \
         [--learned-carry RUN_CARRY/learned/test.json ...] [--benchmark ORACLE.json ...] \
-        --out bench/results/relations_test_table.json
+        --out bench/results/relations_test15_table.json
 
 Each ORACLE.json is `symlearn benchmark --run pretrained/recommended --problems A,B --planners
 fast-downward-lifted,astar-outcomes` on the same sets (its closed-loop rows are read).
