@@ -70,6 +70,24 @@ def test_a_parameter_no_precondition_names_ranges_over_every_object_of_its_type(
     assert len(short) == 1 and short[0].startswith("(move-2 l0 o1 ") and short[0].endswith(" l2)")
 
 
+def test_without_the_relations_in_preconditions_a_step_picks_where_the_item_does_not_stand():
+    from search.plan_shortening import applicable
+    from symlearn.planning.learned_loop import step_action, without
+
+    # the ablation of drop_preconditions.toml: effects keep `at`, so the goal is still reached in the domain, but
+    # nothing ties ?from to where o1 stands; the learned relation is what made the robot pick at l0
+    state, types = _cells({"o1": "l0", "o2": "l1"}), {"item": list(ITEMS), "location": ["l0", "l1", "l2", "l3"]}
+    with_at = sorted(step for step, _ in applicable([MOVE], state, types))
+    assert with_at == ["(move-0 l0 o1 l2)", "(move-0 l0 o1 l3)", "(move-0 l1 o2 l2)", "(move-0 l1 o2 l3)"]
+    free = without([MOVE], (), ("at", "clear", "on-table", "empty"))[0]
+    assert free.add == MOVE.add and free.delete == MOVE.delete and free.precondition == ()
+    steps = {step: after for step, after in applicable([free], state, types)}
+    assert len(steps) == 4 * 2 * 3  # every (?from, ?o1, ?to) with ?from != ?to
+    after = steps["(move-0 l2 o1 l1)"]  # o1 "moved" from an empty cell onto o2's: the goal atom holds in the domain
+    assert ("at", "o1", "l1") in after and ("at", "o1", "l0") in after
+    assert step_action("(move-0 l2 o1 l1)", {"move-0": free}) == 2 * 6 + 1  # the robot picks at empty l2
+
+
 def _atoms(text: str) -> frozenset:
     return frozenset(tuple(m.split()) for m in re.findall(r"\(([a-z0-9-]+(?: [a-z0-9-]+)+)\)", text))
 

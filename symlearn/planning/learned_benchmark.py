@@ -25,7 +25,7 @@ def benchmark_learned(run_dir: Path, problems_dir: Path, out: Path,
     ops = load_operators(run_dir)
     model, blob = load_relational(Path(run_dir))
     settings = {"run": str(run_dir), **run_hashes(run_dir), "problems": str(problems_dir),
-                "config": {**cfg.__dict__, "goal_relations": list(cfg.goal_relations), "drop": list(cfg.drop)}}
+                "config": {k: list(v) if isinstance(v, tuple) else v for k, v in cfg.__dict__.items()}}
     done: dict[str, dict] = {}
     if out.is_file():
         old = read_json_file(out, what="learned-route benchmark")

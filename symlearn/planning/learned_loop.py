@@ -52,6 +52,10 @@ class LearnedLoopConfig:
     max_steps_factor: float = 2.0  # at most factor x the generator's plan length + 2 actions are executed
     goal_relations: tuple[str, ...] = ()  # object-object heads ("r1", ...) the goal keeps beside `at`
     drop: tuple[str, ...] = ()  # the ablation: predicates ("r1", "nothing-r1", ...) removed from domain and states
+    # the ablation of what decides where an action applies: predicates removed from every operator's precondition
+    # alone (effects, states and goals keep them, so a goal can still be stated and reached); a location parameter
+    # no precondition names then ranges over every cell, and the robot picks where the plan says
+    drop_preconditions: tuple[str, ...] = ()
     # when the planner proves the whole goal unreachable in the learned domain (a goal scene's relation read wrong
     # can ask for two objects on one) or runs out of RELAX_SHARE of the time limit, plan for its `at` atoms alone
     # (relaxed_goal) in the time left
@@ -202,12 +206,14 @@ def step_action(step: str, ops: dict[str, Operator]) -> int:
     return Action(int(loc.match(pick).group(1)), int(loc.match(release).group(1))).id
 
 
-def without(ops: Sequence[Operator], drop: Sequence[str]) -> list[Operator]:
-    """The operators with every atom of the predicates in `drop` removed (the load-bearing ablation)."""
-    if not drop:
+def without(ops: Sequence[Operator], drop: Sequence[str], preconditions: Sequence[str] = ()) -> list[Operator]:
+    """The operators with every atom of the predicates in `drop` removed, and the atoms of those in `preconditions`
+    removed from their preconditions alone (the load-bearing ablations)."""
+    if not drop and not preconditions:
         return list(ops)
-    keep = lambda atoms: tuple(a for a in atoms if a[0] not in drop)  # noqa: E731
-    return [dataclasses.replace(o, precondition=keep(o.precondition), add=keep(o.add), delete=keep(o.delete))
+    keep = lambda atoms, gone=tuple(drop): tuple(a for a in atoms if a[0] not in gone)  # noqa: E731
+    pre = tuple(drop) + tuple(preconditions)
+    return [dataclasses.replace(o, precondition=keep(o.precondition, pre), add=keep(o.add), delete=keep(o.delete))
             for o in ops]
 
 
@@ -215,7 +221,7 @@ def run_learned(sim, model, blob: dict, ops: Sequence[Operator], problem: Proble
                 cfg: LearnedLoopConfig = LearnedLoopConfig(), goal: frozenset[Atom] | None = None) -> LoopResult:
     """One problem, closed loop (see the module docstring). `goal`: atoms a person wrote (objects o1..ok), in
     place of those read from the problem's goal scene; success is still the simulator's, against the goal scene."""
-    ops = without(ops, cfg.drop)
+    ops = without(ops, cfg.drop, cfg.drop_preconditions)
     domain = domain_pddl(ops)
     by_name = {o.name: o for o in ops}
     predicates = predicates_of(ops)
