@@ -12,7 +12,9 @@ relation head of a trained relational model against them over the pairs of a spl
   footprint (b's extents turned by its yaw, plus a margin).
 
 For a head k and a kind of pair (object-location, object-object), `holds_given` is P(r_k = 1 | relation)
-and `given_holds` is P(relation | r_k = 1); a head "means" a relation when both are high.
+and `given_holds` is P(relation | r_k = 1); a head "means" a relation when both are high. Each unary bit is
+scored the same way against properties of one object (UNARY_PROPERTIES): its kind, whether it spans two or more
+locations, whether it rests on an object, whether one rests on it, whether it stands in the far row.
 """
 from __future__ import annotations
 
@@ -79,6 +81,29 @@ def oracle_on(pose: np.ndarray, types: np.ndarray, mask: np.ndarray) -> np.ndarr
     return touch & over & pair
 
 
+UNARY_PROPERTIES = ("stick", "spans", "on_object", "supports", "far_row")
+
+
+def unary_properties(pose: np.ndarray, types: np.ndarray, mask: np.ndarray) -> dict[str, np.ndarray]:
+    """(N, K) bool per property of UNARY_PROPERTIES, from the true poses (analysis only)."""
+    on = oracle_on(pose, types, mask)
+    covers = oracle_covers(pose, types, mask)
+    return {"stick": (types == ObjectType.STICK) & mask, "spans": (covers.sum(-1) >= 2) & mask,
+            "on_object": on.any(2) & mask, "supports": on.any(1) & mask,
+            "far_row": (pose[..., 0] > 0.65) & mask}
+
+
+@torch.no_grad()
+def unary_bits(model, split: EntitySplit, windows: torch.Tensor, batch_size: int = 256) -> np.ndarray:
+    """(N, K, bits) bool: the model's unary bits on a split's pre-states (evaluation: thresholded)."""
+    out = []
+    for a in range(0, len(split), batch_size):
+        idx = torch.arange(a, min(a + batch_size, len(split)))
+        obj, mask, loc, _ = split.inputs(idx, windows)
+        out.append(model.symbols(obj, mask, loc)[0].bool().numpy())
+    return np.concatenate(out)
+
+
 @torch.no_grad()
 def relation_bits(model, split: EntitySplit, windows: torch.Tensor, batch_size: int = 256) -> np.ndarray:
     """(N, R, E, E) bool: the model's relational bits on a split's pre-states (evaluation: thresholded)."""
@@ -127,7 +152,11 @@ def probe(run_dir: Path, roots: Sequence[Path], split: str = "val") -> dict:
                       "location_object": {"at": score(lo, at, obj_loc_valid)},
                       "object_object": {"on": score(oo, on, obj_obj_valid),
                                         "under": score(oo, on.transpose(0, 2, 1), obj_obj_valid)}})
-    return {"run": str(run_dir), "data": [str(r) for r in roots], "split": split, "heads": heads}
+    codes = unary_bits(model, data, torch.from_numpy(windows_np.astype(np.float32)))
+    props = unary_properties(pose, types, mask)
+    unary = [{"bit": b, **{name: score(codes[..., b], truth, mask) for name, truth in props.items()}}
+             for b in range(codes.shape[-1])]
+    return {"run": str(run_dir), "data": [str(r) for r in roots], "split": split, "heads": heads, "unary": unary}
 
 
 def format_probe(res: dict) -> str:
@@ -139,4 +168,9 @@ def format_probe(res: dict) -> str:
                 f = lambda v: "-" if v is None else f"{v:.3f}"  # noqa: E731
                 lines.append(f"{h['head']:>4}  {kind:<16} {name:<6} {f(s['holds_given']):>10} "
                              f"{f(s['given_holds']):>10} {s['rate']:>7.3f}")
+    lines.append(f"{'bit':>4}  " + " ".join(f"{p + ' P(b|p) P(p|b)':>24}" for p in UNARY_PROPERTIES))
+    for u in res.get("unary", []):
+        f = lambda v: "    -" if v is None else f"{v:.3f}"  # noqa: E731
+        lines.append(f"{'u' + str(u['bit']):>4}  " + " ".join(f"{f(u[p]['holds_given']):>17} "
+                                                             f"{f(u[p]['given_holds'])}" for p in UNARY_PROPERTIES))
     return "\n".join(lines)
