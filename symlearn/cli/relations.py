@@ -19,7 +19,7 @@ from symlearn.cli.args import (add_config_flag, config_from_file, non_negative_i
 from symlearn.outputs import folder_output
 
 # the keys of symlearn.learning.relational_training.TRAIN_PRESETS, written here so that the CLI loads without torch
-TRAIN_PRESET_NAMES = ("attention", "support", "support-post", "support-exclusive", "cover", "cover-carry")
+TRAIN_PRESET_NAMES = ("attention", "support", "support-post", "support-exclusive", "cover", "cover-carry", "effect")
 
 
 def cmd_train_relations(args: argparse.Namespace) -> int:

@@ -258,6 +258,12 @@ class RelationalDeepSym(nn.Module):
             rel[:, 1, :k, :k] = choice * pairs.to(choice.dtype)
         return codes, loc_codes, rel, logits, ent
 
+    def effect_parameters(self) -> list[nn.Parameter]:
+        """The weights of the effect predictor that reads the symbols (decode): the tokens, the message passing
+        and the decoder; no weight that computes a symbol."""
+        parts = (self.token, self.values, self.updates, self.norms, self.decoder)
+        return [p for part in parts for p in part.parameters()]
+
     def decode(self, codes: torch.Tensor, loc_codes: torch.Tensor, rel: torch.Tensor, ent: torch.Tensor,
                actions: torch.Tensor) -> torch.Tensor:
         """Effects (B, K, 3) from the symbols and the action ids (B,) alone."""

@@ -85,10 +85,19 @@ class RelationalTrainConfig:
     # cube on each end); far-stick data (pretrained/relations_carry/collect_far_stick.toml) shows it in 539 of
     # 12,000 samples, the paper's scenes in 40 (data/k15)
     exclusion_spares_carriers: bool = False
+    # fit the effect predictor alone (RelationalDeepSym.effect_parameters) on the symbols the model computes in
+    # evaluation, as the probes and the planner read them: a run started from --init whose every symbol, and so
+    # whose domain, stays what it was; the other terms shape symbols and must be 0
+    effect_only: bool = False
     seed: int = 0
 
     def __post_init__(self) -> None:
         check_bounds(self, TRAIN_BOUNDS)
+        shaping = ("grasp_weight", "ride_weight", "support_weight", "post_support_weight", "support_exclusive",
+                   "relation_sparsity", "code_stability")
+        if self.effect_only and any(getattr(self, f) for f in shaping):
+            raise ValueError(f"effect_only trains no symbol: {', '.join(f for f in shaping if getattr(self, f))} "
+                             "must be 0")
         if (self.support_weight or self.post_support_weight or self.support_exclusive) and not self.model.support:
             raise ValueError("support_weight, post_support_weight and support_exclusive need a model with a rests-on "
                              "head (model.support)")
@@ -134,6 +143,10 @@ TRAIN_PRESETS["cover"] = dataclasses.replace(TRAIN_PRESETS["support-exclusive"],
                                              model=RelationalConfig.from_preset("cover"))
 # as cover, for data with carrying (far-stick scenes): an object seen to carry two riders may hold both
 TRAIN_PRESETS["cover-carry"] = dataclasses.replace(TRAIN_PRESETS["cover"], exclusion_spares_carriers=True)
+# a cover model's effect predictor fit alone on its evaluation symbols (--init: the symbols and the domain stay)
+TRAIN_PRESETS["effect"] = dataclasses.replace(
+    TRAIN_PRESETS["cover-carry"], effect_only=True, grasp_weight=0.0, support_weight=0.0, post_support_weight=0.0,
+    support_exclusive=0.0, relation_sparsity=0.0, exclusion_spares_carriers=False)
 
 
 @dataclass
@@ -234,6 +247,41 @@ def epoch_order(split: EntitySplit, repeat: int, gen: torch.Generator) -> torch.
     return rows[torch.randperm(len(rows), generator=gen)]
 
 
+@dataclass
+class FrozenSymbols:
+    """A split's symbols as the model computes them in evaluation (0/1, stored as bool), for effect_only."""
+
+    codes: torch.Tensor  # (N, K, bits)
+    loc_codes: torch.Tensor  # (N, L, location_bits)
+    rel: torch.Tensor  # (N, R, E, E)
+    ent: torch.Tensor  # (N, E)
+
+
+@torch.no_grad()
+def frozen_symbols(model: RelationalDeepSym, split: EntitySplit, windows: torch.Tensor,
+                   batch_size: int = 256) -> FrozenSymbols:
+    """Every row's evaluation-mode symbols, computed once: an effect_only epoch then runs the decoder alone."""
+    model.eval()
+    parts: list[tuple] = []
+    for a in range(0, len(split), batch_size):
+        idx = torch.arange(a, min(a + batch_size, len(split)))
+        obj, mask, loc, _ = split.inputs(idx, windows)
+        codes, loc_codes, rel, _, ent = model.symbols(obj, mask, loc)
+        for t in (codes, loc_codes, rel):
+            if not bool(((t == 0) | (t == 1)).all()):
+                raise ValueError("the model's evaluation symbols are not 0/1; effect_only needs hard symbols")
+        parts.append((codes.bool(), loc_codes.bool(), rel.bool(), ent.bool()))
+    return FrozenSymbols(*(torch.cat(p) for p in zip(*parts)))
+
+
+def effect_loss(model: RelationalDeepSym, sym: FrozenSymbols, split: EntitySplit, idx: torch.Tensor) -> torch.Tensor:
+    """The effect error of rows idx predicted from their frozen symbols (effect_only)."""
+    dt = next(model.decoder.parameters()).dtype
+    pred = model.decode(sym.codes[idx].to(dt), sym.loc_codes[idx].to(dt), sym.rel[idx].to(dt), sym.ent[idx],
+                        split.action[idx])
+    return masked_mse(pred, split.effect[idx], split.mask[idx])
+
+
 def carriers(held: torch.Tensor, rider: torch.Tensor) -> torch.Tensor:
     """(B, K) bool: the held object of each scene where two or more objects rode on it."""
     k = rider.shape[1]
@@ -302,11 +350,18 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
         if init_model != cfg.model:
             raise ValueError(f"{Path(init) / CHECKPOINT} holds another architecture than --preset asks for")
         inputs.append({"init": str(Path(init) / CHECKPOINT), "sha256": sha256_file(Path(init) / CHECKPOINT)})
+    if cfg.effect_only and init is None:
+        raise ValueError("effect_only fits the effect predictor of a trained model; give --init RUN")
     run_dir.mkdir(parents=True, exist_ok=True)
     last = run_dir / LAST
     torch.manual_seed(cfg.seed)
     model = RelationalDeepSym(cfg.model)
-    opt = torch.optim.AdamW(model.parameters(), lr=cfg.lr, weight_decay=0.0)
+    trained = model.effect_parameters() if cfg.effect_only else list(model.parameters())
+    if cfg.effect_only:  # nothing that computes a symbol is trained
+        ids = {id(p) for p in trained}
+        for p in model.parameters():
+            p.requires_grad_(id(p) in ids)
+    opt = torch.optim.AdamW(trained, lr=cfg.lr, weight_decay=0.0)
     start, best, history = 0, math.inf, []
     if last.exists():
         blob = guarded_blob(last, RELATIONAL_MODEL)
@@ -322,18 +377,19 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
     va, _, _ = entity_split(val_data, windows_np, k, mean, std)
     del train_data, val_data  # the padded tensors hold what training reads
     windows = torch.from_numpy(windows_np.astype(np.float32))
+    sym = frozen_symbols(model, tr, windows) if cfg.effect_only else None
     for epoch in range(start, cfg.epochs):
         gen = torch.Generator().manual_seed(cfg.seed * 100_003 + epoch)
         lr = cfg.lr * (cfg.lr_min_ratio + (1 - cfg.lr_min_ratio) * 0.5 * (1 + math.cos(math.pi * epoch / cfg.epochs)))
         for g in opt.param_groups:
             g["lr"] = lr
-        model.train()
+        model.train(not cfg.effect_only)  # effect_only: the symbols' batch norms keep their statistics
         model.soft_at = epoch < cfg.soft_at_epochs
         t0, total, seen = time.time(), 0.0, 0
         order = epoch_order(tr, cfg.rider_scene_repeat, gen)
         for a in range(0, len(order), cfg.batch_size):
             idx = order[a:a + cfg.batch_size]
-            loss = batch_loss(model, cfg, tr, idx, windows, gen)
+            loss = effect_loss(model, sym, tr, idx) if sym is not None else batch_loss(model, cfg, tr, idx, windows, gen)
             opt.zero_grad(set_to_none=True)
             loss.backward()
             opt.step()
