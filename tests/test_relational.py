@@ -11,7 +11,7 @@ import torch
 from symlearn.learning.carrying import CARRY_PROBES, judge
 from symlearn.learning.entities import location_crops, location_windows, project_to_pixels
 from symlearn.learning.relational import RelationalConfig, RelationalDeepSym
-from symlearn.learning.relation_probe import oracle_at, oracle_on
+from symlearn.learning.relation_probe import oracle_at, oracle_on, unary_properties
 from symlearn.sim.camera import CameraConfig
 from symlearn.world import LOCATIONS, ObjectType
 
@@ -111,6 +111,9 @@ def test_oracle_relations_of_the_probe_read_a_stack_and_a_rider(sim):
     at = oracle_at(pose, mask)[0]
     assert at[0].tolist() == [i == 1 for i in range(6)]
     assert at[1, 0] and at[2, 0]
+    props = {name: v[0].tolist() for name, v in unary_properties(pose, types, mask).items()}
+    assert props == {"stick": [True, False, False], "spans": [True, False, False], "on_object": [False, True, True],
+                     "supports": [True, True, False], "far_row": [True, True, True]}
 
 
 def test_carrying_verdicts():
@@ -154,6 +157,32 @@ def test_train_relations_trains_resumes_and_refuses_other_settings(tiny_data, tm
     assert rc == 2 and "other settings" in capsys.readouterr().err
     rc, text = cli("train-relations", "--data", tmp_path / "nowhere", "--out", tmp_path / "r2", "--quiet")
     assert rc == 2 and "not a data set folder" in capsys.readouterr().err and not (tmp_path / "r2").exists()
+
+
+def test_an_effect_only_run_fits_the_decoder_and_leaves_every_symbol_weight_as_it_was(tiny_data, tmp_path, capsys):
+    from symlearn.learning.relational_training import RelationalTrainConfig
+
+    base = tmp_path / "cover"
+    rc, text = cli("train-relations", "--preset", "cover", "--data", tiny_data.path, "--out", base, "--epochs", "1",
+                   "--threads", "1", "--quiet")
+    assert rc == 0, text
+    out = tmp_path / "effect"
+    rc, text = cli("train-relations", "--preset", "effect", "--init", base, "--data", tiny_data.path, "--out", out,
+                   "--epochs", "2", "--threads", "1", "--quiet")
+    assert rc == 0, text
+    before = torch.load(base / "relations.pt", map_location="cpu", weights_only=True)
+    after = torch.load(out / "relations_last.pt", map_location="cpu", weights_only=True)
+    effect = ("token.", "values.", "updates.", "norms.", "decoder.")
+    changed = {n for n, w in before["model"].items() if not torch.equal(w, after["model"][n])}
+    assert changed and all(n.startswith(effect) for n in changed), sorted(changed)
+    # batch norm statistics too: the symbols a planner reads are computed by the same weights
+    assert all(torch.equal(before["model"][n], after["model"][n]) for n in before["model"] if "running" in n)
+    # no effect-only run without a model to start from, none that also shapes symbols
+    rc, text = cli("train-relations", "--preset", "effect", "--data", tiny_data.path, "--out", tmp_path / "e2",
+                   "--epochs", "1", "--threads", "1", "--quiet")
+    assert rc == 2 and "give --init RUN" in capsys.readouterr().err and not (tmp_path / "e2").exists()
+    with pytest.raises(ValueError, match="effect_only trains no symbol: grasp_weight must be 0"):
+        RelationalTrainConfig.from_preset("effect", grasp_weight=1.0)
 
 
 def test_the_grasp_loss_pulls_the_held_object_to_the_pick_location_only():
@@ -370,6 +399,8 @@ def test_benchmark_learned_reads_its_loop_settings_from_the_file_and_the_flags_w
                             "--planner", "fd-lama-first"))
     assert (cfg.drop, cfg.goal_relations, cfg.relax_unreachable, cfg.planner, cfg.timeout_s, cfg.shorten_s) == (
         ("on", "clear", "on-table"), ("on",), True, "fd-lama-first", 10.0, 2.0)
+    cfg = loop_config(parse("--config", "pretrained/relations_carry/drop_preconditions.toml"))
+    assert (cfg.drop, cfg.drop_preconditions) == ((), ("at", "on", "clear", "on-table", "empty"))
     loop = tmp_path / "loop.toml"
     loop.write_text('[learned_loop]\nunary = "first"\nshorten_s = 0\ntimeout_s = 5\nplanner = "fd-lama-first"\n')
     cfg = loop_config(parse("--config", loop, "--timeout", "3"))  # the flag wins over the file's timeout_s
@@ -544,6 +575,22 @@ def test_a_tower_written_by_hand_for_the_rests_on_domain_is_solved_by_stock_plan
     assert len(plans["fd-lmcut"].steps) == 5 and all(len(r.steps) >= 5 for r in plans.values())
     up = solve_pddl(domain, problem, "fast-downward", 60.0)
     assert up.status.name == "SOLVED" and len(up.steps) >= 5, up.message  # UP's validator accepted it
+
+
+def test_the_tower_docs_domain_md_writes_for_the_learned_domain_is_solved_as_it_says():
+    # docs/DOMAIN.md, "writing a problem by hand": its problem text, read from the file, on the shipped carry domain
+    import re
+
+    from search.stock_planners import solve_texts
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "DOMAIN.md").read_text()
+    problem = re.search(r"\(define \(problem tower4\).*?\n```", doc, re.S).group(0)[:-4]
+    domain = (SHIPPED_CARRY / "learned" / "domain.pddl").read_text()
+    for planner in ("fd-lama-first", "fd-lmcut"):
+        res = solve_texts(domain, problem, planner, 60.0)
+        assert res.status.name == "SOLVED", (planner, res.message)
+        assert [step.strip("()").split()[0] for step in res.steps] == ["move-0", "move-1", "move-1", "move-1"]
+        assert res.steps[0].strip("()").split()[1:] == ["l0", "a", "l5"]
 
 
 @pytest.mark.parametrize("run", ["relations_on", "relations_cover", "relations_carry"])
