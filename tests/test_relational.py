@@ -775,6 +775,32 @@ def test_the_carry_model_predicts_table_one_and_its_variants(sim):
             assert all(not o["moved"] and o["right"] for o in r["objects"][1:])  # no false rider
 
 
+SHIPPED_CARRY_EFFECT = SHIPPED_CARRY.parent / "relations_carry_effect"
+
+
+def test_the_refit_effect_predictor_gets_every_rider_and_reads_the_carry_models_symbols(sim):
+    # pretrained/relations_carry_effect: the carry model's effect predictor refit on its evaluation symbols. Every
+    # weight that computes a symbol is the carry model's, so its domain is too; the probes all come out right
+    from symlearn.learning.carrying import run_probes
+    from symlearn.learning.relational_training import load_relational
+
+    model, blob = load_relational(SHIPPED_CARRY_EFFECT)
+    carry, _ = load_relational(SHIPPED_CARRY)
+    effect = {n for n, p in model.named_parameters() if any(p is q for q in model.effect_parameters())}
+    refit, kept = model.state_dict(), carry.state_dict()
+    assert {n for n in refit if not torch.equal(refit[n], kept[n])} <= effect and any(
+        not torch.equal(refit[n], kept[n]) for n in effect)
+    for name in ("operators.json", "domain.pddl"):
+        assert (SHIPPED_CARRY_EFFECT / "learned" / name).read_bytes() == (SHIPPED_CARRY / "learned" / name).read_bytes()
+    res = run_probes(model, blob)
+    assert (res["table1_right"], res["all_right"], res["riders_right"]) == ("9/9", "31/31", "12/12")
+    stacked = next(r for r in res["probes"] if r["name"] == "stacked_on_end")
+    assert all(o["moved"] and o["miss_mm"] < 50 for o in stacked["objects"])
+    for r in res["probes"]:
+        if r["name"].startswith("stack_beside"):
+            assert all(not o["moved"] for o in r["objects"][1:])  # no false rider
+
+
 def test_a_stock_planner_carries_a_stick_with_its_rider_and_the_simulator_builds_it(sim, tmp_path, capsys):
     # the goal: the far-row stick with a cube on its end, both in the near row. Stock lama-first's plan on the
     # exported problem is one action of a learned carrying operator (it moves two items and keeps (on c s)),
