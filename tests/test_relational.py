@@ -415,6 +415,13 @@ def test_benchmark_learned_reads_its_loop_settings_from_the_file_and_the_flags_w
         err = capsys.readouterr().err
         assert rc == 2 and said in err and str(loop) in err and len(err.strip().splitlines()) == 1, err
         assert not (tmp_path / "b.json").exists()
+    # an ablation of a predicate the domain lacks would change nothing: refused, naming the domain's file
+    loop.write_text('[learned_loop]\ndrop_preconditions = ["at", "bogus"]\n')
+    rc, _ = cli("benchmark-learned", "--run", SHIPPED_CARRY, "--problems", tmp_path, "--out", tmp_path / "b.json",
+                "--config", loop)
+    err = capsys.readouterr().err
+    assert rc == 2 and "drop_preconditions names 'bogus'" in err and "relations_carry/learned/operators.json" in err, err
+    assert len(err.strip().splitlines()) == 1 and not (tmp_path / "b.json").exists()
 
 
 def _support_model() -> RelationalDeepSym:

@@ -9,9 +9,9 @@ from pathlib import Path
 
 from pddl_export.bounded_json import read_json_file
 from pddl_export.files import atomic_write_text
-from symlearn.export.learned_export import load_operators, run_hashes
+from symlearn.export.learned_export import load_operators, operators_path, run_hashes
 from symlearn.learning.relational_training import load_relational
-from symlearn.planning.learned_loop import LearnedLoopConfig, LoopResult, run_learned, summarize
+from symlearn.planning.learned_loop import LearnedLoopConfig, LoopResult, check_ablation, run_learned, summarize
 from symlearn.problems.problem import load_problems
 from symlearn.provenance import versions
 
@@ -23,6 +23,7 @@ def benchmark_learned(run_dir: Path, problems_dir: Path, out: Path,
     from symlearn.sim.simulator import TabletopSimulator
 
     ops = load_operators(run_dir)
+    check_ablation(cfg, ops, str(operators_path(run_dir)))
     model, blob = load_relational(Path(run_dir))
     settings = {"run": str(run_dir), **run_hashes(run_dir), "problems": str(problems_dir),
                 "config": {k: list(v) if isinstance(v, tuple) else v for k, v in cfg.__dict__.items()}}

@@ -217,6 +217,17 @@ def without(ops: Sequence[Operator], drop: Sequence[str], preconditions: Sequenc
             for o in ops]
 
 
+def check_ablation(cfg: LearnedLoopConfig, ops: Sequence[Operator], where: str) -> None:
+    """Refuse (ValueError, one line) a predicate in cfg.drop or cfg.drop_preconditions that the domain of `where`
+    does not have: an ablation of a name it lacks would change nothing and read as a finding."""
+    have = set(predicates_of(ops))
+    for key in ("drop", "drop_preconditions"):
+        unknown = [p for p in getattr(cfg, key) if p not in have]
+        if unknown:
+            raise ValueError(f"[learned_loop] {key} names {', '.join(map(repr, unknown))}, which the domain of {where} "
+                             f"does not have; it has {', '.join(sorted(have))}")
+
+
 def run_learned(sim, model, blob: dict, ops: Sequence[Operator], problem: Problem,
                 cfg: LearnedLoopConfig = LearnedLoopConfig(), goal: frozenset[Atom] | None = None) -> LoopResult:
     """One problem, closed loop (see the module docstring). `goal`: atoms a person wrote (objects o1..ok), in
