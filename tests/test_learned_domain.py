@@ -412,3 +412,12 @@ def test_the_loop_holds_the_unary_bits_each_scene_shows_the_first_or_every_one_s
     assert held_bits("first", None, first) == first and held_bits("first", first, then) == first
     assert held_bits("seen", None, first) == first
     assert held_bits("seen", first, then) == {("u0", "o1"), ("u6", "o2"), ("u2", "o2")}
+
+
+def test_a_covered_item_holds_every_unary_bit_with_hidden_bits():
+    # LearnedLoopConfig.hidden_bits: o2 has o1 on it, o3 is under nothing; only o2 gets the domain's bits
+    from symlearn.planning.learned_loop import covered_bits
+
+    state = frozenset({("on", "o1", "o2"), ("at", "o1", "l0"), ("at", "o2", "l0"), ("at", "o3", "l1"), ("u0", "o3")})
+    assert covered_bits(state, ["u3", "u4"]) == {("u3", "o2"), ("u4", "o2")}
+    assert covered_bits(state - {("on", "o1", "o2")}, ["u3", "u4"]) == set()
