@@ -113,12 +113,15 @@ def lift(t: Transition, placed: bool = False) -> tuple[tuple, dict[str, str]]:
 
 
 def learn_operators(transitions: Iterable[Transition], min_count: int = 3, share: float = 1.0,
-                    max_objects: int = 4, placed: bool = False) -> list[Operator]:
+                    max_objects: int = 4, placed: bool = False, multi_min_count: int = 0) -> list[Operator]:
     """Operators over the transitions' atoms, most supported first (see the module docstring). A precondition
     atom must hold in at least `share` of its group's pre-states (1: in all); an effect naming more than
     `max_objects` objects is dropped (it grounds into too many actions to be worth its rare use). With `placed`,
     an effect naming another location is grouped per place of the action (lift), and its operator binds its
-    location variables there: `(= ?to l1)` in its precondition."""
+    location variables there: `(= ?to l1)` in its precondition. A group whose effect moves three or more items (a
+    stick and two riders) needs `multi_min_count` transitions where that is set and below min_count: such scenes are
+    rare, and each group of them splits further by what the riders read. The groups are named in order of size,
+    so a rarer group never renames a common one."""
     groups: dict[tuple, list[frozenset[Atom]]] = defaultdict(list)
     for t in transitions:
         if not any(changes(t)):
@@ -127,9 +130,11 @@ def learn_operators(transitions: Iterable[Transition], min_count: int = 3, share
         groups[key].append(frozenset(x for x in (_lift(a, names) for a in t.pre) if x is not None))
     ops = []
     for key, pres in sorted(groups.items(), key=lambda kv: -len(kv[1])):
-        if len(pres) < min_count:
-            continue
         loc_vars, add, delete, where = key
+        moved = {a[1] for a in add if a[0] == "at"} & {a[1] for a in delete if a[0] == "at"}
+        need = min(min_count, multi_min_count) if multi_min_count and len(moved) >= 3 else min_count
+        if len(pres) < need:
+            continue
         if len({v for a in add + delete for v in a[1:] if v.startswith("?o")}) > max_objects:
             continue
         counts = Counter(a for p in pres for a in p)

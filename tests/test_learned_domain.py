@@ -421,3 +421,21 @@ def test_a_covered_item_holds_every_unary_bit_with_hidden_bits():
     state = frozenset({("on", "o1", "o2"), ("at", "o1", "l0"), ("at", "o2", "l0"), ("at", "o3", "l1"), ("u0", "o3")})
     assert covered_bits(state, ["u3", "u4"]) == {("u3", "o2"), ("u4", "o2")}
     assert covered_bits(state - {("on", "o1", "o2")}, ["u3", "u4"]) == set()
+
+
+def test_a_group_that_moves_three_items_needs_only_multi_min_count_transitions_and_renames_nothing():
+    # a stick o1 with riders o2 (over l0) and o3 (over l2) carried from l1 to l4, three times; a lone cube moved
+    # from l3 to l5 five times: with min_count 5 the carry goes, with multi_min_count 3 it stays, named after the move
+    from pddl_export.learned_domain import Transition, carried, learn_operators
+
+    carry = Transition(frozenset({("at", "o1", "l1"), ("at", "o2", "l0"), ("at", "o3", "l2"), ("on", "o2", "o1"),
+                                  ("on", "o3", "o1"), ("empty", "l4")}),
+                       frozenset({("at", "o1", "l4"), ("at", "o2", "l4"), ("at", "o3", "l4"), ("on", "o2", "o1"),
+                                  ("on", "o3", "o1"), ("empty", "l0"), ("empty", "l1"), ("empty", "l2")}), "l1", "l4")
+    move = Transition(frozenset({("at", "o1", "l3"), ("empty", "l5")}),
+                      frozenset({("at", "o1", "l5"), ("empty", "l3")}), "l3", "l5")
+    data = [carry] * 3 + [move] * 5
+    assert [o.name for o in learn_operators(data, 5, placed=True)] == ["move-0"]
+    ops = learn_operators(data, 5, placed=True, multi_min_count=3)
+    assert [(o.name, o.count, len(carried(o))) for o in ops] == [("move-0", 5, 1), ("move-1", 3, 3)]
+    assert learn_operators(data, 5, placed=True, multi_min_count=4)[1:] == []  # 3 transitions, 4 needed

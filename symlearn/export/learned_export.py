@@ -60,12 +60,16 @@ class LearnedExportConfig:
     seed: int = 0
     placed: bool = False  # an effect naming a location besides the action's two gets an operator per place (lift)
     by_place: bool = False
+    # a group that moves three or more items at once (a stick and two riders) needs this many transitions (0:
+    # min_count): far-stick data show 16 for the largest, under 20 (pretrained/relations_carry)
+    multi_min_count: int = 0
 
     def __post_init__(self) -> None:
         check_bounds(self, {"min_count": Bound(1, 2**62, integer=True), "share": Bound(0.0, 1.0, lo_open=True),
                             "max_objects": Bound(1, 8, integer=True), "min_precision": Bound(0.0, 1.0),
                             "slack": Bound(-1.0, 1.0), "confidence_z": Bound(0.0, 10.0),
-                            "sample": Bound(1, 2**31, integer=True), "seed": Bound(0, 2**63 - 1, integer=True)})
+                            "sample": Bound(1, 2**31, integer=True), "seed": Bound(0, 2**63 - 1, integer=True),
+                            "multi_min_count": Bound(0, 2**62, integer=True)})
 
     @staticmethod
     def from_preset(name: str, **overrides) -> "LearnedExportConfig":
@@ -84,6 +88,8 @@ EXPORT_PRESETS = {
 EXPORT_PRESETS["placed"] = dataclasses.replace(EXPORT_PRESETS["precise"], placed=True)
 # as placed, each operator for one place judged on the transitions at that place (LearnedExportConfig.by_place)
 EXPORT_PRESETS["carry"] = dataclasses.replace(EXPORT_PRESETS["placed"], by_place=True)
+# as carry, a stick carrying two riders from 10 transitions (LearnedExportConfig.multi_min_count); not shipped
+EXPORT_PRESETS["carry-two"] = dataclasses.replace(EXPORT_PRESETS["carry"], multi_min_count=10)
 
 
 def wilson_lower(hits: int, n: int, z: float) -> float:
@@ -124,7 +130,7 @@ def judged_on(op: Operator, placed: Sequence[tuple[dict[str, str], Transition]],
 
 def find_operators(transitions: Sequence[Transition], cfg: LearnedExportConfig) -> tuple[list[Operator], list[dict]]:
     """The operators of `transitions` (see LearnedExportConfig) and, per operator found, what became of it."""
-    ops = learn_operators(transitions, cfg.min_count, cfg.share, cfg.max_objects, cfg.placed)
+    ops = learn_operators(transitions, cfg.min_count, cfg.share, cfg.max_objects, cfg.placed, cfg.multi_min_count)
     shared = list(transitions)
     if len(shared) > cfg.sample:
         shared = random.Random(cfg.seed).sample(shared, cfg.sample)
