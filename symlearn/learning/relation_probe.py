@@ -94,25 +94,18 @@ def unary_properties(pose: np.ndarray, types: np.ndarray, mask: np.ndarray) -> d
 
 
 @torch.no_grad()
-def unary_bits(model, split: EntitySplit, windows: torch.Tensor, batch_size: int = 256) -> np.ndarray:
-    """(N, K, bits) bool: the model's unary bits on a split's pre-states (evaluation: thresholded)."""
-    out = []
+def symbol_bits(model, split: EntitySplit, windows: torch.Tensor,
+                batch_size: int = 256) -> tuple[np.ndarray, np.ndarray]:
+    """The model's bits on a split's pre-states (evaluation: thresholded), from one pass: unary (N, K, bits) and
+    relational (N, R, E, E), bool."""
+    codes, rels = [], []
     for a in range(0, len(split), batch_size):
         idx = torch.arange(a, min(a + batch_size, len(split)))
         obj, mask, loc, _ = split.inputs(idx, windows)
-        out.append(model.symbols(obj, mask, loc)[0].bool().numpy())
-    return np.concatenate(out)
-
-
-@torch.no_grad()
-def relation_bits(model, split: EntitySplit, windows: torch.Tensor, batch_size: int = 256) -> np.ndarray:
-    """(N, R, E, E) bool: the model's relational bits on a split's pre-states (evaluation: thresholded)."""
-    out = []
-    for a in range(0, len(split), batch_size):
-        idx = torch.arange(a, min(a + batch_size, len(split)))
-        obj, mask, loc, _ = split.inputs(idx, windows)
-        out.append(model.symbols(obj, mask, loc)[2].bool().numpy())
-    return np.concatenate(out)
+        c, _, r, _, _ = model.symbols(obj, mask, loc)
+        codes.append(c.bool().numpy())
+        rels.append(r.bool().numpy())
+    return np.concatenate(codes), np.concatenate(rels)
 
 
 def score(bits: np.ndarray, truth: np.ndarray, valid: np.ndarray) -> dict:
@@ -136,7 +129,7 @@ def probe(run_dir: Path, roots: Sequence[Path], split: str = "val") -> dict:
     types = np.concatenate([np.pad(d.obj_type, [(0, 0), (0, k - d.obj_type.shape[1])], constant_values=-1)
                             for d in datas])
     mask = data.mask.numpy()
-    bits = relation_bits(model, data, torch.from_numpy(windows_np.astype(np.float32)))
+    codes, bits = symbol_bits(model, data, torch.from_numpy(windows_np.astype(np.float32)))
     at, on = oracle_at(pose, mask), oracle_on(pose, types, mask)
     n_loc = len(LOCATIONS)
     obj_loc_valid = np.broadcast_to(mask[..., None], at.shape)
@@ -152,7 +145,6 @@ def probe(run_dir: Path, roots: Sequence[Path], split: str = "val") -> dict:
                       "location_object": {"at": score(lo, at, obj_loc_valid)},
                       "object_object": {"on": score(oo, on, obj_obj_valid),
                                         "under": score(oo, on.transpose(0, 2, 1), obj_obj_valid)}})
-    codes = unary_bits(model, data, torch.from_numpy(windows_np.astype(np.float32)))
     props = unary_properties(pose, types, mask)
     unary = [{"bit": b, **{name: score(codes[..., b], truth, mask) for name, truth in props.items()}}
              for b in range(codes.shape[-1])]
