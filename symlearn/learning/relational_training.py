@@ -356,12 +356,7 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
     last = run_dir / LAST
     torch.manual_seed(cfg.seed)
     model = RelationalDeepSym(cfg.model)
-    trained = model.effect_parameters() if cfg.effect_only else list(model.parameters())
-    if cfg.effect_only:  # nothing that computes a symbol is trained
-        ids = {id(p) for p in trained}
-        for p in model.parameters():
-            p.requires_grad_(id(p) in ids)
-    opt = torch.optim.AdamW(trained, lr=cfg.lr, weight_decay=0.0)
+    opt = _optimizer(model, cfg)
     start, best, history = 0, math.inf, []
     if last.exists():
         blob = guarded_blob(last, RELATIONAL_MODEL)
@@ -412,6 +407,18 @@ def train_relations(roots: Sequence[Path], run_dir: Path, cfg: RelationalTrainCo
                "versions": versions()}
     atomic_write_text(run_dir / "relations_metrics.json", json.dumps(metrics, indent=1))
     return metrics
+
+
+def _optimizer(model: RelationalDeepSym, cfg: RelationalTrainConfig) -> torch.optim.Optimizer:
+    """AdamW over what cfg trains: every weight, or with effect_only the effect predictor's alone (the others stop
+    taking gradients, so nothing that computes a symbol changes)."""
+    if not cfg.effect_only:
+        return torch.optim.AdamW(model.parameters(), lr=cfg.lr, weight_decay=0.0)
+    trained = model.effect_parameters()
+    ids = {id(p) for p in trained}
+    for p in model.parameters():
+        p.requires_grad_(id(p) in ids)
+    return torch.optim.AdamW(trained, lr=cfg.lr, weight_decay=0.0)
 
 
 def _save(blob: dict, path: Path) -> None:

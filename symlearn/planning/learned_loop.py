@@ -218,10 +218,13 @@ def without(ops: Sequence[Operator], drop: Sequence[str], preconditions: Sequenc
     removed from their preconditions alone (the load-bearing ablations)."""
     if not drop and not preconditions:
         return list(ops)
-    keep = lambda atoms, gone=tuple(drop): tuple(a for a in atoms if a[0] not in gone)  # noqa: E731
-    pre = tuple(drop) + tuple(preconditions)
-    return [dataclasses.replace(o, precondition=keep(o.precondition, pre), add=keep(o.add), delete=keep(o.delete))
-            for o in ops]
+    gone, gone_pre = set(drop), {*drop, *preconditions}
+
+    def keep(atoms: Sequence[Atom], names: set[str]) -> tuple[Atom, ...]:
+        return tuple(a for a in atoms if a[0] not in names)
+
+    return [dataclasses.replace(o, precondition=keep(o.precondition, gone_pre), add=keep(o.add, gone),
+                                delete=keep(o.delete, gone)) for o in ops]
 
 
 def check_ablation(cfg: LearnedLoopConfig, ops: Sequence[Operator], where: str) -> None:
