@@ -185,6 +185,27 @@ def test_an_effect_only_run_fits_the_decoder_and_leaves_every_symbol_weight_as_i
         RelationalTrainConfig.from_preset("effect", grasp_weight=1.0)
 
 
+def test_the_stable_carry_preset_adds_the_code_stability_hinge_to_the_loss_and_the_cli_lists_every_preset(
+        tiny_data, tmp_path):
+    from symlearn.cli.relations import TRAIN_PRESET_NAMES
+    from symlearn.learning.relational_training import TRAIN_PRESETS
+
+    assert sorted(TRAIN_PRESET_NAMES) == sorted(TRAIN_PRESETS)
+    base = tmp_path / "cover"
+    rc, text = cli("train-relations", "--preset", "cover", "--data", tiny_data.path, "--out", base, "--epochs", "1",
+                   "--threads", "1", "--quiet")
+    assert rc == 0, text
+    losses = {}
+    for name in ("cover-carry", "cover-carry-stable"):  # the same start, seed and batches; only the hinge differs
+        rc, text = cli("train-relations", "--preset", name, "--init", base, "--data", tiny_data.path, "--out",
+                       tmp_path / name, "--epochs", "1", "--threads", "1", "--quiet")
+        assert rc == 0, text
+        metrics = json.loads((tmp_path / name / "relations_metrics.json").read_text())
+        assert metrics["config"]["code_stability"] == (0.1 if name.endswith("stable") else 0.0)
+        losses[name] = metrics["history"][0]["train_loss"]
+    assert losses["cover-carry-stable"] > losses["cover-carry"]  # a hinge is never negative, and flips happen
+
+
 def test_the_grasp_loss_pulls_the_held_object_to_the_pick_location_only():
     from symlearn.learning.relational_losses import grasp_loss
 

@@ -19,7 +19,8 @@ from symlearn.cli.args import (add_config_flag, config_from_file, non_negative_i
 from symlearn.outputs import folder_output
 
 # the keys of symlearn.learning.relational_training.TRAIN_PRESETS, written here so that the CLI loads without torch
-TRAIN_PRESET_NAMES = ("attention", "support", "support-post", "support-exclusive", "cover", "cover-carry", "effect")
+TRAIN_PRESET_NAMES = ("attention", "support", "support-post", "support-exclusive", "cover", "cover-carry",
+                      "cover-carry-stable", "effect")
 
 
 def cmd_train_relations(args: argparse.Namespace) -> int:
@@ -131,7 +132,8 @@ def add_relations_commands(sub) -> None:
                    help="attention: three free object-object heads; support: one rests-on head; support-post: "
                         "and its reading after the action; support-exclusive: and one object on each "
                         "cover: and at(o, l) for every cell whose pick lifts o; cover-carry: and an object seen "
-                        "carrying two riders may hold both (docs/RELATIONS.md; default attention)")
+                        "carrying two riders may hold both; cover-carry-stable: and unary codes kept across "
+                        "the action (docs/RELATIONS.md; default attention)")
     t.add_argument("--epochs", type=positive_int, help="default 30")
     t.add_argument("--init", help="start a new run from the weights of this run's relations.pt (same preset)")
     t.add_argument("--seed", type=non_negative_int, help="default 0")
