@@ -358,7 +358,7 @@ def _candidates(value) -> list:
     if isinstance(value, float):
         return [value * 0.5, value * 2, value + 0.01, 0.5, 0.1, 1.0]
     if isinstance(value, str):
-        return ["independent", "all", "network", "far-stick", "first", "fd-lama-first"]
+        return ["independent", "all", "network", "far-stick", "first", "fd-lama-first", "off"]
     if value == ():  # a list of names, empty by default ([learned_loop] goal_relations, drop)
         return [("on",)]
     if isinstance(value, tuple):

@@ -439,3 +439,80 @@ def test_a_group_that_moves_three_items_needs_only_multi_min_count_transitions_a
     ops = learn_operators(data, 5, placed=True, multi_min_count=3)
     assert [(o.name, o.count, len(carried(o))) for o in ops] == [("move-0", 5, 1), ("move-1", 3, 3)]
     assert learn_operators(data, 5, placed=True, multi_min_count=4)[1:] == []  # 3 transitions, 4 needed
+
+
+def test_hidden_bits_unsolvable_plans_again_with_the_covered_items_bits_only_where_the_goal_was_proved_unreachable():
+    # lifting o1 off o2 reads (u4 ?o2); o2, covered by o1, was read without it: the state as read proves the goal
+    # unreachable, and "unsolvable" plans again with o2 holding every bit; where the bit was read, one call does
+    from pddl_export.learned_domain import Operator
+    from symlearn.planning.learned_loop import LearnedLoopConfig, LoopResult, _plan
+
+    off = Operator("move-2", (("?from", "location"), ("?o1", "item"), ("?o2", "item"), ("?to", "location")),
+                   (("at", "?o1", "?from"), ("on", "?o1", "?o2"), ("clear", "?o1"), ("empty", "?to"), ("u4", "?o2")),
+                   (("at", "?o1", "?to"), ("clear", "?o2"), ("on-table", "?o1")),
+                   (("at", "?o1", "?from"), ("on", "?o1", "?o2"), ("empty", "?to")), 10)
+    state = frozenset({("at", "o1", "l0"), ("at", "o2", "l0"), ("on", "o1", "o2"), ("clear", "o1"),
+                       ("on-table", "o2"), ("empty", "l1")})
+    goal = frozenset({("on-table", "o1")})
+
+    def plan(mode: str, now: frozenset) -> tuple[list[str], frozenset, LoopResult]:
+        res = LoopResult("p", 2, 1, False)
+        steps, planned = _plan([off], domain_pddl([off]), predicates_of([off]), ["o1", "o2"], now, goal, frozenset(),
+                               LearnedLoopConfig(planner="fd-lama-first", hidden_bits=mode), res, ["u4"])
+        return steps, planned, res
+
+    steps, planned, res = plan("off", state)
+    assert steps == [] and res.stop.startswith("planner: unsolvable") and planned == state
+    steps, planned, res = plan("unsolvable", state)
+    assert steps == ["(move-2 l0 o1 o2 l1)"] and res.hidden_calls == 1 and planned == state | {("u4", "o2")}
+    steps, planned, res = plan("unsolvable", state | {("u4", "o2")})  # read: no second call
+    assert steps == ["(move-2 l0 o1 o2 l1)"] and res.hidden_calls == 0
+    with pytest.raises(ValueError, match="hidden_bits must be off, always, unsolvable"):
+        LearnedLoopConfig(hidden_bits="true")
+
+
+def test_the_bits_a_plan_assumed_for_a_covered_item_stay_for_the_rest_of_the_episode(monkeypatch):
+    # o1 on o2 at l0; the goal: o1 at l1, o2 at l2. Moving o2 on the table reads (u5 o2), which o2, covered, was not
+    # read with, nor after o1 is lifted off: the first plan assumes it, and the loop keeps that plan's second step
+    # (the scene reads as predicted) instead of planning again from a state that proves the goal unreachable
+    from types import SimpleNamespace
+
+    from pddl_export.learned_domain import Operator
+    from symlearn.planning import learned_loop as L
+
+    off = Operator("move-2", (("?from", "location"), ("?o1", "item"), ("?o2", "item"), ("?to", "location")),
+                   (("at", "?o1", "?from"), ("on", "?o1", "?o2"), ("clear", "?o1"), ("empty", "?to")),
+                   (("at", "?o1", "?to"), ("clear", "?o2"), ("on-table", "?o1")),
+                   (("at", "?o1", "?from"), ("on", "?o1", "?o2"), ("empty", "?to")), 10)
+    move = Operator("move-0", (("?from", "location"), ("?o1", "item"), ("?to", "location")),
+                    (("at", "?o1", "?from"), ("clear", "?o1"), ("on-table", "?o1"), ("empty", "?to"), ("u5", "?o1")),
+                    (("at", "?o1", "?to"), ("empty", "?from")), (("at", "?o1", "?from"), ("empty", "?to")), 10)
+    free = {("empty", c) for c in ("l3", "l4", "l5")}
+    scenes = [frozenset({("at", "o1", "l0"), ("at", "o2", "l0"), ("on", "o1", "o2"), ("clear", "o1"),
+                         ("on-table", "o2"), ("empty", "l1"), ("empty", "l2"), *free}),
+              frozenset({("at", "o1", "l1"), ("at", "o2", "l0"), ("clear", "o1"), ("clear", "o2"), ("on-table", "o1"),
+                         ("on-table", "o2"), ("empty", "l2"), *free})]
+
+    class Sim:
+        steps: list = []
+
+        def reset(self, initial):
+            self.steps = []
+
+        def step(self, action):
+            self.steps.append(action)
+
+        def get_scene(self):
+            return len(self.steps)
+
+    monkeypatch.setattr(L, "observe_atoms", lambda sim, model, blob: scenes[len(sim.steps)])
+    monkeypatch.setattr(L, "max_goal_distance", lambda done, goal, free: 0.0 if done == 2 else 1.0)
+    problem = SimpleNamespace(name="p", initial=SimpleNamespace(k=2), optimal_length=2, generator_length=2,
+                              goal=None, free=())
+    goal = frozenset({("at", "o1", "l1"), ("at", "o2", "l2")})
+    res = L.run_learned(Sim(), None, {}, [off, move], problem, L.LearnedLoopConfig(planner="fd-lama-first"), goal)
+    assert res.success and len(res.actions) == 2 and res.hidden_calls == 1 and res.kept_steps == 1
+    assert len(res.plan_times_s) == 1  # one planner call (its second try with the covered bits) for both steps
+    off_cfg = L.LearnedLoopConfig(planner="fd-lama-first", hidden_bits="off")
+    res = L.run_learned(Sim(), None, {}, [off, move], problem, off_cfg, goal)
+    assert not res.success and res.actions == [] and res.stop.startswith("planner: unsolvable")
