@@ -81,18 +81,16 @@ class LearnedLoopConfig:
     # permits what it permits); dev, without monitor: "seen" 0.975 / 0.85 / 0.75 / 0.86, "first" 1.00 / 0.75 /
     # 0.70 / 0.86, "each" 0.975 / 0.85 / 0.70 / 0.82
     unary: str = "seen"
-    # an item read with another resting on it holds every unary bit the domain reads: its crop shows it covered, and
-    # the bits it shows then are not those it shows uncovered (the domain takes bits for properties, so an item
-    # covered now may be proved immovable); the planner assumes what it needs and the loop reads the item again
-    # once it is uncovered (with monitor, a scene not as predicted is planned again). Dev, lama-first: the carry stage
-    # of seed 1 gains (6-8 / 9-10: 0.80 / 0.60 against 0.70 / 0.55), the shipped seed 0 is mixed (walks 1-5 / 6-8 /
-    # 9-10 / structures 0.95 / 0.85 / 0.75 / 0.68 against 0.975 / 0.85 / 0.70 / 0.77) (relations_dev_hidden_bits.json).
-    # "off", "always", or "unsolvable": only where the planner proves the goal unreachable from the state as read,
-    # plan again with the covered items' bits (before relax_unreachable's `at` goal), and keep the bits such a plan
-    # assumed for the rest of the episode, as if seen; a plan found without them stays as it was. Chosen on dev,
-    # lama-first, two runs at a time: seed 1 at 6-8 / 9-10 0.80 / 0.65 against 0.70 / 0.55 (assumed bits not kept:
-    # 0.80 / 0.60); seed 0 proved no goal unreachable at 1-10 objects on dev, so it never planned again there
-    # (relations_dev_hidden_unsolvable.json)
+    # an item read with another resting on it shows other bits than uncovered, and the domain takes bits for
+    # properties, so an item covered now may be proved immovable. "always": each covered item holds every unary bit
+    # the domain reads (dev, lama-first: seed 1 at 6-8 / 9-10 0.80 / 0.60 against 0.70 / 0.55; the shipped seed 0
+    # mixed, walks 1-5 / 6-8 / 9-10 / structures 0.95 / 0.85 / 0.75 / 0.68 against 0.975 / 0.85 / 0.70 / 0.77,
+    # relations_dev_hidden_bits.json). "unsolvable": only where the planner proves the goal unreachable from the
+    # state as read, plan again with those bits (before relax_unreachable's `at` goal), and keep the bits that plan
+    # assumed for the rest of the episode, as if seen; a plan found without them stays as it was. "off": neither.
+    # Chosen on dev, lama-first, two runs at a time: seed 1 at 6-8 / 9-10 0.80 / 0.65 against 0.70 / 0.55 (assumed
+    # bits not kept: 0.80 / 0.60); seed 0 proved no goal unreachable at 1-10 objects on dev, so it never planned
+    # again there (relations_dev_hidden_unsolvable.json)
     hidden_bits: str = "unsolvable"
     # seconds of a planner call's time limit (of what the planner left) for shortening a satisficing planner's plan
     # by plan neighborhood graph search (search.plan_shortening); 0 executes the plan as it comes. An optimal
@@ -279,8 +277,9 @@ def run_learned(sim, model, blob: dict, ops: Sequence[Operator], problem: Proble
         state = frozenset(a for a in observe_atoms(sim, model, blob) if a[0] not in cfg.drop)
         bits = {a for a in state if UNARY.fullmatch(a[0])}
         kept = held_bits(cfg.unary, kept, bits)
-        state = (state - bits) | kept | assumed | (covered_bits(state, unary_names) if cfg.hidden_bits == "always"
-                                                   else set())
+        state = (state - bits) | kept | assumed
+        if cfg.hidden_bits == "always":
+            state |= covered_bits(state, unary_names)
         if goal <= state:
             res.stop = "goal believed reached"
             return res
@@ -322,20 +321,19 @@ def _as_predicted(state: frozenset[Atom], expected: frozenset[Atom]) -> bool:
 
 def _plan(ops: Sequence[Operator], domain: str, predicates: dict, objects: list[str], state: frozenset[Atom],
           goal: frozenset[Atom], located: frozenset[Atom], cfg: LearnedLoopConfig, res: LoopResult,
-          unary: Sequence[str] = ()) -> tuple[list[str], frozenset[Atom]]:
+          unary: Sequence[str]) -> tuple[list[str], frozenset[Atom]]:
     """A plan's steps from state (shortened, LearnedLoopConfig.shorten_s), its call recorded in res, and the state
     it was planned from (state, or with the covered items' bits: hidden_bits "unsolvable"); no steps, with res.stop
     saying why, where no plan came."""
     t0 = time.perf_counter()
-    first = cfg.timeout_s * (RELAX_SHARE if cfg.relax_unreachable else 1.0)
-    plan, solved = _solve(domain, predicates, objects, state, goal, cfg, first)
+    share = RELAX_SHARE if cfg.relax_unreachable else 1.0  # of the time, leaving the rest for the relaxed goal
+    plan, solved = _solve(domain, predicates, objects, state, goal, cfg, cfg.timeout_s * share)
     hidden = covered_bits(state, unary) if cfg.hidden_bits == "unsolvable" else set()
     if plan.status.name == "UNSOLVABLE" and not hidden <= state:
         res.hidden_calls += 1
         state = state | hidden
         left = max(cfg.timeout_s - (time.perf_counter() - t0), 1.0)
-        plan, solved = _solve(domain, predicates, objects, state, goal, cfg,
-                              left * (RELAX_SHARE if cfg.relax_unreachable else 1.0))
+        plan, solved = _solve(domain, predicates, objects, state, goal, cfg, left * share)
     if cfg.relax_unreachable and plan.status.name in ("UNSOLVABLE", "TIMEOUT"):
         relaxed = relaxed_goal(located, state)
         if relaxed != goal:
