@@ -24,8 +24,9 @@ planner's summary counts the reachable goals it reported unsolvable and its mean
         --planners fd-lama-first,fd-lmcut,pyperplan,up-fast-downward,up-pyperplan --out x.json
 
 With `--focus DIR` (export-learned-problems --focus writes OUT/focus), a problem with a file of the same name in DIR
-is planned as the closed loop plans: that focus problem first, in half the time limit, and where it yields no plan
-the whole problem in the time left. The row's status and plan are the last call's; its times are the two calls'
+is planned as the closed loop plans its first and last calls: that focus problem first, in half the time limit, and
+where it yields no plan the whole problem in the time left (the loop tries the focus and the tops of the other
+stacks between them: learned_loop.object_sets). The row's status and plan are the last call's; its times are the two calls'
 sums (a call that reported no Fast Downward clocks adds its whole call time), and `focus` says how the first ended.
 
     python bench/stock_fd.py --domain lp3/domain.pddl --problems lp3 --focus lp3/focus --shortest lp3/problems.json \

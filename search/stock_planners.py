@@ -304,7 +304,7 @@ def _solve_in(tmp: Path, domain: Path, problem: Path, planner: str, timeout_s: f
     if timed_out:
         where = _phase(out) if spec.tool == "fast-downward" else "parsing, grounding or search"
         return failed(planner, PlanStatus.TIMEOUT, t0, f"{planner} hit the {timeout_s:g} s time limit during "
-                      f"{where} (process group killed)", **extra)
+                      f"{where} (process group killed)", phase=where, **extra)
     killed = external_signal(code)
     if killed is not None:  # not a result: the benchmark must not record it (search.processes)
         return failed(planner, PlanStatus.ERROR, t0, f"{planner} was killed by {signal.Signals(killed).name} (not by "

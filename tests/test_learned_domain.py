@@ -305,6 +305,108 @@ def test_the_focus_problem_keeps_the_atoms_of_the_focus_objects_and_the_cells_th
     assert focus_problem(["a", "b", "c"], state, frozenset({("at", "a", "l1"), ("at", "c", "l2")})) is None  # all
 
 
+def test_a_focus_of_nearly_every_object_is_not_planned_over_alone():
+    # grounding grows with about the cube of the objects: a focus of 4 of 5 costs nearly the whole problem, and a
+    # failed focus call would leave the whole too little time, so the loop plans over the whole at once
+    from symlearn.planning.learned_loop import FOCUS_MAX, focus_problem
+
+    names = ["a", "b", "c", "d", "e"]
+    state = frozenset({("at", o, f"l{i}") for i, o in enumerate(names)} | {("clear", o) for o in names}
+                      | {("on-table", o) for o in names} | {("empty", "l5")})
+    three = frozenset({("at", "a", "l5"), ("at", "b", "l0"), ("at", "c", "l1")})  # a, b, c move
+    assert FOCUS_MAX == 0.75
+    assert focus_problem(names[:4], state - {("at", "e", "l4")}, three)[0] == ["a", "b", "c"]  # 3 of 4: kept
+    assert focus_problem(names, state, three)[0] == ["a", "b", "c"]  # 3 of 5
+    assert focus_problem(names, state, three | {("at", "d", "l2")}) is None  # 4 of 5
+
+
+def test_where_the_focus_has_no_place_to_set_an_object_down_the_tops_of_the_other_stacks_are_planned_over_next(
+        monkeypatch):
+    # o1 on o2 at l0 goes onto the table at l1, where o3 stands; every other cell holds a two-item stack. Over the
+    # focus (o1, o2, o3) o3 can only go onto o1, which then cannot move: no plan. Over the focus and the tops of the
+    # other stacks, o3 goes onto one of them and o1 to l1; the whole state is not grounded
+    from pddl_export.learned_domain import Operator, successor
+    from symlearn.planning import learned_loop
+    from symlearn.planning.learned_loop import LearnedLoopConfig, _solve, object_sets
+
+    loc, item = "location", "item"
+    put = Operator("put", (("?from", loc), ("?o1", item), ("?to", loc)),
+                   (("at", "?o1", "?from"), ("clear", "?o1"), ("on-table", "?o1"), ("empty", "?to")),
+                   (("at", "?o1", "?to"), ("empty", "?from")), (("at", "?o1", "?from"), ("empty", "?to")), 9)
+    stack = Operator("stack", (("?from", loc), ("?o1", item), ("?o2", item), ("?to", loc)),
+                     (("at", "?o1", "?from"), ("at", "?o2", "?to"), ("clear", "?o1"), ("clear", "?o2"),
+                      ("on-table", "?o1")),
+                     (("at", "?o1", "?to"), ("empty", "?from"), ("on", "?o1", "?o2")),
+                     (("at", "?o1", "?from"), ("clear", "?o2"), ("on-table", "?o1")), 9)
+    unstack = Operator("unstack", (("?from", loc), ("?o1", item), ("?o2", item), ("?to", loc)),
+                       (("at", "?o1", "?from"), ("clear", "?o1"), ("on", "?o1", "?o2"), ("empty", "?to")),
+                       (("at", "?o1", "?to"), ("clear", "?o2"), ("on-table", "?o1")),
+                       (("at", "?o1", "?from"), ("on", "?o1", "?o2"), ("empty", "?to")), 9)
+    ops = [put, stack, unstack]
+    stacks = {"l0": ["o2", "o1"], "l1": ["o3"], "l2": ["o4", "o5"], "l3": ["o6", "o7"], "l4": ["o8", "o9"],
+              "l5": ["o10", "o11"]}
+    state = set()
+    for cell, tower in stacks.items():
+        state |= {("at", o, cell) for o in tower} | {("on-table", tower[0]), ("clear", tower[-1])}
+        state |= {("on", up, down) for down, up in zip(tower, tower[1:])}
+    state, goal = frozenset(state), frozenset({("at", "o1", "l1"), ("on-table", "o1")})
+    objects = [f"o{i}" for i in range(1, 12)]
+    assert object_sets(objects, state, goal) == [{"o1", "o2", "o3"}, {"o1", "o2", "o3", "o5", "o7", "o9", "o11"}]
+    assert object_sets(objects[:7], state, goal) == [{"o1", "o2", "o3"}]  # 7 of 7 is more than FOCUS_MAX
+    assert object_sets(objects, state, frozenset({("at", "o3", "l1")})) == []  # the goal holds
+
+    calls = []
+    real = learned_loop.solve_texts
+
+    def counted(domain, problem, planner, timeout_s):
+        res = real(domain, problem, planner, timeout_s)
+        calls.append((problem.split("(:objects")[1].split("- item")[0].split(), res.status.name))
+        return res
+
+    monkeypatch.setattr(learned_loop, "solve_texts", counted)
+    plan, (names, few_state, _) = _solve(domain_pddl(ops), predicates_of(ops), objects, state, goal,
+                                         LearnedLoopConfig(planner="fd-lama-first"), 20.0)
+    assert [(len(n), status) for n, status in calls] == [(3, "UNSOLVABLE"), (7, "SOLVED")]
+    assert plan.status.name == "SOLVED" and names == ["o1", "o2", "o3", "o5", "o7", "o9", "o11"]
+    now, by_name = state, {o.name: o for o in ops}  # each step applies to the whole state; the goal holds after
+    for step in plan.steps:
+        name, *args = step.strip("()").split()
+        now = successor(by_name[name], args, now)
+        assert now is not None, step
+    assert goal <= now
+
+
+def test_a_step_makes_no_call_that_a_call_stopped_in_translation_shows_cannot_get_past_it(monkeypatch):
+    # at 9-10 objects the translator alone takes 3-6 s: a call stopped there says that as many objects or more, in
+    # no more time, would be stopped there too, and that call's time goes to the calls that can still finish
+    from search.result import PlanStatus, failed
+    from symlearn.planning import learned_loop
+    from symlearn.planning.learned_loop import LearnedLoopConfig, _call, _Grounding
+
+    made = []
+
+    def stopped(domain, problem, planner, timeout_s):
+        made.append(timeout_s)
+        phase = "search" if "searching" in problem else "translation"
+        return failed(planner, PlanStatus.TIMEOUT, 0.0, "stopped", phase=phase)
+
+    monkeypatch.setattr(learned_loop, "solve_texts", stopped)
+    cfg, grounding = LearnedLoopConfig(planner="fd-lama-first"), _Grounding()
+    assert _call("d", "p", 9, cfg, 3.0, grounding).extra["phase"] == "translation" and made == [3.0]
+    skipped = _call("d", "p", 10, cfg, 2.5, grounding)  # more objects, less time: not made
+    assert made == [3.0] and skipped.status is PlanStatus.TIMEOUT and "not called: 10 objects" in skipped.message
+    assert _call("d", "p", 9, cfg, 3.0, grounding).status is PlanStatus.TIMEOUT and made == [3.0]  # as many, as long
+    _call("d", "p", 10, cfg, 6.0, grounding)  # more time: made
+    _call("d", "p", 5, cfg, 1.0, grounding)  # fewer objects: made
+    assert made == [3.0, 6.0, 1.0]
+    searching = _Grounding()  # a call stopped in search says nothing of grounding
+    _call("d", "p searching", 9, cfg, 3.0, searching)
+    _call("d", "p", 9, cfg, 3.0, searching)
+    assert made == [3.0, 6.0, 1.0, 3.0, 3.0]
+    _call("d", "p", 9, cfg, 3.0, None)  # no record: every call made
+    assert len(made) == 6
+
+
 def test_a_plan_over_the_focus_objects_is_a_plan_of_the_whole_state(tmp_path):
     from unified_planning.engines import ValidationResultStatus
     from unified_planning.io import PDDLReader

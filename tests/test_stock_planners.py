@@ -223,6 +223,10 @@ def test_a_time_limit_reports_timeout_and_leaves_no_process_or_folder(tmp_path, 
     res = solve_files(tmp_path / "domain.pddl", tmp_path / "big.pddl", "fd-blind", timeout_s=limit)
     assert res.status is PlanStatus.TIMEOUT, (res.status, res.message)
     assert f"{limit:g} s time limit" in res.message and "\n" not in res.message
+    # where it stopped, as the closed loop reads it (a call stopped before search says its objects cannot be grounded
+    # in that time): before search at 0.05 s, after the driver's start-up at 1 s
+    assert res.extra["phase"] in (("start-up", "translation") if limit < 0.5 else ("translation", "search"))
+    assert res.message.endswith(f"during {res.extra['phase']} (process group killed)")
     assert _live_cmdlines(str(tmp_path)) == []  # the private folder holds the planners' task files
     assert _stock_folders() == set()
 

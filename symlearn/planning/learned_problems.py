@@ -19,7 +19,9 @@ what rests on them, the top of a stack at a cell the goal puts one at, and what 
 others are left out, so the cells they fill stay not `empty` and what they rest on not `clear`. Every plan of a
 focus problem is a plan of the whole problem (no operator reads or changes an object it does not name), so a
 planner may solve OUT/focus/NAME.pddl first and fall back to OUT/NAME.pddl where that finds no plan (the goal may
-need another object moved out of the way). A problem whose focus is every object or none gets no focus file.
+need another object moved out of the way). A problem whose focus is none, or more than FOCUS_MAX of its objects
+(grounding it would cost nearly the whole problem's time), gets no focus file. The loop plans over a second set
+before the whole (learned_loop.object_sets: the focus and the tops of the other stacks); the files hold the first.
 At 9-10 objects the translator grounds a whole problem in 5-6 s; the focus problem is what makes a 10 s call work:
 
     python bench/stock_fd.py --domain OUT/domain.pddl --problems OUT --focus OUT/focus --shortest OUT/problems.json \\
