@@ -26,8 +26,9 @@ planner's summary counts the reachable goals it reported unsolvable and its mean
 With `--focus DIR` (export-learned-problems --focus writes OUT/focus), a problem with a file of the same name in DIR
 is planned as the closed loop plans its first and last calls: that focus problem first, in half the time limit, and
 where it yields no plan the whole problem in the time left (the loop tries the focus and the tops of the other
-stacks between them: learned_loop.object_sets). The row's status and plan are the last call's; its times are the two calls'
-sums (a call that reported no Fast Downward clocks adds its whole call time), and `focus` says how the first ended.
+stacks between them: learned_loop.object_sets). The row's status and plan are the last call's; its times are the two
+calls' sums (a call that reported no Fast Downward clocks adds its whole call time), and `focus` says how the first
+ended.
 
     python bench/stock_fd.py --domain lp3/domain.pddl --problems lp3 --focus lp3/focus --shortest lp3/problems.json \
         --out x.json

@@ -28,7 +28,7 @@ import numpy as np
 
 from pddl_export.learned_domain import Atom, Operator, domain_pddl, predicates_of, problem_pddl, step_successor
 from search.plan_shortening import shorten_plan
-from search.result import PlanStatus, failed
+from search.result import PlanResult, PlanStatus, failed
 from search.stock_planners import STOCK_PLANNERS, solve_texts
 from symlearn.config_file import TIMEOUT_S, Bound, check_bounds
 from symlearn.problems.problem import GOAL_TOLERANCE_M, Problem, max_goal_distance
@@ -410,11 +410,11 @@ def object_sets(objects: Sequence[str], state: frozenset[Atom], goal: frozenset[
     of its size, so one of nearly every object costs what the whole does); none where the focus is empty (the goal
     holds now, and the whole problem says so at once). A plan over any set is a plan of the whole state
     (focus_objects says why)."""
-    few = focus_objects(state, goal)
-    if not few:
+    few, cap = focus_objects(state, goal), FOCUS_MAX * len(objects)
+    if not few or len(few) > cap:
         return []
     more = few | {a[1] for a in state if a[0] == "clear"}
-    return [s for i, s in enumerate((few, more)) if len(s) <= FOCUS_MAX * len(objects) and (i == 0 or s > few)]
+    return [few, more] if few < more and len(more) <= cap else [few]
 
 
 def sub_problem(objects: Sequence[str], few: set[str], state: frozenset[Atom], goal: frozenset[Atom]
@@ -436,13 +436,13 @@ class _Grounding:
     def hopeless(self, n: int, timeout_s: float) -> bool:
         return any(n >= m and timeout_s <= t for m, t in self.stopped)
 
-    def note(self, plan, n: int, timeout_s: float) -> None:
+    def note(self, plan: PlanResult, n: int, timeout_s: float) -> None:
         if plan.status.name == "TIMEOUT" and plan.extra.get("phase") in ("translation", "start-up"):
             self.stopped.append((n, timeout_s))
 
 
 def _call(domain: str, problem: str, n: int, cfg: LearnedLoopConfig, timeout_s: float,
-          grounding: _Grounding | None):
+          grounding: _Grounding | None) -> PlanResult:
     """One planner call over n objects, or, where grounding says it cannot get past the translator in timeout_s,
     a TIMEOUT result without one."""
     if grounding is None:
