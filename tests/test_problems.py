@@ -10,7 +10,8 @@ import pytest
 
 from symlearn.problems.problem import (GOAL_TOLERANCE_M, PROBLEM_VERSION, Problem, load_problem, load_problems,
                                        max_goal_distance, save_problem)
-from symlearn.problems.problem_generation import MAX_ACTION_DRAWS, ProblemConfig, _changing_action, generate_problems
+from symlearn.problems.problem_generation import (MAX_ACTION_DRAWS, ProblemConfig, _changing_action, generate_problem,
+                                                  generate_problems)
 from symlearn.sim.exploration import ExplorationConfig
 from symlearn.world import N_LOCATIONS, ObjectType, Scene, decode_action
 
@@ -115,6 +116,26 @@ def test_on_locations_redraws_a_walk_that_leaves_a_stick_off_the_locations(tmp_p
 def test_problem_config_refuses_bad_ranges(objects, length):
     with pytest.raises(ValueError, match="range"):
         ProblemConfig(objects=objects, length=length)
+
+
+def test_a_walk_that_leaves_nothing_on_a_table_location_is_drawn_again_in_another_scene(sim):
+    # seed 994, problem 9 (9-10 objects): a step of the first scene's walk, undone, leaves all nine objects between
+    # the table locations, so no action picks anything there; that scene is given up for another, where the set's
+    # generation used to stop with "no action picking an occupied location"
+    cfg = ProblemConfig(objects=(9, 10), length=(1, 4), on_locations=True)
+    pr = generate_problem(sim, np.random.default_rng([994, 9]), cfg, "problem_0009", 994)
+    assert pr.k == 9 and 1 <= len(pr.actions) <= 4
+    assert max_goal_distance(_replay(sim, pr), pr.goal) <= GOAL_TOLERANCE_M
+
+
+def test_a_set_with_fewer_problems_than_its_manifest_lists_is_refused_until_completed(tmp_path, sim):
+    out = tmp_path / "p"
+    generate_problems(out, 3, objects=(1, 2), length=(1, 2), seed=5, sim=sim)
+    (out / "problem_0002.json").unlink()  # as a generation that stopped after two problems leaves it
+    with pytest.raises(ValueError, match=r"holds 2 of the 3 problems its problems.manifest lists.*same command again"):
+        load_problems(out)
+    generate_problems(out, 3, objects=(1, 2), length=(1, 2), seed=5, sim=sim)  # the same command completes it
+    assert [pr.name for _, pr in load_problems(out)] == ["problem_0000", "problem_0001", "problem_0002"]
 
 
 def test_generate_refuses_zero_problems(tmp_path):

@@ -48,6 +48,7 @@ _KEYS = ("format", "version", "name", "seed", "spec", "initial", "actions", "goa
 MAX_ACTIONS = 100  # generator actions a problem file may list (random walks take a handful)
 MAX_TASK_CHARS = 10_000
 PROBLEM_FILE_BYTES = 4 * MiB  # a problem file is a few kilobytes
+PROBLEMS_MANIFEST = "problems.manifest"  # a generated set's settings (JSON, not *.json: never read as a problem)
 
 
 @dataclass(frozen=True)
@@ -301,14 +302,35 @@ def load_problem(path: Path) -> Problem:
 
 
 def load_problems(problems_dir: Path) -> list[tuple[Path, Problem]]:
-    """All *.json problems of a directory, in name order."""
+    """All *.json problems of a directory, in name order. A generated set that holds fewer problems than its
+    manifest lists (its `symlearn problems` stopped early) is refused: a benchmark over part of a set would report
+    figures for problems it never ran."""
     problems_dir = Path(problems_dir)
     if not problems_dir.is_dir():
         raise ValueError(f"no problem directory at {problems_dir}; run 'symlearn problems' first")
     paths = sorted(problems_dir.glob("*.json"))
     if not paths:
         raise ValueError(f"{problems_dir} holds no problem files (*.json)")
+    listed = _listed(problems_dir / PROBLEMS_MANIFEST)
+    if listed is not None and len(paths) < listed:
+        raise ValueError(f"{problems_dir} holds {len(paths)} of the {listed} problems its {PROBLEMS_MANIFEST} lists: the "
+                         f"`symlearn problems` that made it stopped early; run the same command again to complete it")
     return [(p, load_problem(p)) for p in paths]
+
+
+def _listed(manifest: Path) -> int | None:
+    """How many problems a set's manifest says it holds: its n, for a random-walk set or a structure suite (a
+    stratified set's n counts per cell); None where there is no such manifest."""
+    if not manifest.is_file():
+        return None
+    try:
+        m = read_json_file(manifest, max_bytes=MiB, what="problem manifest")
+    except ValueError:
+        return None  # a manifest that cannot be read says nothing here; the generator refuses it itself
+    if not isinstance(m, dict) or m.get("stratify"):
+        return None
+    n = m.get("n")
+    return n if isinstance(n, int) and not isinstance(n, bool) else None
 
 
 def max_goal_distance(scene: Scene, goal: Scene, free: tuple[int, ...] = ()) -> float:

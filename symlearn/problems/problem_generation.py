@@ -19,8 +19,8 @@ import numpy as np
 from pddl_export.bounded_json import JsonFileError, read_json_file
 from symlearn.folder_lock import LOCK_NAME, folder_lock
 from symlearn.problems.paths import path_under
-from symlearn.problems.problem import (GOAL_TOLERANCE_M, MAX_ACTIONS, PROBLEM_VERSION, OutOfReach, Problem,
-                                       load_problem, load_problems, save_problem)
+from symlearn.problems.problem import (GOAL_TOLERANCE_M, MAX_ACTIONS, PROBLEM_VERSION, PROBLEMS_MANIFEST, OutOfReach,
+                                       Problem, load_problem, load_problems, save_problem)
 from symlearn.problems.shortest import with_shortest
 from symlearn.provenance import atomic_write_json
 from symlearn.sim.exploration import MAX_OBJECTS, ExplorationConfig, sample_action, sample_scene_spec
@@ -75,8 +75,34 @@ def _replay(sim, initial: Scene, actions: list[int]) -> None:
         sim.step(decode_action(a))
 
 
+def _walk(sim, rng: np.random.Generator, cfg: ProblemConfig, expl: ExplorationConfig, initial: Scene,
+          length: int) -> list[int] | None:
+    """`length` actions from the scene `initial` (built and reset) that each move something, none off the table, the
+    last leaving some object farther than cfg.min_goal_distance_m from its start; or None where a step finds none in
+    cfg.max_step_tries draws, or nothing stands on a table location to pick (a scene of 9-10 objects can start so)."""
+    actions: list[int] = []
+    while len(actions) < length:
+        for _ in range(cfg.max_step_tries):
+            try:
+                action = _changing_action(rng, sim.occupied(), expl)
+            except RuntimeError:  # no draw picks an occupied location: this scene cannot be walked
+                return None
+            res = sim.step(action)
+            moved = float(np.linalg.norm(res.effect, axis=1).max()) > MOVE_EPS_M
+            last = len(actions) == length - 1
+            far = float(np.linalg.norm(res.after.positions() - initial.positions(), axis=1).max())
+            if moved and not res.off_table and (not last or far > cfg.min_goal_distance_m):
+                actions.append(res.action.id)
+                break
+            _replay(sim, initial, actions)  # undo exactly: the recorded actions from the initial poses
+        else:
+            return None
+    return actions
+
+
 def generate_problem(sim, rng: np.random.Generator, cfg: ProblemConfig, name: str, seed: int) -> Problem:
-    """One problem: build a random scene, execute L actions that each move something, keep the end as goal."""
+    """One problem: build a random scene, execute L actions that each move something, keep the end as goal; a scene
+    that cannot be walked so is replaced by another, at most cfg.max_scene_tries times."""
     expl = ExplorationConfig.with_k_range(*cfg.objects)
     expl = ExplorationConfig(k_values=expl.k_values, k_probs=expl.k_probs, pick_occupied_prob=1.0)
     for _ in range(cfg.max_scene_tries):
@@ -85,20 +111,8 @@ def generate_problem(sim, rng: np.random.Generator, cfg: ProblemConfig, name: st
         sim.build(spec)
         initial = sim.get_scene()
         sim.reset(initial)  # execution starts from a reset to these poses, so generation does too
-        actions: list[int] = []
-        while len(actions) < length:
-            for _ in range(cfg.max_step_tries):
-                res = sim.step(_changing_action(rng, sim.occupied(), expl))
-                moved = float(np.linalg.norm(res.effect, axis=1).max()) > MOVE_EPS_M
-                last = len(actions) == length - 1
-                far = float(np.linalg.norm(res.after.positions() - initial.positions(), axis=1).max())
-                if moved and not res.off_table and (not last or far > cfg.min_goal_distance_m):
-                    actions.append(res.action.id)
-                    break
-                _replay(sim, initial, actions)  # undo exactly: the recorded actions from the initial poses
-            else:
-                break
-        if len(actions) == length:
+        actions = _walk(sim, rng, cfg, expl, initial, length)
+        if actions is not None:
             try:
                 problem = Problem(name, seed, tuple(spec), initial, tuple(actions), sim.get_scene())
             except OutOfReach:  # with 6-8 objects a walk can push one past the table's reach: another scene
@@ -109,7 +123,6 @@ def generate_problem(sim, rng: np.random.Generator, cfg: ProblemConfig, name: st
     raise RuntimeError(f"problem {name}: no valid action sequence{where} after {cfg.max_scene_tries} scenes")
 
 
-PROBLEMS_MANIFEST = "problems.manifest"  # JSON (not *.json, so load_problems never reads it as a problem)
 MANIFEST_FORMAT = "symlearn-problem-set"
 
 
