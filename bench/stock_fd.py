@@ -26,7 +26,7 @@ planner's summary counts the reachable goals it reported unsolvable and its mean
 With `--focus DIR` (export-learned-problems --focus writes OUT/focus), a problem with a file of the same name in DIR
 is planned as the closed loop plans its first and last calls: that focus problem first, in half the time limit, and
 where it yields no plan the whole problem in the time left (the loop tries the focus and the tops of the other
-stacks between them: learned_loop.object_sets). The row's status and plan are the last call's; its times are the two
+stacks between them: learned_calls.object_sets). The row's status and plan are the last call's; its times are the two
 calls' sums (a call that reported no Fast Downward clocks adds its whole call time), and `focus` says how the first
 ended.
 
@@ -42,7 +42,7 @@ import sys
 from pathlib import Path
 
 DEFAULT_PLANNERS = ("fd-lama-first", "fd-lmcut")
-FOCUS_SHARE = 0.5  # of the time limit for a focus problem, as symlearn.planning.learned_loop.FOCUS_SHARE
+FOCUS_SHARE = 0.5  # of the time limit for a focus problem, as symlearn.planning.learned_calls.FOCUS_SHARE
 SUMMED = ("call_time_s", "fd_translate_time_s", "fd_total_time_s", "translate_plus_search_s")
 UP_PLANNERS = {"up-fast-downward": "fast-downward", "up-pyperplan": "pyperplan", "up-symk": "symk"}
 MAX_MANIFEST_BYTES = 16 << 20

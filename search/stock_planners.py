@@ -43,6 +43,7 @@ from typing import Callable, Sequence
 
 from search.processes import MEMORY_LIMIT_MB, external_signal, limit_memory, planner_guard, run_group, temp_dir
 from search.result import PlanResult, PlanStatus, failed
+from search.sas_task import KEEP_OPTIONS
 
 MAX_INPUT_BYTES = 64 << 20  # a domain or problem file larger than this is refused before any work
 MAX_PLAN_BYTES = 16 << 20  # a plan file larger than this is an ERROR (bounded read)
@@ -221,12 +222,14 @@ def _phase(out: str) -> str:
     return "translation" if "Running translator" in out else "start-up"
 
 
-def _command(spec: StockPlanner, domain: Path, problem: Path, tmp: Path, memory_mb: int,
-             left_s: float) -> list[str] | str:
-    """The argument list of the run, or a str saying why it cannot run.
+def _command(spec: StockPlanner, inputs: Sequence[Path], tmp: Path, memory_mb: int, left_s: float,
+             translate_options: Sequence[str] = ()) -> list[str] | str:
+    """The argument list of the run on `inputs` (a domain and a problem file, or Fast Downward's translated task:
+    one SAS+ file, searched on alone), or a str saying why it cannot run.
 
     Fast Downward's driver gets limits of its own (a memory limit, and a CPU-time limit a second past the
-    call's wall-clock limit of left_s): were this process and its watchdog both gone, it still stops.
+    call's wall-clock limit of left_s): were this process and its watchdog both gone, it still stops. Its
+    translator writes tmp/output.sas; `translate_options` are passed on to it.
     """
     if spec.tool == "fast-downward":
         driver = fast_downward_driver()
@@ -234,11 +237,15 @@ def _command(spec: StockPlanner, domain: Path, problem: Path, tmp: Path, memory_
             return "Fast Downward's driver was not found (pip install up-fast-downward)"
         limits = ["--overall-time-limit", f"{math.ceil(left_s) + 1}s"]
         limits += ["--overall-memory-limit", f"{memory_mb}M"] if memory_mb else []
-        return [sys.executable, str(driver), "--plan-file", str(tmp / "sas_plan"), "--sas-file",
-                str(tmp / "output.sas"), *limits, *spec.before_files, str(domain), str(problem), *spec.after_files]
+        sas = ["--sas-file", str(tmp / "output.sas")] if len(inputs) == 2 else []
+        after = [*spec.after_files, *(["--translate-options", *translate_options] if translate_options else [])]
+        return [sys.executable, str(driver), "--plan-file", str(tmp / "sas_plan"), *sas, *limits, *spec.before_files,
+                *map(str, inputs), *after]
+    if len(inputs) != 2 or translate_options:
+        return "pyperplan plans on PDDL files alone (no translated task, no translator options)"
     if importlib.util.find_spec("pyperplan") is None:
         return "pyperplan is not installed (pip install pyperplan)"
-    return [sys.executable, "-m", "pyperplan", "-l", "info", *spec.before_files, str(domain), str(problem)]
+    return [sys.executable, "-m", "pyperplan", "-l", "info", *spec.before_files, *map(str, inputs)]
 
 
 def _finish(planner: str, spec: StockPlanner, code: int | None, out: str, err: str, plan_name: str, tmp: Path,
@@ -281,15 +288,17 @@ def _finish(planner: str, spec: StockPlanner, code: int | None, out: str, err: s
         return failed(planner, PlanStatus.ERROR, t0, f"{planner}'s plan does not map to action ids: {e}", **extra)
 
 
-def _solve_in(tmp: Path, domain: Path, problem: Path, planner: str, timeout_s: float, t0: float,
-              action_ids: Callable[[Sequence[str]], Sequence[int]] | None, memory_mb: int) -> PlanResult:
-    """Run the planner on the two files with tmp as its working folder (inside planner_guard and temp_dir)."""
+def _solve_in(tmp: Path, inputs: Sequence[Path], planner: str, timeout_s: float, t0: float,
+              action_ids: Callable[[Sequence[str]], Sequence[int]] | None, memory_mb: int,
+              translate_options: Sequence[str] = ()) -> PlanResult:
+    """Run the planner on the input files (_command) with tmp as its working folder (inside planner_guard and
+    temp_dir)."""
     spec = STOCK_PLANNERS[planner]
-    if spec.tool == "pyperplan" and problem.parent != tmp:  # it writes PROBLEM.soln beside the problem:
-        domain = Path(shutil.copyfile(domain, tmp / "domain.pddl"))  # it works on copies in the run's folder
-        problem = Path(shutil.copyfile(problem, tmp / "problem.pddl"))
+    if spec.tool == "pyperplan" and len(inputs) == 2 and inputs[1].parent != tmp:  # it writes PROBLEM.soln beside
+        # the problem: it works on copies in the run's folder
+        inputs = [Path(shutil.copyfile(f, tmp / name)) for f, name in zip(inputs, ("domain.pddl", "problem.pddl"))]
     left = timeout_s - (time.perf_counter() - t0)
-    args = _command(spec, domain, problem, tmp, memory_mb, left)
+    args = _command(spec, inputs, tmp, memory_mb, left, translate_options)
     if isinstance(args, str):
         return failed(planner, PlanStatus.ERROR, t0, args)
     if left <= 0:
@@ -309,7 +318,7 @@ def _solve_in(tmp: Path, domain: Path, problem: Path, planner: str, timeout_s: f
     if killed is not None:  # not a result: the benchmark must not record it (search.processes)
         return failed(planner, PlanStatus.ERROR, t0, f"{planner} was killed by {signal.Signals(killed).name} (not by "
                       "its time limit)", killed_by_signal=killed, **extra)
-    plan_name = "sas_plan" if spec.tool == "fast-downward" else problem.name + ".soln"
+    plan_name = "sas_plan" if spec.tool == "fast-downward" else inputs[1].name + ".soln"
     return _finish(planner, spec, code, out, err, plan_name, tmp, action_ids, t0, extra)
 
 
@@ -343,25 +352,71 @@ def solve_files(domain: Path | str, problem: Path | str, planner: str, timeout_s
     if bad:
         return failed(planner, PlanStatus.ERROR, t0, bad)
     with planner_guard(), temp_dir("symlearn-stock-") as tmp:
-        return _solve_in(tmp, domain, problem, planner, timeout_s, t0, action_ids, memory_mb)
+        return _solve_in(tmp, [domain, problem], planner, timeout_s, t0, action_ids, memory_mb)
 
 
 def solve_texts(domain_text: str, problem_text: str, planner: str, timeout_s: float, *,
                 action_ids: Callable[[Sequence[str]], Sequence[int]] | None = None, memory_mb: int = MEMORY_LIMIT_MB) -> PlanResult:
     """solve_files on PDDL texts: they are written as domain.pddl and problem.pddl into the run's own folder."""
+    return _solve_texts(domain_text, problem_text, planner, timeout_s, action_ids, memory_mb)[0]
+
+
+def _solve_texts(domain_text: str, problem_text: str, planner: str, timeout_s: float,
+                 action_ids: Callable[[Sequence[str]], Sequence[int]] | None = None, memory_mb: int = MEMORY_LIMIT_MB,
+                 translate_options: Sequence[str] = ()) -> tuple[PlanResult, str | None]:
+    """solve_texts, and the translator's output where it finished and wrote one (else None)."""
+    t0 = time.perf_counter()
+    refused = _check(planner, timeout_s, t0)
+    if refused is not None:
+        return refused, None
+    for what, text in (("domain", domain_text), ("problem", problem_text)):
+        if not isinstance(text, str) or len(text) > MAX_INPUT_BYTES:
+            return failed(planner, PlanStatus.ERROR, t0, f"the {what} text must be a str of at most "
+                          f"{MAX_INPUT_BYTES} characters"), None
+    with planner_guard(), temp_dir("symlearn-stock-") as tmp:
+        (tmp / "domain.pddl").write_text(domain_text)
+        (tmp / "problem.pddl").write_text(problem_text)
+        res = _solve_in(tmp, [tmp / "domain.pddl", tmp / "problem.pddl"], planner, timeout_s, t0, action_ids,
+                        memory_mb, translate_options)
+        return res, _translated(tmp / "output.sas", res)
+
+
+def _translated(path: Path, res: PlanResult) -> str | None:
+    """The translator's output at path where the translator finished and wrote it, within MAX_INPUT_BYTES; else
+    None. (Where the translator found the goal unreachable or true at once it writes a trivial stand-in task of one
+    made-up variable, which search.sas_task.Translation never reuses for a goal of real atoms.)"""
+    if res.status is PlanStatus.ERROR or (res.status is PlanStatus.TIMEOUT and res.extra.get("phase") != "search"):
+        return None
+    if not path.is_file() or path.stat().st_size > MAX_INPUT_BYTES:
+        return None
+    return path.read_text()
+
+
+def solve_keeping_translation(domain_text: str, problem_text: str, planner: str, timeout_s: float, *,
+                              memory_mb: int = MEMORY_LIMIT_MB) -> tuple[PlanResult, str | None]:
+    """solve_texts with Fast Downward, its translator told to keep what a later call over the same objects from
+    another state to another goal needs (search.sas_task.KEEP_OPTIONS), and the translated task (SAS+ text) where
+    the translator finished, else None."""
+    if STOCK_PLANNERS.get(planner, StockPlanner("", ())).tool != "fast-downward":
+        return solve_texts(domain_text, problem_text, planner, timeout_s, memory_mb=memory_mb), None
+    return _solve_texts(domain_text, problem_text, planner, timeout_s, None, memory_mb, KEEP_OPTIONS)
+
+
+def solve_sas_text(sas_text: str, planner: str, timeout_s: float, *, memory_mb: int = MEMORY_LIMIT_MB) -> PlanResult:
+    """Fast Downward's search alone (the planner's configuration, STOCK_PLANNERS) on a translated task, as
+    search.sas_task.Translation.task_for writes it: the steps are ground operators as from the PDDL files."""
     t0 = time.perf_counter()
     refused = _check(planner, timeout_s, t0)
     if refused is not None:
         return refused
-    for what, text in (("domain", domain_text), ("problem", problem_text)):
-        if not isinstance(text, str) or len(text) > MAX_INPUT_BYTES:
-            return failed(planner, PlanStatus.ERROR, t0, f"the {what} text must be a str of at most "
-                          f"{MAX_INPUT_BYTES} characters")
+    if STOCK_PLANNERS[planner].tool != "fast-downward":
+        return failed(planner, PlanStatus.ERROR, t0, f"{planner} does not read a translated task (SAS+)")
+    if not isinstance(sas_text, str) or len(sas_text) > MAX_INPUT_BYTES:
+        return failed(planner, PlanStatus.ERROR, t0, f"the task text must be a str of at most {MAX_INPUT_BYTES} "
+                      "characters")
     with planner_guard(), temp_dir("symlearn-stock-") as tmp:
-        (tmp / "domain.pddl").write_text(domain_text)
-        (tmp / "problem.pddl").write_text(problem_text)
-        return _solve_in(tmp, tmp / "domain.pddl", tmp / "problem.pddl", planner, timeout_s, t0, action_ids,
-                         memory_mb)
+        (tmp / "task.sas").write_text(sas_text)
+        return _solve_in(tmp, [tmp / "task.sas"], planner, timeout_s, t0, None, memory_mb)
 
 
 _RECORD_KEYS = ("fd_translate_time_s", "fd_search_time_s", "fd_total_time_s", "fd_driver_time_s", "planner_time_s",
@@ -383,4 +438,5 @@ def call_record(result: PlanResult) -> dict:
     return rec
 
 
-__all__ = ["STOCK_PLANNERS", "StockPlanner", "call_record", "fast_downward_driver", "solve_files", "solve_texts"]
+__all__ = ["STOCK_PLANNERS", "StockPlanner", "call_record", "fast_downward_driver", "solve_files",
+           "solve_keeping_translation", "solve_sas_text", "solve_texts"]

@@ -31,6 +31,7 @@ SOURCE_DIRS = ("symlearn", "pddl_export", "search", "examples", "bench", "experi
 FOREIGN_FLAGS = {
     "--alias": "Fast Downward", "--search": "Fast Downward", "--overall-time-limit": "Fast Downward",
     "--overall-memory-limit": "Fast Downward", "--internal-plan-file": "Fast Downward",
+    "--keep-unimportant-variables": "Fast Downward's translator",
     "--junitxml": "pytest", "--no-deps": "pip",
 }
 FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9_-]*")

@@ -168,7 +168,7 @@ ZERO_OK = {"collect.exploration.stick_prob", "collect.exploration.pick_occupied_
            "collect.sim.camera.eye", "collect.sim.camera.target", "train.lr_min_ratio", "train.model.dropout",
            "train.model.depth_ref", "transition.copy_prior", "export.pddl_fidelity_cases", "lifted.min_gain",
            "execution.max_replans",
-           "execution.max_fallbacks", "learned_loop.shorten_s",
+           "execution.max_fallbacks", "learned_loop.shorten_s", "learned_loop.optimal_s",
            "problems.min_goal_distance_m"}  # ProblemConfig's checks belong to the problems' own fixes
 NEGATIVE_OK = {"collect.sim.home", "collect.sim.robot_base", "collect.sim.camera.eye", "collect.sim.camera.target",
                "collect.sim.camera.up", "train.model.depth_ref", "export.pddl_fidelity_cases",

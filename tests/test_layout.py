@@ -396,8 +396,8 @@ def test_benchmark_and_pipeline_are_split_by_job():
 LEARNED_ROUTE = ("symlearn.learning.entities", "symlearn.learning.relational", "symlearn.learning.relational_training",
                  "symlearn.learning.relational_losses",
                  "symlearn.symbolic.learned_state", "pddl_export.learned_domain", "symlearn.export.learned_export",
-                 "symlearn.planning.learned_loop", "symlearn.planning.learned_benchmark", "symlearn.learning.carrying",
-                 "symlearn.planning.learned_problems")
+                 "symlearn.planning.learned_loop", "symlearn.planning.learned_calls", "symlearn.planning.learned_benchmark",
+                 "symlearn.learning.carrying", "symlearn.planning.learned_problems")
 # The hand-written geometry it must not reach: the location fields, the scene graph over them, their codec,
 # and the lifted domain built on them (the oracle route, kept for comparison).
 GEOMETRY = ("symlearn.symbolic.locations", "pddl_export.lifted_scene", "pddl_export.location_codec",

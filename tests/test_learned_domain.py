@@ -274,7 +274,7 @@ def test_the_relaxed_goal_keeps_an_object_at_the_goal_cells_it_covers_now():
 
 
 def test_the_focus_objects_are_what_the_goal_moves_and_what_stands_in_its_way():
-    from symlearn.planning.learned_loop import focus_objects
+    from symlearn.planning.learned_calls import focus_objects
 
     state = frozenset([("at", "a", "l0"), ("at", "b", "l0"), ("on", "b", "a"), ("clear", "b"), ("on-table", "a"),
                        ("at", "c", "l3"), ("clear", "c"), ("on-table", "c"), ("at", "d", "l4"), ("clear", "d"),
@@ -293,7 +293,7 @@ def test_the_focus_objects_are_what_the_goal_moves_and_what_stands_in_its_way():
 
 
 def test_the_focus_problem_keeps_the_atoms_of_the_focus_objects_and_the_cells_the_others_fill():
-    from symlearn.planning.learned_loop import focus_problem
+    from symlearn.planning.learned_calls import focus_problem
 
     state = frozenset([("at", "a", "l0"), ("at", "b", "l0"), ("on", "b", "a"), ("clear", "b"), ("on-table", "a"),
                        ("at", "c", "l3"), ("clear", "c"), ("on-table", "c"), ("empty", "l1"), ("empty", "l2")])
@@ -308,7 +308,7 @@ def test_the_focus_problem_keeps_the_atoms_of_the_focus_objects_and_the_cells_th
 def test_a_focus_of_nearly_every_object_is_not_planned_over_alone():
     # grounding grows with about the cube of the objects: a focus of 4 of 5 costs nearly the whole problem, and a
     # failed focus call would leave the whole too little time, so the loop plans over the whole at once
-    from symlearn.planning.learned_loop import FOCUS_MAX, focus_problem
+    from symlearn.planning.learned_calls import FOCUS_MAX, focus_problem
 
     names = ["a", "b", "c", "d", "e"]
     state = frozenset({("at", o, f"l{i}") for i, o in enumerate(names)} | {("clear", o) for o in names}
@@ -326,8 +326,8 @@ def test_where_the_focus_has_no_place_to_set_an_object_down_the_tops_of_the_othe
     # focus (o1, o2, o3) o3 can only go onto o1, which then cannot move: no plan. Over the focus and the tops of the
     # other stacks, o3 goes onto one of them and o1 to l1; the whole state is not grounded
     from pddl_export.learned_domain import Operator, successor
-    from symlearn.planning import learned_loop
-    from symlearn.planning.learned_loop import LearnedLoopConfig, _solve, object_sets
+    from symlearn.planning import learned_calls
+    from symlearn.planning.learned_calls import object_sets, solve
 
     loc, item = "location", "item"
     put = Operator("put", (("?from", loc), ("?o1", item), ("?to", loc)),
@@ -356,16 +356,16 @@ def test_where_the_focus_has_no_place_to_set_an_object_down_the_tops_of_the_othe
     assert object_sets(objects, state, frozenset({("at", "o3", "l1")})) == []  # the goal holds
 
     calls = []
-    real = learned_loop.solve_texts
+    real = learned_calls.solve_texts
 
     def counted(domain, problem, planner, timeout_s):
         res = real(domain, problem, planner, timeout_s)
         calls.append((problem.split("(:objects")[1].split("- item")[0].split(), res.status.name))
         return res
 
-    monkeypatch.setattr(learned_loop, "solve_texts", counted)
-    plan, (names, few_state, _) = _solve(domain_pddl(ops), predicates_of(ops), objects, state, goal,
-                                         LearnedLoopConfig(planner="fd-lama-first"), 20.0)
+    monkeypatch.setattr(learned_calls, "solve_texts", counted)
+    plan, (names, few_state, _) = solve(domain_pddl(ops), predicates_of(ops), objects, state, goal, "fd-lama-first",
+                                        True, 20.0)
     assert [(len(n), status) for n, status in calls] == [(3, "UNSOLVABLE"), (7, "SOLVED")]
     assert plan.status.name == "SOLVED" and names == ["o1", "o2", "o3", "o5", "o7", "o9", "o11"]
     now, by_name = state, {o.name: o for o in ops}  # each step applies to the whole state; the goal holds after
@@ -380,8 +380,8 @@ def test_a_step_makes_no_call_that_a_call_stopped_in_translation_shows_cannot_ge
     # at 9-10 objects the translator alone takes 3-6 s: a call stopped there says that as many objects or more, in
     # no more time, would be stopped there too, and that call's time goes to the calls that can still finish
     from search.result import PlanStatus, failed
-    from symlearn.planning import learned_loop
-    from symlearn.planning.learned_loop import LearnedLoopConfig, _call, _Grounding
+    from symlearn.planning import learned_calls
+    from symlearn.planning.learned_calls import Grounding, call
 
     made = []
 
@@ -390,20 +390,26 @@ def test_a_step_makes_no_call_that_a_call_stopped_in_translation_shows_cannot_ge
         phase = "search" if "searching" in problem else "translation"
         return failed(planner, PlanStatus.TIMEOUT, 0.0, "stopped", phase=phase)
 
-    monkeypatch.setattr(learned_loop, "solve_texts", stopped)
-    cfg, grounding = LearnedLoopConfig(planner="fd-lama-first"), _Grounding()
-    assert _call("d", "p", 9, cfg, 3.0, grounding).extra["phase"] == "translation" and made == [3.0]
-    skipped = _call("d", "p", 10, cfg, 2.5, grounding)  # more objects, less time: not made
+    monkeypatch.setattr(learned_calls, "solve_texts", stopped)
+    grounding = Grounding()
+
+    def make(n, timeout_s, grounding, what="at"):  # a call over n objects; what="searching" is stopped in search
+        goal = frozenset({(what, "o1", "l0")})
+        return call("d", {"at": 2}, [f"o{i + 1}" for i in range(n)], frozenset(), goal, "fd-lama-first", timeout_s,
+                    grounding)
+
+    assert make(9, 3.0, grounding).extra["phase"] == "translation" and made == [3.0]
+    skipped = make(10, 2.5, grounding)  # more objects, less time: not made
     assert made == [3.0] and skipped.status is PlanStatus.TIMEOUT and "not called: 10 objects" in skipped.message
-    assert _call("d", "p", 9, cfg, 3.0, grounding).status is PlanStatus.TIMEOUT and made == [3.0]  # as many, as long
-    _call("d", "p", 10, cfg, 6.0, grounding)  # more time: made
-    _call("d", "p", 5, cfg, 1.0, grounding)  # fewer objects: made
+    assert make(9, 3.0, grounding).status is PlanStatus.TIMEOUT and made == [3.0]  # as many, as long
+    make(10, 6.0, grounding)  # more time: made
+    make(5, 1.0, grounding)  # fewer objects: made
     assert made == [3.0, 6.0, 1.0]
-    searching = _Grounding()  # a call stopped in search says nothing of grounding
-    _call("d", "p searching", 9, cfg, 3.0, searching)
-    _call("d", "p", 9, cfg, 3.0, searching)
+    searching = Grounding()  # a call stopped in search says nothing of grounding
+    make(9, 3.0, searching, "searching")
+    make(9, 3.0, searching)
     assert made == [3.0, 6.0, 1.0, 3.0, 3.0]
-    _call("d", "p", 9, cfg, 3.0, None)  # no record: every call made
+    make(9, 3.0, None)  # no record: every call made
     assert len(made) == 6
 
 
@@ -413,7 +419,7 @@ def test_a_plan_over_the_focus_objects_is_a_plan_of_the_whole_state(tmp_path):
     from unified_planning.shortcuts import PlanValidator
 
     from symlearn.export.learned_export import load_operators
-    from symlearn.planning.learned_loop import LearnedLoopConfig, _solve, focus_objects
+    from symlearn.planning.learned_calls import focus_objects, solve
 
     ops = load_operators(Path("pretrained/relations_cover"))
     # nine cubes: towers at l3, l4, l5 and one cube at l0; the goal moves the cube at l0 onto the l4 tower
@@ -426,8 +432,8 @@ def test_a_plan_over_the_focus_objects_is_a_plan_of_the_whole_state(tmp_path):
     goal = frozenset({a for a in state if a[0] == "at" and a[1] != "o9"} | {("at", "o9", "l4"), ("on", "o9", "o6")})
     assert focus_objects(state, goal) == {"o5", "o6", "o9"}  # the top at the goal cell, and what it rests on
     objects = [f"o{i}" for i in range(1, 10)]
-    cfg = LearnedLoopConfig(planner="fd-lmcut")  # optimal: the focus objects cost no action here
-    plan, solved = _solve(domain_pddl(ops), predicates_of(ops), objects, state, goal, cfg, 20.0)
+    # LM-cut, optimal: the focus objects cost no action here
+    plan, solved = solve(domain_pddl(ops), predicates_of(ops), objects, state, goal, "fd-lmcut", True, 20.0)
     assert plan.status.name == "SOLVED" and plan.steps
     # the problem it was found for: the focus objects' atoms alone
     names, few_state, few_goal = solved
@@ -440,8 +446,7 @@ def test_a_plan_over_the_focus_objects_is_a_plan_of_the_whole_state(tmp_path):
     up_plan = reader.parse_plan_string(whole, "\n".join(plan.steps))
     with PlanValidator(problem_kind=whole.kind, plan_kind=up_plan.kind) as validator:
         assert validator.validate(whole, up_plan).status == ValidationResultStatus.VALID
-    full, solved = _solve(domain_pddl(ops), predicates_of(ops), objects, state, goal,
-                          dataclasses.replace(cfg, focus=False), 20.0)
+    full, solved = solve(domain_pddl(ops), predicates_of(ops), objects, state, goal, "fd-lmcut", False, 20.0)
     assert full.status.name == "SOLVED" and len(plan.steps) == len(full.steps) and solved == (objects, state, goal)
 
 
@@ -468,7 +473,7 @@ def test_an_operator_that_moves_two_items_is_written_as_carrying():
 def test_a_plan_step_leads_where_the_domain_says_and_only_where_its_precondition_holds():
     from pddl_export.learned_domain import successor
     from symlearn.export.learned_export import load_operators
-    from symlearn.planning.learned_loop import LearnedLoopConfig, _solve
+    from symlearn.planning.learned_calls import solve
 
     ops = load_operators(Path("pretrained/relations_carry"))
     by_name = {o.name: o for o in ops}
@@ -477,8 +482,7 @@ def test_a_plan_step_leads_where_the_domain_says_and_only_where_its_precondition
                        ("on-table", "o1"), ("at", "o3", "l4"), ("clear", "o3"), ("on-table", "o3"), ("u3", "o2"),
                        ("empty", "l0"), ("empty", "l1"), ("empty", "l2"), ("empty", "l5")})
     goal = frozenset({("on", "o2", "o3"), ("at", "o1", "l0")})
-    plan, _ = _solve(domain_pddl(ops), predicates_of(ops), ["o1", "o2", "o3"], state, goal,
-                  LearnedLoopConfig(planner="fd-lmcut"), 20.0)
+    plan, _ = solve(domain_pddl(ops), predicates_of(ops), ["o1", "o2", "o3"], state, goal, "fd-lmcut", True, 20.0)
     assert plan.status.name == "SOLVED" and len(plan.steps) == 2
     now = state
     for step in plan.steps:  # each step applies where the one before led, and the goal holds after the last

@@ -389,7 +389,7 @@ def test_the_stock_fd_bench_plans_a_focus_problem_first_and_the_whole_one_where_
     import json
     import shutil
 
-    from symlearn.planning.learned_loop import FOCUS_SHARE
+    from symlearn.planning.learned_calls import FOCUS_SHARE
 
     bench, out, focus = _bench(), tmp_path / "stock.json", tmp_path / "focus"
     assert bench.FOCUS_SHARE == FOCUS_SHARE  # outside the loop as inside it

@@ -10,8 +10,8 @@ so far in the episode (LearnedLoopConfig.unary): the domain takes them for prope
 from each view. The goal is given as the problem's goal scene,
 as the seed paper gives it: the scene is placed, observed and turned into learned atoms the same way, and the
 goal keeps its `at` atoms and the atoms of the relation heads named in `goal_relations`. Each call plans first over
-the objects the goal needs, then over those and the tops of the other stacks (object_sets), so that a scene of 10
-objects need not be grounded whole.
+the objects the goal needs, then over those and the tops of the other stacks, so that a scene of 10 objects need
+not be grounded whole, and searches a translation kept from an earlier step where it can (learned_calls).
 
 Success is the simulator's: every object within the problem's tolerance of its goal position.
 """
@@ -26,25 +26,22 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
-from pddl_export.learned_domain import Atom, Operator, domain_pddl, predicates_of, problem_pddl, step_successor
+from pddl_export.learned_domain import Atom, Operator, domain_pddl, predicates_of, step_successor
 from search.plan_shortening import shorten_plan
-from search.result import PlanResult, PlanStatus, failed
-from search.stock_planners import STOCK_PLANNERS, solve_texts
+from search.stock_planners import STOCK_PLANNERS
 from symlearn.config_file import TIMEOUT_S, Bound, check_bounds
+from symlearn.planning.learned_calls import Grounding, Translations, shortest_plan, solve
 from symlearn.problems.problem import GOAL_TOLERANCE_M, Problem, max_goal_distance
 from symlearn.symbolic.learned_state import atoms_of, scene_symbols
 from symlearn.world import N_LOCATIONS, Action
 
 
-LOCATIONS = frozenset(f"l{i}" for i in range(N_LOCATIONS))  # the domain's location constants
 UNARY = re.compile(r"u\d+")  # the unary bits' predicates, (uB o)
 RELAX_SHARE = 0.6  # of a planner call's time limit for the whole goal, when relax_unreachable may plan again
-FOCUS_SHARE = 0.5  # of the time left for each of object_sets in turn, when LearnedLoopConfig.focus
-# an object set is planned over alone only where it holds at most this share of the objects: grounding grows with
-# about the cube of the objects (a three-item operator: 10,800 of 18,086 ground operators at 10 objects), so 8 of 9
-# cost nearly what all 9 do, and a failed call over them would leave the whole problem too little time to be
-# grounded (object_sets; dev figures at LearnedLoopConfig.focus)
-FOCUS_MAX = 0.75
+# with reuse_translation, the seconds of a planner call's time limit left for the relaxed goal instead: a translation
+# of the whole goal's call is kept even where its search runs out of time, and the relaxed goal's call then searches
+# the same task, which takes about 1 s at 10 objects
+RELAX_RESERVE_S = 2.0
 HIDDEN_BITS = ("off", "always", "unsolvable")  # LearnedLoopConfig.hidden_bits
 
 
@@ -110,6 +107,25 @@ class LearnedLoopConfig:
     # 9-10 / structures): 0.975 / 0.85 / 0.70 / 0.77 against 0.95 / 0.90 / 0.70 / 0.68 without, executed over the
     # shortest 1.02 / 1.12 / 1.21 / 1.00 against 1.18 / 1.25 / 1.08 / 1.06 (LM-cut with it, 2 s: the same outcomes)
     shorten_s: float = 2.0
+    # keep each translation of the episode (by the objects planned over) and search it from a later state to a later
+    # goal where it can stand for them (learned_calls.Translations, search.sas_task; else translate again); a step
+    # whose whole task is kept searches it first, and the whole goal gets all of the time but RELAX_RESERVE_S, as
+    # the relaxed goal searches its translation. At 10 objects the translator takes 5-6 s of CPU and search often
+    # under 1 s, so that 6 s of 10 (RELAX_SHARE) left many whole problems untranslated. Chosen on dev (lama-first,
+    # two runs at a time, 9-10 objects, 105 / 106): whole-scene calls stopped in translation 13 -> 4, goals built
+    # 0.65 / 0.75 -> 0.80 / 0.75 (28 -> 31 of 40; the code before read 0.85 / 0.75 the day before, so within a
+    # set's noise); 6-8, 1-5 and structures within a problem or two, each that changed the same again with it off
+    # (relations_dev_reuse.json). Stock Fast Downward's search (the planner's own options) on its translator's task,
+    # told to keep every variable; Fast Downward only
+    reuse_translation: bool = True
+    # seconds of a planner call's time limit (of what the planner left) for stock A* with LM-cut on the translation
+    # of a satisficing planner's first plan (kept: search alone, learned_calls.shortest_plan), whose shortest plan
+    # then replaces it; where it finds none in time, the first plan is shortened (shorten_s). 0: none. lama-first's
+    # first plans wander (14 actions where 7 do, 31 after an action that did not do what the domain said), and a
+    # long plan meets the step limit. Chosen on dev (with reuse_translation, two runs at a time): structures 0.727
+    # -> 0.864, walks 1-5 0.95 -> 0.975, 6-8 0.85 / 0.90 -> 0.85 / 0.95, 9-10 31 -> 29 of 40 (123 of 142 against
+    # 120; relations_dev_reuse.json)
+    optimal_s: float = 3.0
 
     def __post_init__(self) -> None:
         """Refuse a planner, time limit, step factor or unary reading no run can use, before the simulator starts."""
@@ -120,7 +136,7 @@ class LearnedLoopConfig:
         if self.planner not in STOCK_PLANNERS:
             raise ValueError(f"unknown planner {self.planner!r}; known: {', '.join(STOCK_PLANNERS)}")
         check_bounds(self, {"timeout_s": TIMEOUT_S, "max_steps_factor": Bound(0.0, 100.0, lo_open=True),
-                            "shorten_s": Bound(0.0, 3600.0)})
+                            "shorten_s": Bound(0.0, 3600.0), "optimal_s": Bound(0.0, 3600.0)})
 
 
 @dataclass
@@ -279,6 +295,7 @@ def run_learned(sim, model, blob: dict, ops: Sequence[Operator], problem: Proble
     expected: frozenset[Atom] | None = None
     kept: set[Atom] | None = None  # the unary bits the last state held
     assumed: set[Atom] = set()  # the bits a plan assumed for covered items (hidden_bits "unsolvable")
+    translations = Translations(predicates) if cfg.reuse_translation else None
     while True:
         if max_goal_distance(sim.get_scene(), problem.goal, problem.free) <= GOAL_TOLERANCE_M:
             res.success, res.stop = True, "goal reached"
@@ -300,7 +317,8 @@ def run_learned(sim, model, blob: dict, ops: Sequence[Operator], problem: Proble
         if after is not None:
             res.kept_steps += 1
         else:
-            rest, planned = _plan(ops, domain, predicates, objects, state, goal, located, cfg, res, unary_names)
+            rest, planned = _plan(ops, domain, predicates, objects, state, goal, located, cfg, res, unary_names,
+                                  translations)
             if not rest:
                 return res
             assumed |= planned - state  # the covered items' bits a plan assumed stay for the episode, as if seen
@@ -333,144 +351,48 @@ def _as_predicted(state: frozenset[Atom], expected: frozenset[Atom]) -> bool:
 
 def _plan(ops: Sequence[Operator], domain: str, predicates: dict, objects: list[str], state: frozenset[Atom],
           goal: frozenset[Atom], located: frozenset[Atom], cfg: LearnedLoopConfig, res: LoopResult,
-          unary: Sequence[str]) -> tuple[list[str], frozenset[Atom]]:
+          unary: Sequence[str], translations: Translations | None = None) -> tuple[list[str], frozenset[Atom]]:
     """A plan's steps from state (shortened, LearnedLoopConfig.shorten_s), its call recorded in res, and the state
     it was planned from (state, or with the covered items' bits: hidden_bits "unsolvable"); no steps, with res.stop
     saying why, where no plan came."""
     t0 = time.perf_counter()
     share = RELAX_SHARE if cfg.relax_unreachable else 1.0  # of the time, leaving the rest for the relaxed goal
-    grounding = _Grounding()
-    plan, solved = _solve(domain, predicates, objects, state, goal, cfg, cfg.timeout_s * share, grounding)
+    if cfg.relax_unreachable and translations is not None:
+        share = max(1.0 - RELAX_RESERVE_S / cfg.timeout_s, RELAX_SHARE)
+    grounding = Grounding(translations)
+    plan, solved = solve(domain, predicates, objects, state, goal, cfg.planner, cfg.focus, cfg.timeout_s * share,
+                         grounding)
     hidden = covered_bits(state, unary) if cfg.hidden_bits == "unsolvable" else set()
     if plan.status.name == "UNSOLVABLE" and not hidden <= state:
         res.hidden_calls += 1
         state = state | hidden
         left = max(cfg.timeout_s - (time.perf_counter() - t0), 1.0)
-        plan, solved = _solve(domain, predicates, objects, state, goal, cfg, left * share, grounding)
+        plan, solved = solve(domain, predicates, objects, state, goal, cfg.planner, cfg.focus, left * share,
+                             grounding)
     if cfg.relax_unreachable and plan.status.name in ("UNSOLVABLE", "TIMEOUT"):
         relaxed = relaxed_goal(located, state)
         if relaxed != goal:
             res.relaxed_calls += 1
             left = max(cfg.timeout_s - (time.perf_counter() - t0), 1.0)
-            plan, solved = _solve(domain, predicates, objects, state, relaxed, cfg, left, grounding)
+            plan, solved = solve(domain, predicates, objects, state, relaxed, cfg.planner, cfg.focus, left,
+                                 grounding)
     steps = list(plan.steps) if plan.status.name == "SOLVED" else []
     if res.first_plan_length is None and steps:
         res.first_plan_length = len(steps)
+    shortest = STOCK_PLANNERS[cfg.planner].optimal  # an optimal plan is shortest
+    budget = min(cfg.optimal_s, cfg.timeout_s - (time.perf_counter() - t0))
+    if len(steps) > 1 and budget > 0 and not shortest and translations is not None:
+        better = shortest_plan(translations, *solved, budget)
+        if better is not None and len(better) <= len(steps):
+            steps, shortest = better, True
     budget = min(cfg.shorten_s, cfg.timeout_s - (time.perf_counter() - t0))
-    if len(steps) > 1 and budget > 0 and not STOCK_PLANNERS[cfg.planner].optimal:  # an optimal plan is shortest
+    if len(steps) > 1 and budget > 0 and not shortest:
         steps = shorten_plan(ops, *solved, steps, timeout_s=budget, n_locations=N_LOCATIONS)
     res.plan_times_s.append(round(time.perf_counter() - t0, 3))
     if not steps:
         res.stop = f"planner: {plan.status.name.lower()} {plan.message}"[:200]
         return [], state
     return steps, state
-
-
-def focus_objects(state: frozenset[Atom], goal: frozenset[Atom]) -> set[str]:
-    """The objects a plan for `goal` from `state` needs to name: each one a goal atom names that does not hold now,
-    and each one covering a cell the goal wants empty; then, until nothing is added, what rests on one of them (it
-    must be cleared), what a goal atom of one of them names, and the top of what stands at a cell the goal puts one
-    of them at (where nothing there reads clear, all of it); last, what each of them rests on (an operator that lifts
-    an object off another names both).
-
-    An operator's precondition and effects name its parameters and the locations alone, and its precondition is
-    positive, so a plan over these objects, with every atom of the others left out (the cells they fill stay not
-    `empty`, what they rest on not `clear`), is a plan of the whole state: it never moves the others, and their goal
-    atoms hold now. It may be longer, with fewer places to set an object down, or not found; then the caller plans
-    over every object (the incremental object sets of Silver et al., AAAI 2021, with the goal, not a learned score,
-    choosing the first set)."""
-    objects = lambda a: [x for x in a[1:] if x not in LOCATIONS]  # noqa: E731
-    on = [(a[1], a[2]) for a in state if a[0] == "on"]
-    at = [(a[1], a[2]) for a in state if a[0] == "at"]
-    clear = {a[1] for a in state if a[0] == "clear"}
-    vacate = {a[1] for a in goal - state if a[0] == "empty"}
-    focus = {o for a in goal - state for o in objects(a)} | {o for o, c in at if c in vacate}
-    while True:
-        cells = {a[2] for a in goal if a[0] == "at" and a[1] in focus}
-        there = {c: {o for o, where in at if where == c} for c in cells}
-        more = ({x for x, y in on if y in focus} | {o for here in there.values() for o in (here & clear or here)}
-                | {o for a in goal if set(objects(a)) & focus for o in objects(a)})
-        if more <= focus:
-            return focus | {y for x, y in on if x in focus}
-        focus |= more
-
-
-def focus_problem(objects: Sequence[str], state: frozenset[Atom], goal: frozenset[Atom]
-                  ) -> tuple[list[str], frozenset[Atom], frozenset[Atom]] | None:
-    """The problem over focus_objects alone (the first of object_sets), or None where object_sets has none."""
-    sets = object_sets(objects, state, goal)
-    return sub_problem(objects, sets[0], state, goal) if sets else None
-
-
-def object_sets(objects: Sequence[str], state: frozenset[Atom], goal: frozenset[Atom]) -> list[set[str]]:
-    """The growing sets of objects a planning step plans over before every object (incremental object sets, as in
-    Silver et al., AAAI 2021, with the goal, not a learned score, choosing them): focus_objects; then those and
-    every item read clear, the tops of the other stacks, as places to set an object on where the cells the others
-    fill leave the focus none. Each set holds at most FOCUS_MAX of the objects (grounding a set costs about the cube
-    of its size, so one of nearly every object costs what the whole does); none where the focus is empty (the goal
-    holds now, and the whole problem says so at once). A plan over any set is a plan of the whole state
-    (focus_objects says why)."""
-    few, cap = focus_objects(state, goal), FOCUS_MAX * len(objects)
-    if not few or len(few) > cap:
-        return []
-    more = few | {a[1] for a in state if a[0] == "clear"}
-    return [few, more] if few < more and len(more) <= cap else [few]
-
-
-def sub_problem(objects: Sequence[str], few: set[str], state: frozenset[Atom], goal: frozenset[Atom]
-                ) -> tuple[list[str], frozenset[Atom], frozenset[Atom]]:
-    """The problem over the objects `few` alone: those objects (in the order of `objects`), and the atoms of state
-    and goal that name no other object (the cells the others fill stay not `empty`)."""
-    keep = lambda atoms: frozenset(a for a in atoms if all(x in few for x in a[1:] if x not in LOCATIONS))  # noqa: E731
-    return [o for o in objects if o in few], keep(state), keep(goal)
-
-
-class _Grounding:
-    """The calls of one planning step that the time limit stopped before search began, as (objects, time limit):
-    a later call over at least as many objects in at most as much time would be stopped there too, so it is not
-    made, and its time goes to the calls that can still finish (at 9-10 objects the translator alone takes 3-6 s)."""
-
-    def __init__(self) -> None:
-        self.stopped: list[tuple[int, float]] = []
-
-    def hopeless(self, n: int, timeout_s: float) -> bool:
-        return any(n >= m and timeout_s <= t for m, t in self.stopped)
-
-    def note(self, plan: PlanResult, n: int, timeout_s: float) -> None:
-        if plan.status.name == "TIMEOUT" and plan.extra.get("phase") in ("translation", "start-up"):
-            self.stopped.append((n, timeout_s))
-
-
-def _call(domain: str, problem: str, n: int, cfg: LearnedLoopConfig, timeout_s: float,
-          grounding: _Grounding | None) -> PlanResult:
-    """One planner call over n objects, or, where grounding says it cannot get past the translator in timeout_s,
-    a TIMEOUT result without one."""
-    if grounding is None:
-        return solve_texts(domain, problem, cfg.planner, timeout_s)
-    if grounding.hopeless(n, timeout_s):
-        return failed(cfg.planner, PlanStatus.TIMEOUT, time.perf_counter(), f"{cfg.planner} not called: {n} objects "
-                      f"did not get past translation in as much time this step", phase="translation")
-    plan = solve_texts(domain, problem, cfg.planner, timeout_s)
-    grounding.note(plan, n, timeout_s)
-    return plan
-
-
-def _solve(domain: str, predicates: dict, objects: list[str], state: frozenset[Atom], goal: frozenset[Atom],
-           cfg: LearnedLoopConfig, timeout_s: float, grounding: _Grounding | None = None):
-    """A plan for `goal` from `state`, and the (objects, state, goal) it was found for: with cfg.focus, over each
-    of object_sets in turn, each in FOCUS_SHARE of the time left, until one yields a plan; then over every object
-    in the time left. `grounding` (one planning step's) skips the calls that could not get past translation."""
-    t0 = time.perf_counter()
-    for few in object_sets(objects, state, goal) if cfg.focus else []:
-        names, few_state, few_goal = sub_problem(objects, few, state, goal)
-        left = max(timeout_s - (time.perf_counter() - t0), 1.0)
-        plan = _call(domain, problem_pddl("p", names, few_state, few_goal, predicates), len(names), cfg,
-                     left * FOCUS_SHARE, grounding)
-        if plan.status.name == "SOLVED":
-            return plan, (names, few_state, few_goal)
-    left = max(timeout_s - (time.perf_counter() - t0), 1.0)
-    return (_call(domain, problem_pddl("p", objects, state, goal, predicates), len(objects), cfg, left, grounding),
-            (objects, state, goal))
 
 
 def summarize(results: Sequence[LoopResult]) -> dict:

@@ -38,7 +38,8 @@ from pddl_export.files import atomic_write_folder, sha256_file
 from pddl_export.learned_domain import domain_pddl, predicates_of, problem_pddl
 from symlearn.export.learned_export import load_operators, operators_path, run_hashes
 from symlearn.learning.relational_training import load_relational
-from symlearn.planning.learned_loop import focus_problem, goal_atoms, observe_atoms
+from symlearn.planning.learned_calls import focus_problem
+from symlearn.planning.learned_loop import goal_atoms, observe_atoms
 from symlearn.problems.problem import load_problems
 from symlearn.provenance import versions
 
