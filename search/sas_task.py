@@ -62,6 +62,7 @@ def parse_sas(text: str) -> SasTask:
     head_lines = text[:cut].split("\n")
     values: list[tuple[str, ...]] = []
     mutexes: list[tuple[tuple[int, int], ...]] = []
+    derived: list[str] = []
     i = 0
     try:
         while i < len(head_lines):
@@ -69,7 +70,7 @@ def parse_sas(text: str) -> SasTask:
             if line == "begin_variable":
                 body, i = _section(head_lines, i, "variable")
                 if int(body[1]) != -1:
-                    raise ValueError(f"variable {body[0]} is derived (axiom layer {body[1]}): not reusable")
+                    derived.append(f"{body[0]} (axiom layer {body[1]})")
                 n = int(body[2])
                 if len(body) != 3 + n:
                     raise ValueError(f"variable {body[0]} lists {len(body) - 3} values, says {n}")
@@ -79,13 +80,12 @@ def parse_sas(text: str) -> SasTask:
                 mutexes.append(tuple((int(v), int(x)) for v, x in (ln.split() for ln in body[1:])))
             else:
                 i += 1
-        state_lines = text[cut + 1:end].split("\n")
-        state, after = _section(state_lines, 0, "state")
+        state, _ = _section(text[cut + 1:end].split("\n"), 0, "state")
         init = tuple(int(x) for x in state)
     except (IndexError, ValueError) as e:
-        if "not reusable" in str(e):
-            raise
         raise ValueError(f"not a SAS+ task this reader knows: {e}") from None
+    if derived:
+        raise ValueError(f"variable {derived[0]} is derived: not reusable")
     if len(init) != len(values) or any(not 0 <= x < len(v) for x, v in zip(init, values)):
         raise ValueError("the initial state does not match the variables")
     return SasTask(text[:cut + 1], tuple(values), tuple(mutexes), text[end + len("\nend_goal\n"):], init)

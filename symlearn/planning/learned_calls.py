@@ -104,11 +104,6 @@ class Translations:
         self.reused += text is not None
         return text
 
-    def stands_for(self, names: Sequence[str], state: frozenset[Atom], goal: frozenset[Atom]) -> bool:
-        """Whether a kept task over these objects can stand for state and goal (task_for, not counted as reused)."""
-        kept = self.tasks.get(tuple(names))
-        return kept is not None and kept.task_for([a for a in state if a[0] in self.known], goal) is not None
-
     def keep(self, names: Sequence[str], state: frozenset[Atom], sas_text: str) -> None:
         """Keep the translator's task over these objects, translated from state."""
         try:
@@ -176,8 +171,9 @@ def solve(domain: str, predicates: dict, objects: list[str], state: frozenset[At
     (about 1 s at 10 objects, where translating 7 of them takes 1-2 s)."""
     t0 = time.perf_counter()
     translations = grounding.translations if grounding is not None else None
-    if translations is not None and translations.stands_for(objects, state, goal):  # search alone: no set is cheaper
-        return call(domain, predicates, objects, state, goal, planner, timeout_s, grounding), (objects, state, goal)
+    whole = translations.task_for(objects, state, goal) if translations is not None else None
+    if whole is not None:  # search alone: no object set is cheaper
+        return solve_sas_text(whole, planner, timeout_s), (objects, state, goal)
     for few in object_sets(objects, state, goal) if focus else []:
         names, few_state, few_goal = sub_problem(objects, few, state, goal)
         left = max(timeout_s - (time.perf_counter() - t0), 1.0)
