@@ -229,21 +229,26 @@ def precision(ops: Sequence[Operator], transitions: Sequence[Transition]) -> lis
     return out
 
 
-def generalize(op: Operator, transitions: Sequence[Transition], slack: float = 0.05) -> Operator:
+def generalize(op: Operator, transitions: Sequence[Transition], slack: float = 0.05,
+               keep_deleted: bool = False) -> Operator:
     """The operator with every precondition atom dropped that the data do not need: an atom goes when, without
     it, the operator still predicts the observed change as often (its precision falls by at most `slack`).
 
     A group's shared atoms include correlates of its members (most stacks are built on a cube that stands on
     the table, so `on-table ?o2` holds in nearly every member of "put ?o1 on ?o2"); a precondition kept for no
     reason forbids plans the robot can carry out, such as a third cube on a tower. Atoms are tried in a fixed
-    order, and the relations of the objects the effect moves (`at ?o ?from`) are never dropped."""
+    order, and the relations of the objects the effect moves (`at ?o ?from`) are never dropped.
+
+    With `keep_deleted`, no atom the operator deletes is dropped: the data rarely show "put a stick on ?o2" where
+    something already rests on ?o2, so its precision does not miss `(clear ?o2)`, yet without it a planner puts the
+    stick on a covered cube, deletes `(clear ?o2)` that was false, and the robot undoes what the plan expected."""
     def prec(o: Operator) -> float:
         a, h = precision([o], transitions)[0]
         return h / a if a else 0.0
 
     base = prec(op)
     for atom in sorted(op.precondition, key=lambda a: (a[0].startswith(STATIC_PREFIX) is False, a)):
-        if (atom[0] == "at" and atom in op.delete) or atom[0] == "=":
+        if (atom in op.delete and (keep_deleted or atom[0] == "at")) or atom[0] == "=":
             continue
         trial = dataclasses.replace(op, precondition=tuple(a for a in op.precondition if a != atom))
         if prec(trial) >= base - slack:

@@ -7,7 +7,7 @@ import pddl
 import pytest
 
 from pddl_export.learned_domain import (Transition, coverage, domain_pddl, learn_operators, lift, predicates_of,
-                                        problem_pddl)
+                                        problem_pddl, successor)
 from search.stock_planners import solve_texts
 
 
@@ -162,6 +162,25 @@ def test_generalize_drops_a_correlate_the_data_do_not_need_and_keeps_what_they_d
     op = generalize(next(o for o in learn_operators(onto, min_count=3, share=0.85) if o.count == 23), onto)
     assert ("on-table", "?o2") not in op.precondition  # a block goes on a tower's top just as well
     assert {("clear", "?o2"), ("clear", "?o1"), ("at", "?o1", "?from"), ("at", "?o2", "?to")} <= set(op.precondition)
+
+
+def test_generalize_keeps_an_atom_the_operator_deletes_when_told_to():
+    from pddl_export.learned_domain import generalize
+
+    onto, _, _ = _stack_world()
+    op = next(o for o in learn_operators(onto, min_count=3, share=0.85) if o.count == 23)
+    assert ("clear", "?o2") in op.delete and ("clear", "?o2") in op.precondition
+    # on data where nothing ever rests on a block at l1, "put ?o1 on ?o2" predicts as well without (clear ?o2)
+    loose = generalize(op, onto[:20])
+    assert ("clear", "?o2") not in loose.precondition
+    strict = generalize(op, onto[:20], keep_deleted=True)
+    assert set(strict.delete) <= set(strict.precondition)
+    assert ("on-table", "?o2") not in strict.precondition  # atoms it does not delete still go
+    # the loose operator puts a block on a covered one and deletes a (clear ?o2) that was false
+    covered = frozenset({("at", "a", "l0"), ("clear", "a"), ("on-table", "a"), ("at", "b", "l1"),
+                         ("at", "c", "l1"), ("on", "c", "b"), ("clear", "c"), ("on-table", "b")})
+    assert successor(loose, ["l0", "a", "b", "l1"], covered) is not None
+    assert successor(strict, ["l0", "a", "b", "l1"], covered) is None
 
 
 def test_a_goal_keeps_only_the_on_atoms_its_at_atoms_allow():

@@ -859,6 +859,22 @@ def test_a_stock_planner_carries_a_stick_with_its_rider_and_the_simulator_builds
     assert max_goal_distance(sim.get_scene(), problem.goal) <= GOAL_TOLERANCE_M  # the cube on the stick, near row
 
 
+def test_every_shipped_carry_operator_requires_what_it_deletes():
+    # export preset carry keeps each deleted atom in the precondition (LearnedExportConfig.keep_deleted): "put a stick
+    # on ?o2" requires (clear ?o2), so no planner puts it on a covered cube; the other operators are as the data found
+    # them, every carrying operator among them
+    from symlearn.export.learned_export import EXPORT_PRESETS, load_operators
+
+    ops = load_operators(SHIPPED_CARRY)
+    assert EXPORT_PRESETS["carry"].keep_deleted
+    assert [o.name for o in ops if not set(o.delete) <= set(o.precondition)] == []
+    on_item = [o for o in ops if ("clear", "?o2") in o.delete]
+    assert len(on_item) >= 10 and all(("clear", "?o2") in o.precondition for o in on_item)
+    report = json.loads((SHIPPED_CARRY / "learned" / "report.json").read_text())
+    assert report["config"]["keep_deleted"] and report["operators"] == len(ops) == 54
+    assert sum(1 for n in report["found"] if n["kept"] and "carries" in n) == 8
+
+
 def test_the_carrying_problem_of_the_carry_readme_is_one_carry_for_every_planner(tmp_path):
     # pretrained/relations_carry/README.md writes a problem by hand: a far-row stick with a cube on its end, both to the
     # near row. Stock lama-first and LM-cut, and pyperplan and Fast Downward through unified-planning (its validator

@@ -163,7 +163,8 @@ def add_relations_commands(sub) -> None:
                                                                     "carry-two"),
                    help="intersection: preconditions every group member holds; precise: for a noisy rests-on head; "
                         "placed: and an operator per place for an effect naming other locations (a cover model); "
-                        "carry: and each such operator judged on the data at its place (a carrying model); "
+                        "carry: and each such operator judged on the data at its place, no deleted atom dropped from "
+                        "a precondition (a carrying model); "
                         "carry-two: and a stick carrying two riders from 10 transitions "
                         "(learned_export.EXPORT_PRESETS; default intersection)")
     x.add_argument("--min-count", type=positive_int, help="drop a lifted effect seen fewer times (default "

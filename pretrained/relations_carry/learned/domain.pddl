@@ -79,7 +79,7 @@
     :effect (and (at ?o1 ?to) (at ?o2 ?to) (empty ?from) (empty l1) (not (at ?o1 ?from)) (not (at ?o1 l1)) (not (at ?o2 ?from)) (not (empty ?to))))
   (:action move-20  ; seen 92 times
     :parameters (?from - location ?o1 - item ?o2 - item ?o3 - item ?to - location)
-    :precondition (and (at ?o2 ?from) (clear ?o3) (empty ?to) (on-table ?o2) (on-table ?o3) (u2 ?o3) (u3 ?o2) (u6 ?o1) (u6 ?o2) (u7 ?o1) (u7 ?o2) (not (= ?from ?to)) (not (= ?o1 ?o2)) (not (= ?o1 ?o3)) (not (= ?o2 ?o3)))
+    :precondition (and (at ?o2 ?from) (clear ?o1) (clear ?o3) (empty ?to) (on-table ?o3) (u2 ?o3) (u3 ?o2) (u6 ?o1) (u6 ?o2) (u7 ?o1) (u7 ?o2) (not (= ?from ?to)) (not (= ?o1 ?o2)) (not (= ?o1 ?o3)) (not (= ?o2 ?o3)))
     :effect (and (at ?o1 ?from) (at ?o2 ?to) (on ?o3 ?o1) (not (at ?o2 ?from)) (not (clear ?o1)) (not (empty ?to)) (not (on-table ?o3))))
   (:action move-21  ; seen 90 times
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
@@ -91,15 +91,15 @@
     :effect (and (at ?o1 ?to) (at ?o1 l1) (clear ?o2) (on-table ?o1) (not (at ?o1 ?from)) (not (empty ?to)) (not (empty l1)) (not (on ?o1 ?o2))))
   (:action move-25  ; seen 79 times
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
-    :precondition (and (= ?from l1) (at ?o1 l0) (at ?o2 ?from) (at ?o2 l0) (empty ?to) (on-table ?o1) (u3 ?o2) (u5 ?o1) (u6 ?o2) (u7 ?o2) (not (= ?from ?to)) (not (= ?o1 ?o2)))
+    :precondition (and (= ?from l1) (at ?o1 l0) (at ?o2 ?from) (at ?o2 l0) (empty ?to) (on ?o2 ?o1) (u3 ?o2) (u5 ?o1) (u6 ?o2) (u7 ?o2) (not (= ?from ?to)) (not (= ?o1 ?o2)))
     :effect (and (at ?o1 ?from) (at ?o2 ?to) (clear ?o1) (on-table ?o2) (not (at ?o2 ?from)) (not (at ?o2 l0)) (not (empty ?to)) (not (on ?o2 ?o1))))
   (:action move-26  ; seen 75 times
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
-    :precondition (and (= ?from l0) (at ?o1 ?from) (at ?o1 l1) (at ?o2 ?to) (clear ?o1) (on-table ?o1) (u1 ?o2) (u7 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)))
+    :precondition (and (= ?from l0) (at ?o1 ?from) (at ?o1 l1) (at ?o2 ?to) (clear ?o1) (clear ?o2) (on-table ?o1) (u1 ?o2) (u7 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)))
     :effect (and (at ?o1 ?to) (empty ?from) (empty l1) (on ?o1 ?o2) (not (at ?o1 ?from)) (not (at ?o1 l1)) (not (clear ?o2)) (not (on-table ?o1))))
   (:action move-28  ; seen 70 times
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
-    :precondition (and (= ?from l2) (at ?o1 ?from) (at ?o1 l1) (at ?o2 ?to) (clear ?o1) (on-table ?o1) (u1 ?o2) (not (= ?from ?to)) (not (= ?o1 ?o2)))
+    :precondition (and (= ?from l2) (at ?o1 ?from) (at ?o1 l1) (at ?o2 ?to) (clear ?o1) (clear ?o2) (on-table ?o1) (u1 ?o2) (not (= ?from ?to)) (not (= ?o1 ?o2)))
     :effect (and (at ?o1 ?to) (empty ?from) (empty l1) (on ?o1 ?o2) (not (at ?o1 ?from)) (not (at ?o1 l1)) (not (clear ?o2)) (not (on-table ?o1))))
   (:action move-30  ; seen 68 times
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
@@ -111,7 +111,7 @@
     :effect (and (at ?o1 ?to) (at ?o1 l0) (empty ?from) (on ?o1 ?o2) (not (at ?o1 ?from)) (not (at ?o2 ?to)) (not (clear ?o2)) (not (on-table ?o1))))
   (:action move-33  ; seen 65 times
     :parameters (?from - location ?o1 - item ?o2 - item ?o3 - item ?to - location)
-    :precondition (and (at ?o1 l1) (at ?o3 ?from) (clear ?o3) (empty ?to) (on-table ?o1) (on-table ?o3) (u3 ?o1) (u5 ?o2) (u7 ?o1) (u7 ?o2) (not (= ?from ?to)) (not (= ?o1 ?o2)) (not (= ?o1 ?o3)) (not (= ?o2 ?o3)))
+    :precondition (and (at ?o1 l1) (at ?o3 ?from) (clear ?o2) (clear ?o3) (empty ?to) (on-table ?o1) (on-table ?o3) (u3 ?o1) (u5 ?o2) (u7 ?o1) (u7 ?o2) (not (= ?from ?to)) (not (= ?o1 ?o2)) (not (= ?o1 ?o3)) (not (= ?o2 ?o3)))
     :effect (and (at ?o1 ?from) (at ?o2 ?from) (at ?o3 ?to) (on ?o1 ?o2) (not (at ?o3 ?from)) (not (clear ?o2)) (not (empty ?to)) (not (on-table ?o1))))
   (:action move-35  ; seen 62 times
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
@@ -123,7 +123,7 @@
     :effect (and (at ?o1 ?to) (at ?o2 ?to) (empty ?from) (empty l1) (not (at ?o1 ?from)) (not (at ?o1 l1)) (not (at ?o2 ?from)) (not (empty ?to))))
   (:action move-38  ; seen 57 times
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
-    :precondition (and (= ?to l0) (at ?o1 ?from) (at ?o2 ?to) (clear ?o1) (empty l1) (on-table ?o2) (u0 ?o1) (u3 ?o2) (u7 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)))
+    :precondition (and (= ?to l0) (at ?o1 ?from) (at ?o2 ?to) (clear ?o1) (clear ?o2) (empty l1) (on-table ?o1) (u0 ?o1) (u3 ?o2) (u7 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)))
     :effect (and (at ?o1 ?to) (at ?o1 l1) (empty ?from) (on ?o1 ?o2) (not (at ?o1 ?from)) (not (clear ?o2)) (not (empty l1)) (not (on-table ?o1))))
   (:action move-39  ; seen 53 times
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
@@ -139,7 +139,7 @@
     :effect (and (at ?o1 l0) (not (empty l0))))
   (:action move-50  ; seen 43 times
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
-    :precondition (and (= ?from l1) (at ?o1 ?from) (at ?o1 l0) (at ?o1 l2) (at ?o2 ?to) (clear ?o1) (on-table ?o1) (u1 ?o2) (u7 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)))
+    :precondition (and (= ?from l1) (at ?o1 ?from) (at ?o1 l0) (at ?o1 l2) (at ?o2 ?to) (clear ?o1) (clear ?o2) (on-table ?o1) (u1 ?o2) (u7 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)))
     :effect (and (at ?o1 ?to) (empty ?from) (empty l0) (empty l2) (on ?o1 ?o2) (not (at ?o1 ?from)) (not (at ?o1 l0)) (not (at ?o1 l2)) (not (clear ?o2)) (not (on-table ?o1))))
   (:action move-52  ; seen 40 times
     :parameters (?from - location ?o1 - item ?to - location)
@@ -155,7 +155,7 @@
     :effect (and (at ?o1 ?to) (at ?o1 l1) (at ?o2 ?to) (empty ?from) (on ?o1 ?o2) (not (at ?o1 ?from)) (not (clear ?o2)) (not (empty ?to)) (not (on-table ?o1))))
   (:action move-62  ; seen 35 times
     :parameters (?from - location ?o1 - item ?o2 - item ?o3 - item ?to - location)
-    :precondition (and (at ?o2 ?to) (at ?o3 ?from) (on-table ?o2) (on-table ?o3) (u2 ?o3) (u3 ?o2) (u3 ?o3) (u6 ?o1) (u6 ?o2) (u7 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)) (not (= ?o1 ?o3)) (not (= ?o2 ?o3)))
+    :precondition (and (at ?o2 ?to) (at ?o3 ?from) (clear ?o1) (clear ?o2) (on-table ?o2) (on-table ?o3) (u2 ?o3) (u3 ?o2) (u3 ?o3) (u6 ?o1) (u6 ?o2) (u7 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)) (not (= ?o1 ?o3)) (not (= ?o2 ?o3)))
     :effect (and (at ?o1 ?from) (at ?o1 ?to) (at ?o2 ?from) (at ?o3 ?to) (on ?o2 ?o1) (on ?o3 ?o2) (not (at ?o3 ?from)) (not (clear ?o1)) (not (clear ?o2)) (not (on-table ?o2)) (not (on-table ?o3))))
   (:action move-66  ; seen 32 times
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
@@ -199,7 +199,7 @@
     :effect (and (at ?o1 ?to) (at ?o2 ?to) (at ?o3 l1) (empty ?from) (on ?o1 ?o3) (not (at ?o1 ?from)) (not (clear ?o3)) (not (on-table ?o1))))
   (:action move-97  ; seen 22 times
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
-    :precondition (and (= ?from l1) (at ?o1 ?from) (at ?o1 l2) (at ?o2 ?from) (empty ?to) (on-table ?o2) (u3 ?o1) (u5 ?o2) (u7 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)))
+    :precondition (and (= ?from l1) (at ?o1 ?from) (at ?o1 l2) (at ?o2 ?from) (empty ?to) (on ?o1 ?o2) (on-table ?o2) (u3 ?o1) (u5 ?o2) (u7 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)))
     :effect (and (at ?o1 ?to) (clear ?o2) (on-table ?o1) (not (at ?o1 ?from)) (not (at ?o1 l2)) (not (empty ?to)) (not (on ?o1 ?o2))))
   (:action move-98  ; seen 21 times
     :parameters (?from - location ?o1 - item ?o2 - item ?to - location)
@@ -219,7 +219,7 @@
     :effect (and (at ?o1 ?to) (at ?o1 l3) (at ?o2 ?to) (at ?o2 l3) (empty ?from) (empty l0) (not (at ?o1 ?from)) (not (at ?o2 l0)) (not (empty ?to)) (not (empty l3))))
   (:action move-103  ; seen 20 times
     :parameters (?from - location ?o1 - item ?o2 - item ?o3 - item ?to - location)
-    :precondition (and (= ?to l0) (at ?o1 ?from) (at ?o3 ?to) (clear ?o1) (empty l1) (empty l2) (on ?o1 ?o2) (on-table ?o3) (u2 ?o2) (u3 ?o1) (u3 ?o3) (u5 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)) (not (= ?o1 ?o3)) (not (= ?o2 ?o3)))
+    :precondition (and (= ?to l0) (at ?o1 ?from) (at ?o3 ?to) (clear ?o1) (clear ?o3) (empty l1) (empty l2) (on ?o1 ?o2) (on-table ?o3) (u2 ?o2) (u3 ?o1) (u3 ?o3) (u5 ?o1) (not (= ?from ?to)) (not (= ?o1 ?o2)) (not (= ?o1 ?o3)) (not (= ?o2 ?o3)))
     :effect (and (at ?o1 ?to) (at ?o1 l1) (clear ?o2) (on ?o1 ?o3) (not (at ?o1 ?from)) (not (clear ?o3)) (not (empty l1)) (not (on ?o1 ?o2))))
   (:action move-104  ; seen 20 times
     :parameters (?from - location ?o1 - item ?to - location)
