@@ -180,16 +180,16 @@ def test_the_results_grid_is_recomputed_from_its_two_files():
 
 def test_the_learned_route_table_is_the_one_its_result_file_holds():
     # README's table under "A domain learned all the way down": each route's success at 1-5, 6-8, 9-10 objects and on
-    # structures, two digits, from bench/results/relations_test20_table.json (one run each on the fresh sets
-    # 1001-1004; docs/RELATIONS.md prints the same figures), the learned row's runs also in relations_test20_runs.json
-    table = json.loads((ROOT / "bench/results/relations_test20_table.json").read_text())["table"]
-    runs = json.loads((ROOT / "bench/results/relations_test20_runs.json").read_text())["runs"]
+    # structures, two digits, from bench/results/relations_test21_table.json (one run each on the fresh sets
+    # 1011-1014; docs/RELATIONS.md prints the same figures), the learned row's runs also in relations_test21_runs.json
+    table = json.loads((ROOT / "bench/results/relations_test21_table.json").read_text())["table"]
+    runs = json.loads((ROOT / "bench/results/relations_test21_runs.json").read_text())["runs"]
     rows = {"learned carry `at` + `on`, stock lama-first, then LM-cut on its task (`pretrained/relations_carry`)":
             "learned carry (fd-lama-first)",
             "oracle predicates, stock Fast Downward (`fast-downward-lifted`)": "oracle predicates (fast-downward-lifted)",
             "whole codes (`astar-outcomes`, the paper's route)": "whole codes (astar-outcomes)"}
     readme = (ROOT / "README.md").read_text()
-    sets = ("rel_test20", "rel_test2068", "rel_test20910", "rel_struct_test20")
+    sets = ("rel_test21", "rel_test2168", "rel_test21910", "rel_struct_test21")
     for label, route in rows.items():
         m = re.search(rf"^\| {re.escape(label)} \| ([^|]+) \| ([^|]+) \| ([^|]+) \| ([^|]+) \|$", readme, re.M)
         assert m, label
