@@ -18,7 +18,7 @@ from typing import Sequence
 
 import numpy as np
 
-from pddl_export.bounded_json import MiB, read_json_file
+from pddl_export.bounded_json import DEFAULT_MAX_BYTES, JsonFileError, MiB, read_json_file
 from symlearn.problems.paths import check_safe_name, is_safe_name
 from symlearn.sim.exploration import MAX_OBJECTS
 from symlearn.provenance import atomic_write_json
@@ -311,22 +311,30 @@ def load_problems(problems_dir: Path) -> list[tuple[Path, Problem]]:
     paths = sorted(problems_dir.glob("*.json"))
     if not paths:
         raise ValueError(f"{problems_dir} holds no problem files (*.json)")
-    listed = _listed(problems_dir / PROBLEMS_MANIFEST)
+    listed = _listed(problems_dir)
     if listed is not None and len(paths) < listed:
         raise ValueError(f"{problems_dir} holds {len(paths)} of the {listed} problems its {PROBLEMS_MANIFEST} lists: the "
                          f"`symlearn problems` that made it stopped early; run the same command again to complete it")
     return [(p, load_problem(p)) for p in paths]
 
 
-def _listed(manifest: Path) -> int | None:
-    """How many problems a set's manifest says it holds: its n, for a random-walk set or a structure suite (a
-    stratified set's n counts per cell); None where there is no such manifest."""
+def read_manifest(problems_dir: Path, max_bytes: int = DEFAULT_MAX_BYTES):
+    """The JSON value of a set's manifest (PROBLEMS_MANIFEST), or None where it is missing or cannot be read: its
+    readers decide what a missing one means."""
+    manifest = Path(problems_dir) / PROBLEMS_MANIFEST
     if not manifest.is_file():
         return None
     try:
-        m = read_json_file(manifest, max_bytes=MiB, what="problem manifest")
-    except ValueError:
-        return None  # a manifest that cannot be read says nothing here; the generator refuses it itself
+        return read_json_file(manifest, max_bytes=max_bytes, what="problem manifest")
+    except JsonFileError:
+        return None
+
+
+def _listed(problems_dir: Path) -> int | None:
+    """How many problems a set's manifest says it holds: its n, for a random-walk set or a structure suite (a
+    stratified set's n counts per cell); None where there is no such manifest, or it cannot be read (the generator
+    refuses that one itself)."""
+    m = read_manifest(problems_dir, max_bytes=MiB)
     if not isinstance(m, dict) or m.get("stratify"):
         return None
     n = m.get("n")

@@ -16,11 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from pddl_export.bounded_json import JsonFileError, read_json_file
 from symlearn.folder_lock import LOCK_NAME, folder_lock
 from symlearn.problems.paths import path_under
 from symlearn.problems.problem import (GOAL_TOLERANCE_M, MAX_ACTIONS, PROBLEM_VERSION, PROBLEMS_MANIFEST, OutOfReach,
-                                       Problem, load_problem, load_problems, save_problem)
+                                       Problem, load_problem, load_problems, read_manifest, save_problem)
 from symlearn.problems.shortest import with_shortest
 from symlearn.provenance import atomic_write_json
 from symlearn.sim.exploration import MAX_OBJECTS, ExplorationConfig, sample_action, sample_scene_spec
@@ -169,12 +168,7 @@ def prepare_problem_dir(out_dir: Path, settings: dict, overwrite: bool = False) 
     if out_dir.exists() and not out_dir.is_dir():
         raise ValueError(f"--out {out_dir} is a file, not a folder")
     if out_dir.is_dir() and any(f.name != LOCK_NAME for f in out_dir.iterdir()):
-        old = None
-        if manifest.is_file():
-            try:
-                old = read_json_file(manifest, what="problem manifest")
-            except JsonFileError:
-                old = None
+        old = read_manifest(out_dir)
         if overwrite:
             own = _own_files(out_dir)
             others = sorted(f.name for f in out_dir.iterdir() if f not in own and f.name != LOCK_NAME)
@@ -286,12 +280,7 @@ def add_shortest_plans(problems_dir: Path) -> dict[str, int]:
             save_problem(path, problem)
             counts["annotated"] += 1
         counts["known" if problem.optimal_length is not None else "undecided"] += 1
-    manifest = problems_dir / PROBLEMS_MANIFEST
-    if manifest.is_file():
-        try:
-            settings = read_json_file(manifest, what="problem set manifest")
-        except JsonFileError:
-            settings = None
-        if isinstance(settings, dict) and settings.get("format") == MANIFEST_FORMAT:
-            atomic_write_json(manifest, {**settings, "problem_version": PROBLEM_VERSION})
+    settings = read_manifest(problems_dir)
+    if isinstance(settings, dict) and settings.get("format") == MANIFEST_FORMAT:
+        atomic_write_json(problems_dir / PROBLEMS_MANIFEST, {**settings, "problem_version": PROBLEM_VERSION})
     return counts
