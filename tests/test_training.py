@@ -99,12 +99,15 @@ def _batch4(tmp_path: Path) -> Path:
 
 
 def test_two_process_ddp_ends_with_identical_weights(data, tmp_path):
-    run = tmp_path / "ddp"
-    cmd = [sys.executable, "-m", "torch.distributed.run", "--standalone", "--nproc_per_node=2", "-m", "symlearn.cli.main",
-           "train", "--data", str(data), "--out", str(run), "--preset", "quick", "--epochs", "1", "--config",
-           str(_batch4(tmp_path)), "--quiet"]
+    run, logs = tmp_path / "ddp", tmp_path / "rank_logs"
+    # each rank's stderr goes to a file of its own (--redirects 2), so that a rank that dies says why in the
+    # failure message; the launcher's stderr alone had only the other rank's SIGTERM
+    cmd = [sys.executable, "-m", "torch.distributed.run", "--standalone", "--nproc_per_node=2", "--log-dir", str(logs),
+           "--redirects", "2", "-m", "symlearn.cli.main", "train", "--data", str(data), "--out", str(run),
+           "--preset", "quick", "--epochs", "1", "--config", str(_batch4(tmp_path)), "--quiet"]
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
-    assert r.returncode == 0, r.stderr[-2000:]
+    ranks = "".join(f"\n--- {f.relative_to(logs)} ---\n{f.read_text()[-3000:]}" for f in sorted(logs.rglob("stderr.log")))
+    assert r.returncode == 0, r.stderr[-2000:] + ranks
     m = json.loads((run / "metrics.json").read_text())
     assert m["world_size"] == 2 and m["ranks_identical"] is True
 
