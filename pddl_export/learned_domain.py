@@ -294,36 +294,50 @@ def _atom(a: Atom) -> str:
     return "(" + " ".join(a) + ")"
 
 
-def distinct(op: Operator) -> list[str]:
+def distinct(op: Operator, equality: bool = True) -> list[str]:
     """`(not (= ?a ?b))` for every pair of variables of one type: lifting gave different objects (and the pick and
     release location, when they differ) different variables, so an operator was only ever seen with them apart.
-    Without it a planner may bind two to one object (move ?o1 onto itself) and reach a goal no robot can."""
+    Without it a planner may bind two to one object (move ?o1 onto itself) and reach a goal no robot can. Without
+    `equality`, `(differ ?a ?b)`, a static predicate the problem states of every two different objects
+    (problem_pddl): pyperplan's parser takes no `=`."""
     out = []
     for (a, ta), (b, tb) in itertools.combinations(op.parameters, 2):
         if ta == tb:
-            out.append(f"(not (= {a} {b}))")
+            out.append(f"(not (= {a} {b}))" if equality else f"(differ {a} {b})")
     return out
 
 
+def _precondition(op: Operator, equality: bool) -> list[str]:
+    """The operator's precondition atoms as PDDL, and distinct's; without `equality`, a placed operator's
+    `(= ?to l1)` written `(same ?to l1)` (problem_pddl states `(same l l)` of each location)."""
+    same = lambda a: ("same", *a[1:]) if a[0] == "=" and not equality else a  # noqa: E731
+    return [*(_atom(same(a)) for a in op.precondition), *distinct(op, equality)]
+
+
 def domain_pddl(ops: Sequence[Operator], name: str = "learned-relations", comments: dict[str, str] | None = None,
-                n_locations: int = 6) -> str:
+                n_locations: int = 6, equality: bool = True) -> str:
     """The operators as a typed STRIPS domain with equality (distinct); `comments` say what each predicate was found
-    to mean."""
+    to mean. Without `equality`, the same domain in plain typed STRIPS, for planners whose parser takes no `=`
+    (stock pyperplan): `(differ ?a ?b)` and `(same ?to l1)` in place of `(not (= ?a ?b))` and `(= ?to l1)`, both
+    static, stated in each problem (problem_pddl with equality=False)."""
     comments = comments or {}
     locs = " ".join(f"l{i}" for i in range(n_locations))
-    lines = [f"(define (domain {name})", "  (:requirements :strips :typing :equality)", "  (:types item location)",
-             f"  (:constants {locs} - location)", "  (:predicates"]
+    lines = [f"(define (domain {name})", f"  (:requirements :strips :typing{' :equality' if equality else ''})",
+             "  (:types item location)", f"  (:constants {locs} - location)", "  (:predicates"]
     for p, types in predicates_of(ops).items():
         args = " ".join(f"?x{i} - {t}" for i, t in enumerate(types))
         note = f"  ; {comments[p]}" if p in comments else ""
         lines.append(f"    ({p} {args}){note}")
+    if not equality:
+        lines += ["    (differ ?x0 ?x1)  ; static: two different objects or locations",
+                  "    (same ?x0 - location ?x1 - location)  ; static: a location and itself"]
     lines.append("  )")
     for o in ops:
         params = " ".join(f"{v} - {t}" for v, t in o.parameters)
         moved = carried(o)
         what = f"; carries {' and '.join(moved)} together" if len(moved) > 1 else ""
         lines += [f"  (:action {o.name}  ; seen {o.count} times{what}", f"    :parameters ({params})",
-                  f"    :precondition (and {' '.join([*map(_atom, o.precondition), *distinct(o)])})",
+                  f"    :precondition (and {' '.join(_precondition(o, equality))})",
                   f"    :effect (and {' '.join(map(_atom, o.add))} "
                   f"{' '.join('(not ' + _atom(a) + ')' for a in o.delete)}))"]
     lines.append(")")
@@ -331,12 +345,19 @@ def domain_pddl(ops: Sequence[Operator], name: str = "learned-relations", commen
 
 
 def problem_pddl(name: str, objects: Sequence[str], init: Iterable[Atom], goal: Iterable[Atom],
-                 predicates: Iterable[str], domain: str = "learned-relations") -> str:
+                 predicates: Iterable[str], domain: str = "learned-relations", equality: bool = True,
+                 n_locations: int = 6) -> str:
     """A problem over the learned predicates: objects, the observed atoms and a goal (the six locations are the
     domain's constants l0..l5). Atoms of a predicate the domain does not declare (a bit no operator reads or
-    changes) are left out of the initial state: they can neither help nor hinder a plan."""
+    changes) are left out of the initial state: they can neither help nor hinder a plan. Without `equality` (the
+    domain written so), also the static `(differ a b)` of every two objects and every two locations, and `(same l
+    l)` of each location."""
     known = set(predicates)
     init = [a for a in init if a[0] in known]
+    if not equality:
+        locs = [f"l{i}" for i in range(n_locations)]
+        init += [("differ", a, b) for group in (list(objects), locs) for a, b in itertools.permutations(group, 2)]
+        init += [("same", x, x) for x in locs]
     return (f"(define (problem {name}) (:domain {domain})\n  (:objects {' '.join(objects)} - item)\n"
             f"  (:init {' '.join(map(_atom, sorted(init)))})\n  (:goal (and {' '.join(map(_atom, sorted(goal)))})))\n")
 

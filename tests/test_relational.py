@@ -621,6 +621,38 @@ def test_the_tower_docs_domain_md_writes_for_the_learned_domain_is_solved_as_it_
         assert res.steps[0].strip("()").split()[1:] == ["l0", "a", "l5"]
 
 
+def test_the_carry_domain_without_equality_is_read_by_stock_pyperplan_and_plans_as_with_it():
+    # export-learned-problems --no-equality: docs/DOMAIN.md's tower in plain typed STRIPS, (differ ?a ?b) and
+    # (same ?to l1) stated as static facts; stock pyperplan, whose parser takes no `=`, refuses the domain as shipped
+    # and solves this one, and LM-cut finds the same shortest plan on both
+    import re
+
+    from pddl_export.learned_domain import domain_pddl, predicates_of, problem_pddl
+    from search.stock_planners import solve_texts
+    from symlearn.export.learned_export import load_operators
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "DOMAIN.md").read_text()
+    problem = re.search(r"\(define \(problem tower4\).*?\n```", doc, re.S).group(0)[:-4]
+    objects = re.search(r"\(:objects ([^-]+)- item\)", problem).group(1).split()
+    init_text, goal_text = problem.split("(:goal")
+    atoms = lambda text: [tuple(a.split()) for a in re.findall(r"\(([^():]+)\)", text) if a.split()[0] != "and"]  # noqa: E731
+    ops = load_operators(SHIPPED_CARRY)
+    domain = (SHIPPED_CARRY / "learned" / "domain.pddl").read_text()
+    plain = domain_pddl(ops, equality=False)
+    plain_problem = problem_pddl("tower4", objects, atoms(init_text.split("(:init")[1]), atoms(goal_text),
+                                 predicates_of(ops), equality=False)
+    assert "(= " not in plain and ":equality" not in plain and plain.count("(differ ?") > 50
+    assert "(differ a b)" in plain_problem and "(differ l0 l5)" in plain_problem and "(same l3 l3)" in plain_problem
+    assert "(differ a a)" not in plain_problem and "(same l0 l1)" not in plain_problem
+    refused = solve_texts(domain, problem, "pyperplan", 60.0)
+    assert refused.status.name == "ERROR", refused.status
+    read = solve_texts(plain, plain_problem, "pyperplan", 120.0)
+    assert read.status.name == "SOLVED" and len(read.steps) >= 4, read.message
+    shortest = [solve_texts(d, p, "fd-lmcut", 60.0) for d, p in ((domain, problem), (plain, plain_problem))]
+    assert all(r.status.name == "SOLVED" for r in shortest)
+    assert shortest[0].steps == shortest[1].steps and len(shortest[0].steps) == 4
+
+
 @pytest.mark.parametrize("run", ["relations_on", "relations_cover", "relations_carry"])
 def test_exported_learned_problems_are_solvable_wherever_the_simulator_reaches_the_goal(run, tmp_path, capsys):
     # a sample of fresh located walks, read by a shipped model (rests-on, cover) and written as PDDL problems: every

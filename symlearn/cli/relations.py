@@ -113,7 +113,8 @@ def cmd_export_learned_problems(args: argparse.Namespace) -> int:
 
     set_threads(args.threads)
     man = export_learned_problems(Path(args.run), Path(args.problems), Path(args.out),
-                                  tuple(args.goal_relations or ()), focus=args.focus)
+                                  tuple(args.goal_relations or ()), focus=args.focus,
+                                  equality=not args.no_equality)
     believed = sum(r["goal_believed_reached"] for r in man["rows"])
     focused = sum("focus_file" in r for r in man["rows"])
     print(f"{len(man['rows'])} problems written to {args.out} (domain.pddl, NAME.pddl, problems.json"
@@ -196,5 +197,8 @@ def add_relations_commands(sub) -> None:
     q.add_argument("--goal-relations", nargs="*", help="object-object relations the goals keep beside at, e.g. on")
     q.add_argument("--focus", action="store_true", help="also write OUT/focus/NAME.pddl over the objects the goal "
                    "needs alone (the closed loop's first call): each of its plans is a plan of OUT/NAME.pddl")
+    q.add_argument("--no-equality", action="store_true", help="write the domain in plain typed STRIPS, "
+                   "(differ ?a ?b) and (same ?to l1) for (not (= ?a ?b)) and (= ?to l1), with those static facts in "
+                   "each problem: for planners whose parser takes no = (stock pyperplan)")
     q.add_argument("--threads", type=thread_count)
     q.set_defaults(func=cmd_export_learned_problems)

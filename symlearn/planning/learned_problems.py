@@ -49,9 +49,10 @@ FOCUS_FOLDER = "focus"
 
 
 def export_learned_problems(run_dir: Path, problems_dir: Path, out: Path,
-                            goal_relations: tuple[str, ...] = (), focus: bool = False) -> dict:
+                            goal_relations: tuple[str, ...] = (), focus: bool = False, equality: bool = True) -> dict:
     """Write OUT/domain.pddl, OUT/NAME.pddl for every problem of problems_dir and OUT/problems.json (with `focus`,
-    OUT/focus/NAME.pddl too, over the objects the goal needs); returns the manifest. Refused in one line, before the
+    OUT/focus/NAME.pddl too, over the objects the goal needs); returns the manifest. Without `equality`, the domain
+    and problems in plain typed STRIPS (pddl_export.learned_domain.domain_pddl). Refused in one line, before the
     simulator starts, when OUT exists or an input is missing."""
     from symlearn.sim.simulator import TabletopSimulator
 
@@ -68,7 +69,7 @@ def export_learned_problems(run_dir: Path, problems_dir: Path, out: Path,
         raise ValueError(f"{operators_path(run_dir)}: no operator reads or changes {unknown}; "
                          f"relations of this domain: {sorted(set(predicates) - {'at', 'empty'})}")
     problems = load_problems(problems_dir)
-    files: dict[str, str] = {"domain.pddl": domain_pddl(ops)}
+    files: dict[str, str] = {"domain.pddl": domain_pddl(ops, equality=equality)}
     rows = []
     with TabletopSimulator() as sim:
         for path, problem in problems:
@@ -76,20 +77,21 @@ def export_learned_problems(run_dir: Path, problems_dir: Path, out: Path,
             sim.reset(problem.initial)
             init = observe_atoms(sim, model, blob)
             objects = [f"o{i + 1}" for i in range(problem.initial.k)]
-            files[f"{problem.name}.pddl"] = problem_pddl(problem.name, objects, init, goal, predicates)
+            files[f"{problem.name}.pddl"] = problem_pddl(problem.name, objects, init, goal, predicates,
+                                                         equality=equality)
             row = {}
             few = focus_problem(objects, init, goal) if focus else None
             if few is not None:
                 names, few_init, few_goal = few
                 files[f"{FOCUS_FOLDER}/{problem.name}.pddl"] = problem_pddl(problem.name, names, few_init, few_goal,
-                                                                           predicates)
+                                                                           predicates, equality=equality)
                 row = {"focus_file": f"{FOCUS_FOLDER}/{problem.name}.pddl", "focus_objects": names}
             rows.append({"name": problem.name, "file": f"{problem.name}.pddl", **row, "k": problem.initial.k,
                          "shortest": problem.optimal_length, "generator_length": problem.generator_length,
                          "goal_atoms": len(goal), "goal_believed_reached": goal <= init,
                          "problem_sha256": sha256_file(path)})
     manifest = {"format": FORMAT, "run": str(run_dir), **run_hashes(run_dir), "problems": str(problems_dir),
-                "goal_relations": list(goal_relations), "focus": focus, "rows": rows, "versions": versions()}
+                "goal_relations": list(goal_relations), "focus": focus, "equality": equality, "rows": rows, "versions": versions()}
     files[MANIFEST] = json.dumps(manifest, indent=1)
     atomic_write_folder(out, files)
     return manifest
