@@ -694,6 +694,15 @@ def test_exported_learned_problems_are_solvable_wherever_the_simulator_reaches_t
             plan = solve_files(out / "domain.pddl", out / row["focus_file"], "fd-lmcut", 60.0)
             assert plan.status.name == "SOLVED", (row["name"], plan.message)
             _assert_valid(out / "domain.pddl", out / row["file"], plan.steps)
+    # --no-equality: the same problems in plain typed STRIPS, which stock pyperplan reads and solves
+    plain = tmp_path / "plain"
+    assert cli("export-learned-problems", "--run", shipped, "--problems", tmp_path / "walks", "--out", plain,
+               "--goal-relations", "on", "--no-equality")[0] == 0
+    assert json.loads((plain / "problems.json").read_text())["equality"] is False
+    assert "(= " not in (plain / "domain.pddl").read_text() and "(differ ?" in (plain / "domain.pddl").read_text()
+    for row in man["rows"]:
+        res = solve_files(plain / "domain.pddl", plain / row["file"], "pyperplan", 60.0)
+        assert res.status.name == "SOLVED", (row["name"], res.message)
     # never over an existing folder, and a relation no operator reads is refused, both in one line
     capsys.readouterr()
     rc, _ = cli("export-learned-problems", "--run", shipped, "--problems", tmp_path / "walks", "--out", out)
