@@ -329,6 +329,9 @@ def domain_pddl(ops: Sequence[Operator], name: str = "learned-relations", commen
         note = f"  ; {comments[p]}" if p in comments else ""
         lines.append(f"    ({p} {args}){note}")
     if not equality:
+        taken = {"differ", "same"} & set(predicates_of(ops))
+        if taken:
+            raise ValueError(f"the operators already name a predicate {sorted(taken)[0]!r}: no plain STRIPS form")
         lines += ["    (differ ?x0 ?x1)  ; static: two different objects or locations",
                   "    (same ?x0 - location ?x1 - location)  ; static: a location and itself"]
     lines.append("  )")

@@ -651,6 +651,11 @@ def test_the_carry_domain_without_equality_is_read_by_stock_pyperplan_and_plans_
     shortest = [solve_texts(d, p, "fd-lmcut", 60.0) for d, p in ((domain, problem), (plain, plain_problem))]
     assert all(r.status.name == "SOLVED" for r in shortest)
     assert shortest[0].steps == shortest[1].steps and len(shortest[0].steps) == 4
+    import dataclasses
+
+    clash = [dataclasses.replace(ops[0], precondition=(*ops[0].precondition, ("same", "?o1")))]
+    with pytest.raises(ValueError, match="already name a predicate 'same'"):
+        domain_pddl(clash, equality=False)
 
 
 @pytest.mark.parametrize("run", ["relations_on", "relations_cover", "relations_carry"])
