@@ -321,17 +321,18 @@ def domain_pddl(ops: Sequence[Operator], name: str = "learned-relations", commen
     (stock pyperplan): `(differ ?a ?b)` and `(same ?to l1)` in place of `(not (= ?a ?b))` and `(= ?to l1)`, both
     static, stated in each problem (problem_pddl with equality=False)."""
     comments = comments or {}
+    predicates = predicates_of(ops)
+    taken = set() if equality else {"differ", "same"} & set(predicates)
+    if taken:
+        raise ValueError(f"the operators already name a predicate {sorted(taken)[0]!r}: no plain STRIPS form")
     locs = " ".join(f"l{i}" for i in range(n_locations))
     lines = [f"(define (domain {name})", f"  (:requirements :strips :typing{' :equality' if equality else ''})",
              "  (:types item location)", f"  (:constants {locs} - location)", "  (:predicates"]
-    for p, types in predicates_of(ops).items():
+    for p, types in predicates.items():
         args = " ".join(f"?x{i} - {t}" for i, t in enumerate(types))
         note = f"  ; {comments[p]}" if p in comments else ""
         lines.append(f"    ({p} {args}){note}")
     if not equality:
-        taken = {"differ", "same"} & set(predicates_of(ops))
-        if taken:
-            raise ValueError(f"the operators already name a predicate {sorted(taken)[0]!r}: no plain STRIPS form")
         lines += ["    (differ ?x0 ?x1)  ; static: two different objects or locations",
                   "    (same ?x0 - location ?x1 - location)  ; static: a location and itself"]
     lines.append("  )")

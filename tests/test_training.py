@@ -106,7 +106,8 @@ def test_two_process_ddp_ends_with_identical_weights(data, tmp_path):
            "--redirects", "2", "-m", "symlearn.cli.main", "train", "--data", str(data), "--out", str(run),
            "--preset", "quick", "--epochs", "1", "--config", str(_batch4(tmp_path)), "--quiet"]
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
-    ranks = "".join(f"\n--- {f.relative_to(logs)} ---\n{f.read_text()[-3000:]}" for f in sorted(logs.rglob("stderr.log")))
+    ranks = "".join(f"\n--- {f.relative_to(logs)} ---\n{f.read_text()[-3000:]}"
+                    for f in sorted(logs.rglob("stderr.log")))
     assert r.returncode == 0, r.stderr[-2000:] + ranks
     m = json.loads((run / "metrics.json").read_text())
     assert m["world_size"] == 2 and m["ranks_identical"] is True

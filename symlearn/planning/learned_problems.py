@@ -91,7 +91,8 @@ def export_learned_problems(run_dir: Path, problems_dir: Path, out: Path,
                          "goal_atoms": len(goal), "goal_believed_reached": goal <= init,
                          "problem_sha256": sha256_file(path)})
     manifest = {"format": FORMAT, "run": str(run_dir), **run_hashes(run_dir), "problems": str(problems_dir),
-                "goal_relations": list(goal_relations), "focus": focus, "equality": equality, "rows": rows, "versions": versions()}
+                "goal_relations": list(goal_relations), "focus": focus, "equality": equality, "rows": rows,
+                "versions": versions()}
     files[MANIFEST] = json.dumps(manifest, indent=1)
     atomic_write_folder(out, files)
     return manifest
